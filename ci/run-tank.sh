@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# The main job: installs what is missing, builds, runs the default tank scenario end to end and
+# writes its report to out/cras-tank/ (report.json, map.bt, polar.png, fan.png, map_top.png).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash ci/build.sh
+./build/sim/sonarbench run scenes/cras-tank.yaml --out "${1:-out/cras-tank}"

@@ -1,0 +1,40 @@
+#include "sonarbench/mapping/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+namespace sonarbench {
+
+void WriteFileAtomically(const std::string& path,
+                         const std::function<void(std::ostream&)>& write) {
+  const std::string temp = path + ".tmp." + std::to_string(::getpid());
+  try {
+    {
+      std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+      if (!out) throw std::runtime_error(path + ": cannot create " + temp);
+      write(out);
+      out.flush();
+      if (!out) throw std::runtime_error(path + ": write failed");
+    }
+    const int fd = ::open(temp.c_str(), O_RDONLY);
+    if (fd < 0 || ::fsync(fd) != 0) {
+      const std::string reason = std::strerror(errno);
+      if (fd >= 0) ::close(fd);
+      throw std::runtime_error(path + ": fsync failed: " + reason);
+    }
+    ::close(fd);
+    std::filesystem::rename(temp, path);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(temp, ignored);
+    throw;
+  }
+}
+
+}  // namespace sonarbench

@@ -1,0 +1,33 @@
+#include "sonarbench/mapping/mapper_config.hpp"
+
+namespace sonarbench::mapping {
+
+MapperConfig ReadMapperConfig(YamlReader& node) {
+  MapperConfig c;
+  node.Optional("resolution_m", c.resolution_m, InRange(0.001, 10.0));
+  node.Optional("rays_horizontal", c.rays_horizontal, IntInRange(1, 4096));
+  node.Optional("rays_vertical", c.rays_vertical, IntInRange(1, 4096));
+  if (auto detection = node.OptionalChild("detection")) {
+    std::string method = "threshold";
+    detection->Optional("method", method, OneOf({"threshold"}));
+    detection->Optional("threshold", c.detection.threshold, IntInRange(1, 255));
+    detection->Optional("smoothing_bins", c.detection.smoothing_bins, IntInRange(1, 99));
+    detection->Optional("min_run_bins", c.detection.min_run_bins, IntInRange(1, 1000));
+    detection->Optional("max_obstacles", c.detection.max_obstacles, IntInRange(1, 100));
+    detection->RejectUnknownKeys();
+    if (c.detection.smoothing_bins % 2 == 0) {
+      detection->Fail("smoothing_bins", "an odd number of bins (the window is centred)");
+    }
+  }
+  node.Optional("prob_hit", c.prob_hit, InRange(0.5, 1.0));
+  node.Optional("prob_miss", c.prob_miss, InRange(0.0, 0.5));
+  node.Optional("clamp_min", c.clamp_min, InRange(0.0, 0.5));
+  node.Optional("clamp_max", c.clamp_max, InRange(0.5, 1.0));
+  node.Optional("clear_without_obstacle", c.clear_without_obstacle);
+  node.Optional("free_range_m", c.free_range_m, NonNegative());
+  node.Optional("threads", c.threads, IntInRange(0, 1024));
+  node.RejectUnknownKeys();
+  return c;
+}
+
+}  // namespace sonarbench::mapping

@@ -1,0 +1,40 @@
+#pragma once
+
+#include <octomap/OcTree.h>
+
+#include <Eigen/Core>
+#include <span>
+
+#include "sonarbench/mapping/beam_volume.hpp"
+#include "sonarbench/sim/mesh.hpp"
+#include "sonarbench/sim/ray_tracer.hpp"
+
+namespace sonarbench::sim {
+
+/// Exact triangle / axis-aligned box overlap (separating axis theorem, Akenine-Möller 2001).
+/// Touching counts as overlapping, so a surface on a cell face marks both cells.
+[[nodiscard]] bool TriangleBoxOverlap(const Eigen::Vector3d& box_centre,
+                                      const Eigen::Vector3d& box_half_size,
+                                      const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                      const Eigen::Vector3d& c);
+
+/// Every cell of `key_space`'s grid whose box the surface of a mesh crosses.
+[[nodiscard]] mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
+                                             const octomap::OcTree& key_space);
+
+/// The sonar's pose and head angle for one beam.
+struct BeamPose {
+  Eigen::Isometry3d T_world_sonar = Eigen::Isometry3d::Identity();
+  double head_angle_rad = 0.0;
+};
+
+/// Cells a perfect sensor with the same beams, poses and range could see: the cell of the first
+/// surface along each ray of a dense regular rays_h × rays_v grid across every beam's full
+/// aperture. Rays that leave the scene or pass the maximum range see no cell.
+[[nodiscard]] mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer,
+                                                     std::span<const BeamPose> beams,
+                                                     const mapping::SensorGeometry& sensor,
+                                                     int rays_horizontal, int rays_vertical,
+                                                     const octomap::OcTree& key_space);
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <span>
+
+#include "sonarbench/sim/mesh.hpp"
+
+namespace sonarbench::sim {
+
+/// The first surface along a ray.
+struct Hit {
+  /// Distance from the ray origin [m].
+  float distance = 0.0f;
+  /// Unit geometric normal of the triangle hit (either side).
+  Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();
+  /// Index of the mesh hit, in the order the meshes were given.
+  std::uint32_t mesh = 0;
+};
+
+/// An Embree scene over a set of triangle meshes. Thread-safe for queries once constructed.
+class RayTracer {
+ public:
+  explicit RayTracer(std::span<const TriangleMesh> meshes);
+
+  /// The first hit along `direction` (unit) from `origin` within `max_distance` [m].
+  [[nodiscard]] std::optional<Hit> Intersect(const Eigen::Vector3f& origin,
+                                             const Eigen::Vector3f& direction,
+                                             float max_distance) const;
+
+ private:
+  struct DeviceDeleter {
+    void operator()(RTCDeviceTy* device) const { rtcReleaseDevice(device); }
+  };
+  struct SceneDeleter {
+    void operator()(RTCSceneTy* scene) const { rtcReleaseScene(scene); }
+  };
+  std::unique_ptr<RTCDeviceTy, DeviceDeleter> device_;
+  std::unique_ptr<RTCSceneTy, SceneDeleter> scene_;
+};
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,80 @@
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sonarbench/mapping/mapper_config.hpp"
+#include "sonarbench/sim/sensor_model.hpp"
+
+namespace sonarbench::sim {
+
+/// Acoustic properties of a surface.
+struct Material {
+  std::string name;
+  /// Backscatter at normal incidence, as a fraction of a perfect reflector's [0-1].
+  double reflectivity = 0.5;
+  /// Per-ray echo falls as cos^n of the incidence angle (n = 1 is Lambert's law per ray).
+  double backscatter_exponent = 1.0;
+};
+
+/// A procedural mesh, as the scene file describes it.
+struct MeshSpec {
+  enum class Type { kTank, kBox, kPlane, kHeightField };
+  std::string name;
+  Type type = Type::kBox;
+  /// kTank: inner size x, y, wall height; kBox: size; kPlane: size x, y (z ignored);
+  /// kHeightField: extent x, y (z ignored) [m].
+  std::array<double, 3> size_m{1, 1, 1};
+  /// Pose of the mesh frame in the world. kTank: centre of the floor; kBox: centre;
+  /// kPlane: centre, normal along the frame's z; kHeightField: centre at height 0.
+  Eigen::Isometry3d T_world_mesh = Eigen::Isometry3d::Identity();
+  /// kHeightField: grid spacing [m], and relief: height = amplitude·sin(2πx/λ)·cos(2πy/λ) plus a
+  /// seeded random roughness of the given standard deviation.
+  double cell_m = 0.1;
+  double amplitude_m = 0.0;
+  double wavelength_m = 5.0;
+  double roughness_m = 0.0;
+  std::size_t material = 0;
+};
+
+/// A waypoint of the vehicle: time [s] and pose of the vehicle in the world.
+struct Waypoint {
+  double time_s = 0.0;
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rpy_rad = Eigen::Vector3d::Zero();
+};
+
+/// Vehicle poses over time: linear in position, spherical-linear in attitude between waypoints,
+/// held constant before the first and after the last. One waypoint is a static vehicle.
+struct Trajectory {
+  std::vector<Waypoint> waypoints;
+  [[nodiscard]] Eigen::Isometry3d T_world_vehicle(double time_s) const;
+};
+
+/// A scenario: what is in the water, how the vehicle moves, the sonar, and how to map.
+struct Scene {
+  std::string name;
+  std::string file;
+  std::string sensor_model_file;
+  /// The sensor model; the scene's optional `sonar_mounting` (position_m, rpy_deg) replaces the
+  /// model's mounting, since where the sonar sits is the vehicle's business, not the sonar's.
+  SensorModel sensor;
+  std::vector<Material> materials;
+  std::vector<MeshSpec> meshes;
+  Trajectory trajectory;
+  /// Full head revolutions to simulate.
+  int sweeps = 1;
+  /// Head angle of the first beam [rad].
+  double start_head_angle_rad = 0.0;
+  /// Seed of every random draw in the run (overridable on the command line).
+  std::uint64_t seed = 1;
+  mapping::MapperConfig mapping;
+};
+
+/// Loads a scene YAML file and the sensor model it names (relative to the scene file).
+[[nodiscard]] Scene LoadScene(const std::string& path);
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <octomap/OcTree.h>
+
+#include <cstddef>
+
+#include "sonarbench/mapping/beam_volume.hpp"
+
+namespace sonarbench::sim {
+
+/// How a map compares with the ground truth. Cells are leaf cells at the map's resolution; a
+/// pruned inner node counts as all the leaf cells it stands for. Unknown cells (never updated)
+/// are neither occupied nor free: they lower coverage and recall, never precision.
+struct MapMetrics {
+  std::size_t truth_cells = 0;              ///< cells any mesh surface crosses
+  std::size_t observable_cells = 0;         ///< truth cells a perfect sensor could see
+  std::size_t occupied_cells = 0;           ///< cells the map holds occupied
+  std::size_t free_cells = 0;               ///< cells the map holds free
+  std::size_t true_positive_cells = 0;      ///< occupied ∩ truth
+  std::size_t observed_occupied_cells = 0;  ///< occupied ∩ observable
+  std::size_t known_observable_cells = 0;   ///< (occupied ∪ free) ∩ observable
+
+  /// true positives / occupied (0 when the map has no occupied cell).
+  double occupied_precision = 0.0;
+  /// occupied ∩ observable / observable (0 when nothing was observable).
+  double occupied_recall = 0.0;
+  /// Harmonic mean of precision and recall (0 when both are 0).
+  double occupied_f1 = 0.0;
+  /// known ∩ observable / observable: the share of visible surface the map has any belief about.
+  double coverage = 0.0;
+};
+
+/// Scores `map` against the surface cells `truth` and the subset `observable` a perfect sensor
+/// could see (cells of `observable` outside `truth` are ignored).
+[[nodiscard]] MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
+                                  const mapping::KeySet& observable);
+
+/// Leaf cells of `map` at its finest resolution, split by occupancy.
+struct MapCells {
+  mapping::KeySet occupied;
+  mapping::KeySet free;
+};
+[[nodiscard]] MapCells CollectMapCells(const octomap::OcTree& map);
+
+}  // namespace sonarbench::sim

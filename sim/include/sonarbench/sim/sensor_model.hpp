@@ -1,0 +1,54 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "sonarbench/mapping/sensor_geometry.hpp"
+
+namespace sonarbench::sim {
+
+/// What only the simulator needs of the sonar: how echoes form and are digitised. Echo power is
+/// relative to a perfect reflector (reflectivity 1) filling the beam at normal incidence and 1 m;
+/// `gain_db` scales echoes into receiver-output dB, the reference of every other level here.
+struct Acoustics {
+  /// Stratified-jittered ray samples across the horizontal and vertical aperture per beam.
+  int rays_horizontal = 4;
+  int rays_vertical = 160;
+  /// Rays cover this multiple of the nominal (-3 dB) beam widths, weighted by the pattern.
+  double aperture_scale = 1.0;
+  /// Net geometric loss of an area-scattering echo [dB per decade of range] (two-way spherical
+  /// spreading, 40 dB, less the growth of the ensonified area, 20 dB).
+  double spreading_db_per_decade = 20.0;
+  /// Two-way absorption [dB/m].
+  double absorption_db_per_m = 0.2;
+  /// Time-varied gain the sonar applies [dB per decade of range].
+  double tvg_db_per_decade = 20.0;
+  /// Receiver gain applied to echoes [dB].
+  double gain_db = 0.0;
+  /// Range extent of the transmitted pulse, c·τ/2 [m].
+  double pulse_length_m = 0.0375;
+  /// Mean background noise power at the receiver output [dB].
+  double noise_level_db = -40.0;
+  /// Multiplicative speckle: echo power scaled by an exponential draw of mean 1 (Rayleigh amplitude).
+  bool speckle = true;
+  /// Level mapped to intensity 0, and the span [dB] mapped onto 0..255 (the Micron's ADLow/ADSpan).
+  double ad_low_db = -40.0;
+  double ad_span_db = 40.0;
+  /// Mean self-reflection (vehicle body and transducer ringing) power per bin from bin 0, at the
+  /// receiver output [dB]; bins past the end of the list get none.
+  std::vector<double> self_reflection_db;
+};
+
+/// A sensor model file: `geometry` for the mapper, `acoustics` for the simulator.
+struct SensorModel {
+  std::string name;
+  mapping::SensorGeometry geometry;
+  Acoustics acoustics;
+};
+
+/// Loads a sensor model YAML file; throws InputError naming the file and key on bad input.
+[[nodiscard]] SensorModel LoadSensorModel(const std::string& path);
+/// Reads a sensor model from an already-open reader (the root of a sensor model file).
+[[nodiscard]] SensorModel ReadSensorModel(YamlReader& root);
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,30 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "sonarbench/sim/beam_synthesizer.hpp"
+#include "sonarbench/sim/ground_truth.hpp"
+#include "sonarbench/sim/scene.hpp"
+
+namespace sonarbench::sim {
+
+/// Number of beams a scene's run produces: sweeps × beams per revolution.
+[[nodiscard]] std::size_t ScenarioBeamCount(const Scene& scene);
+
+/// Time [s], head angle and sonar pose of beam `index` of a scene's run: the head steps by the
+/// sensor's step angle from the scene's start angle, one beam every 1/beams_per_second, and the
+/// sonar rides the vehicle's true pose at that beam's own time (motion distortion included).
+struct ScheduledBeam {
+  double time_s = 0.0;
+  BeamPose pose;
+};
+[[nodiscard]] ScheduledBeam ScheduleBeam(const Scene& scene, std::size_t index);
+
+/// Synthesises every beam of the scene's run, in time order, on `threads` threads (0 = all).
+/// Beam b draws only from DeriveSeed(seed, b): the output does not depend on the thread count.
+[[nodiscard]] std::vector<SynthesizedBeam> SimulateScene(const Scene& scene,
+                                                         const RayTracer& tracer,
+                                                         std::uint64_t seed, int threads);
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,101 @@
+#include "sonarbench/sim/beam_synthesizer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sonarbench/sim/random.hpp"
+
+namespace sonarbench::sim {
+
+BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tracer,
+                                 std::vector<Material> materials_by_mesh)
+    : sensor_(sensor), tracer_(tracer), materials_by_mesh_(std::move(materials_by_mesh)) {}
+
+std::uint8_t BeamSynthesizer::Quantise(double level_db) const {
+  const Acoustics& a = sensor_.acoustics;
+  const double scaled = std::round((level_db - a.ad_low_db) / a.ad_span_db * 255.0);
+  return static_cast<std::uint8_t>(std::clamp(scaled, 0.0, 255.0));
+}
+
+SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad,
+                                            const Eigen::Isometry3d& T_world_sonar,
+                                            std::uint64_t seed) const {
+  const mapping::SensorGeometry& g = sensor_.geometry;
+  const Acoustics& a = sensor_.acoustics;
+  const auto bins = static_cast<std::size_t>(g.num_bins);
+  const double max_range = g.MaxRangeM();
+  Rng rng(seed);
+
+  SynthesizedBeam out;
+  out.beam.time_s = time_s;
+  out.beam.head_angle_rad = head_angle_rad;
+  out.beam.T_world_sonar = T_world_sonar;
+  out.beam.bin_size_m = g.bin_size_m;
+  out.echo_power.assign(bins, 0.0);
+
+  const Eigen::Matrix3d R_world_beam =
+      T_world_sonar.linear() *
+      Eigen::AngleAxisd(head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3f origin = T_world_sonar.translation().cast<float>();
+  const double width_h = a.aperture_scale * g.beam_width_horizontal_rad;
+  const double width_v = a.aperture_scale * g.beam_width_vertical_rad;
+  const double k_h = 4.0 * std::log(2.0) / (g.beam_width_horizontal_rad * g.beam_width_horizontal_rad);
+  const double k_v = 4.0 * std::log(2.0) / (g.beam_width_vertical_rad * g.beam_width_vertical_rad);
+  const double pulse_bins = a.pulse_length_m / g.bin_size_m;
+
+  double weight_sum = 0.0;
+  for (int i = 0; i < a.rays_horizontal; ++i) {
+    for (int j = 0; j < a.rays_vertical; ++j) {
+      const double theta = ((i + rng.Uniform()) / a.rays_horizontal - 0.5) * width_h;
+      const double epsilon = ((j + rng.Uniform()) / a.rays_vertical - 0.5) * width_v;
+      const double pattern = std::exp(-k_h * theta * theta - k_v * epsilon * epsilon);
+      weight_sum += pattern;
+      const Eigen::Vector3f direction =
+          (R_world_beam * mapping::SonarRayDirection(theta, epsilon)).cast<float>();
+      const auto hit = tracer_.Intersect(origin, direction, static_cast<float>(max_range));
+      if (!hit) continue;
+      const double range = std::max<double>(hit->distance, g.bin_size_m);
+      if (!out.truth.first_hit_range_m || range < *out.truth.first_hit_range_m) {
+        out.truth.first_hit_range_m = range;
+        out.truth.first_hit_mesh = hit->mesh;
+      }
+      const Material& material = materials_by_mesh_[hit->mesh];
+      const double cos_incidence = std::abs(hit->normal.dot(direction));
+      const double loss_db = (a.spreading_db_per_decade - a.tvg_db_per_decade) * std::log10(range) +
+                             a.absorption_db_per_m * range;
+      const double power = pattern * material.reflectivity *
+                           std::pow(cos_incidence, material.backscatter_exponent) *
+                           std::pow(10.0, -loss_db / 10.0);
+      // The echo of a point at r lasts while the pulse passes it: it is heard at every range in
+      // [r, r + L), so each bin gets the power times the fraction of the bin that span covers.
+      const double start = range / g.bin_size_m;
+      const double end = start + pulse_bins;
+      for (auto k = static_cast<std::size_t>(start); k < bins && static_cast<double>(k) < end; ++k) {
+        const double overlap =
+            std::min(static_cast<double>(k + 1), end) - std::max(static_cast<double>(k), start);
+        out.echo_power[k] += power * overlap;
+      }
+    }
+  }
+  for (double& p : out.echo_power) p /= weight_sum;
+
+  if (const auto axis = tracer_.Intersect(
+          origin, (R_world_beam * Eigen::Vector3d::UnitX()).cast<float>(),
+          static_cast<float>(max_range))) {
+    out.truth.axis_hit_range_m = axis->distance;
+  }
+
+  out.beam.intensities.resize(bins);
+  const double noise_power = std::pow(10.0, a.noise_level_db / 10.0);
+  const double gain = std::pow(10.0, a.gain_db / 10.0);
+  for (std::size_t k = 0; k < bins; ++k) {
+    double signal = gain * out.echo_power[k];
+    if (k < a.self_reflection_db.size()) signal += std::pow(10.0, a.self_reflection_db[k] / 10.0);
+    if (a.speckle) signal *= rng.Exponential();
+    const double power = signal + noise_power * rng.Exponential();
+    out.beam.intensities[k] = Quantise(10.0 * std::log10(std::max(power, 1e-30)));
+  }
+  return out;
+}
+
+}  // namespace sonarbench::sim

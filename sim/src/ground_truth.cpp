@@ -1,0 +1,121 @@
+#include "sonarbench/sim/ground_truth.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace sonarbench::sim {
+namespace {
+
+using Eigen::Vector3d;
+
+// Projects the triangle (v0, v1, v2) and the box (half size h, centred at the origin) on `axis`;
+// true if the projections are disjoint, i.e. `axis` separates them.
+bool Separates(const Vector3d& axis, const Vector3d& v0, const Vector3d& v1, const Vector3d& v2,
+               const Vector3d& h) {
+  const double p0 = axis.dot(v0);
+  const double p1 = axis.dot(v1);
+  const double p2 = axis.dot(v2);
+  const double r = h.x() * std::abs(axis.x()) + h.y() * std::abs(axis.y()) + h.z() * std::abs(axis.z());
+  return std::min({p0, p1, p2}) > r || std::max({p0, p1, p2}) < -r;
+}
+
+}  // namespace
+
+bool TriangleBoxOverlap(const Vector3d& box_centre, const Vector3d& box_half_size,
+                        const Vector3d& a, const Vector3d& b, const Vector3d& c) {
+  const Vector3d v0 = a - box_centre;
+  const Vector3d v1 = b - box_centre;
+  const Vector3d v2 = c - box_centre;
+  const Vector3d& h = box_half_size;
+  // The box's face normals.
+  for (int i = 0; i < 3; ++i) {
+    if (std::min({v0[i], v1[i], v2[i]}) > h[i] || std::max({v0[i], v1[i], v2[i]}) < -h[i]) {
+      return false;
+    }
+  }
+  // The triangle's normal.
+  const Vector3d e0 = v1 - v0;
+  const Vector3d e1 = v2 - v1;
+  const Vector3d e2 = v0 - v2;
+  const Vector3d normal = e0.cross(e1);
+  if (Separates(normal, v0, v1, v2, h)) return false;
+  // The nine cross products of box axes and triangle edges.
+  for (const Vector3d& edge : {e0, e1, e2}) {
+    for (int i = 0; i < 3; ++i) {
+      const Vector3d axis = Vector3d::Unit(i).cross(edge);
+      if (axis.squaredNorm() > 0.0 && Separates(axis, v0, v1, v2, h)) return false;
+    }
+  }
+  return true;
+}
+
+mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
+                               const octomap::OcTree& key_space) {
+  mapping::KeySet cells;
+  const double resolution = key_space.getResolution();
+  const Vector3d half(0.5 * resolution, 0.5 * resolution, 0.5 * resolution);
+  for (const TriangleMesh& mesh : meshes) {
+    for (const auto& triangle : mesh.triangles) {
+      const Vector3d a = mesh.vertices[triangle[0]].cast<double>();
+      const Vector3d b = mesh.vertices[triangle[1]].cast<double>();
+      const Vector3d c = mesh.vertices[triangle[2]].cast<double>();
+      const Vector3d lo = a.cwiseMin(b).cwiseMin(c);
+      const Vector3d hi = a.cwiseMax(b).cwiseMax(c);
+      octomap::OcTreeKey key_lo;
+      octomap::OcTreeKey key_hi;
+      if (!key_space.coordToKeyChecked(lo.x(), lo.y(), lo.z(), key_lo) ||
+          !key_space.coordToKeyChecked(hi.x(), hi.y(), hi.z(), key_hi)) {
+        continue;  // outside OctoMap's ±(2^15 · resolution) world
+      }
+      // A vertex on a cell face touches the neighbour too: widen the candidate range by one.
+      octomap::OcTreeKey key;
+      for (int x = key_lo[0] - 1; x <= key_hi[0] + 1; ++x) {
+        for (int y = key_lo[1] - 1; y <= key_hi[1] + 1; ++y) {
+          for (int z = key_lo[2] - 1; z <= key_hi[2] + 1; ++z) {
+            key = octomap::OcTreeKey(static_cast<octomap::key_type>(x),
+                                     static_cast<octomap::key_type>(y),
+                                     static_cast<octomap::key_type>(z));
+            const octomap::point3d centre = key_space.keyToCoord(key);
+            if (TriangleBoxOverlap(Vector3d(centre.x(), centre.y(), centre.z()), half, a, b, c)) {
+              cells.insert(key);
+            }
+          }
+        }
+      }
+    }
+  }
+  return cells;
+}
+
+mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer, std::span<const BeamPose> beams,
+                                       const mapping::SensorGeometry& sensor, int rays_horizontal,
+                                       int rays_vertical, const octomap::OcTree& key_space) {
+  const std::vector<Eigen::Vector3d> directions =
+      mapping::BeamRayDirections(sensor, rays_horizontal, rays_vertical);
+  const auto max_range = static_cast<float>(sensor.MaxRangeM());
+  std::vector<mapping::KeySet> per_thread(static_cast<std::size_t>(omp_get_max_threads()));
+  const auto count = static_cast<std::int64_t>(beams.size());
+#pragma omp parallel for schedule(dynamic, 8)
+  for (std::int64_t b = 0; b < count; ++b) {
+    const BeamPose& pose = beams[static_cast<std::size_t>(b)];
+    mapping::KeySet& cells = per_thread[static_cast<std::size_t>(omp_get_thread_num())];
+    const Eigen::Matrix3d R = pose.T_world_sonar.linear() *
+                              Eigen::AngleAxisd(pose.head_angle_rad, Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Vector3f origin = pose.T_world_sonar.translation().cast<float>();
+    for (const Vector3d& d : directions) {
+      const Eigen::Vector3f direction = (R * d).cast<float>();
+      if (const auto hit = tracer.Intersect(origin, direction, max_range)) {
+        const Eigen::Vector3f p = origin + hit->distance * direction;
+        octomap::OcTreeKey key;
+        if (key_space.coordToKeyChecked(p.x(), p.y(), p.z(), key)) cells.insert(key);
+      }
+    }
+  }
+  mapping::KeySet all;
+  for (const auto& cells : per_thread) all.insert(cells.begin(), cells.end());
+  return all;
+}
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,109 @@
+#include "sonarbench/sim/images.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "sonarbench/mapping/atomic_file.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+void WritePng(const std::string& path, const cv::Mat& image) {
+  std::vector<uchar> bytes;
+  if (!cv::imencode(".png", image, bytes)) throw std::runtime_error(path + ": PNG encoding failed");
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  });
+}
+
+}  // namespace
+
+void WritePolarImage(const std::string& path, std::span<const mapping::Beam> sweep) {
+  std::size_t bins = 0;
+  for (const auto& beam : sweep) bins = std::max(bins, beam.intensities.size());
+  cv::Mat gray(static_cast<int>(sweep.size()), static_cast<int>(bins), CV_8UC1, cv::Scalar(0));
+  for (std::size_t r = 0; r < sweep.size(); ++r) {
+    std::copy(sweep[r].intensities.begin(), sweep[r].intensities.end(),
+              gray.ptr<uchar>(static_cast<int>(r)));
+  }
+  cv::Mat colour;
+  cv::applyColorMap(gray, colour, cv::COLORMAP_INFERNO);
+  cv::resize(colour, colour, cv::Size(), 2.0, 2.0, cv::INTER_NEAREST);
+  WritePng(path, colour);
+}
+
+void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep, double pixel_m) {
+  double max_range = 0.0;
+  for (const auto& beam : sweep) {
+    max_range = std::max(max_range, beam.bin_size_m * static_cast<double>(beam.intensities.size()));
+  }
+  const int half = static_cast<int>(std::ceil(max_range / pixel_m));
+  cv::Mat gray(2 * half + 1, 2 * half + 1, CV_8UC1, cv::Scalar(0));
+  if (sweep.empty()) {
+    WritePng(path, gray);
+    return;
+  }
+  for (int row = 0; row < gray.rows; ++row) {
+    for (int col = 0; col < gray.cols; ++col) {
+      const double x = (col - half) * pixel_m;
+      const double y = (half - row) * pixel_m;
+      const double bearing = std::atan2(y, x);
+      const mapping::Beam* nearest = nullptr;
+      double best = 1e9;
+      for (const auto& beam : sweep) {
+        const double d = std::abs(std::remainder(beam.head_angle_rad - bearing, 2 * std::numbers::pi));
+        if (d < best) {
+          best = d;
+          nearest = &beam;
+        }
+      }
+      const auto bin = static_cast<std::size_t>(std::hypot(x, y) / nearest->bin_size_m);
+      if (bin < nearest->intensities.size()) gray.at<uchar>(row, col) = nearest->intensities[bin];
+    }
+  }
+  cv::Mat colour;
+  cv::applyColorMap(gray, colour, cv::COLORMAP_INFERNO);
+  WritePng(path, colour);
+}
+
+void WriteTopDownImage(const std::string& path, const MapCells& map, const mapping::KeySet& truth,
+                       const mapping::KeySet& observable) {
+  int lo_x = 1 << 16, lo_y = 1 << 16, hi_x = 0, hi_y = 0;
+  auto extend = [&](const mapping::KeySet& cells) {
+    for (const auto& k : cells) {
+      lo_x = std::min<int>(lo_x, k[0]);
+      hi_x = std::max<int>(hi_x, k[0]);
+      lo_y = std::min<int>(lo_y, k[1]);
+      hi_y = std::max<int>(hi_y, k[1]);
+    }
+  };
+  extend(map.occupied);
+  extend(map.free);
+  extend(truth);
+  if (hi_x < lo_x) lo_x = hi_x = lo_y = hi_y = 0;
+  // Per column: 1 free, 2 missed truth, 3 false positive, 4 true positive (higher wins).
+  cv::Mat label(hi_y - lo_y + 1, hi_x - lo_x + 1, CV_8UC1, cv::Scalar(0));
+  auto mark = [&](const octomap::OcTreeKey& k, uchar value) {
+    uchar& cell = label.at<uchar>(hi_y - k[1], k[0] - lo_x);
+    cell = std::max(cell, value);
+  };
+  for (const auto& k : map.free) mark(k, 1);
+  for (const auto& k : observable) {
+    if (truth.contains(k) && !map.occupied.contains(k)) mark(k, 2);
+  }
+  for (const auto& k : map.occupied) mark(k, truth.contains(k) ? 4 : 3);
+  const cv::Vec3b palette[] = {{0, 0, 0}, {70, 70, 70}, {255, 120, 0}, {0, 0, 230}, {0, 210, 0}};
+  cv::Mat colour(label.size(), CV_8UC3);
+  for (int r = 0; r < label.rows; ++r) {
+    for (int c = 0; c < label.cols; ++c) colour.at<cv::Vec3b>(r, c) = palette[label.at<uchar>(r, c)];
+  }
+  const double scale = std::max(1.0, 400.0 / std::max(label.rows, label.cols));
+  cv::resize(colour, colour, cv::Size(), scale, scale, cv::INTER_NEAREST);
+  WritePng(path, colour);
+}
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,73 @@
+#include "sonarbench/sim/ray_tracer.hpp"
+
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace sonarbench::sim {
+
+RayTracer::RayTracer(std::span<const TriangleMesh> meshes)
+    : device_(rtcNewDevice(nullptr)) {
+  if (!device_) {
+    throw std::runtime_error("Embree: cannot create a device (error " +
+                             std::to_string(rtcGetDeviceError(nullptr)) + ")");
+  }
+  scene_.reset(rtcNewScene(device_.get()));
+  rtcSetSceneBuildQuality(scene_.get(), RTC_BUILD_QUALITY_HIGH);
+  for (std::size_t m = 0; m < meshes.size(); ++m) {
+    const TriangleMesh& mesh = meshes[m];
+    RTCGeometry geometry = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+        mesh.vertices.size()));
+    auto* indices = static_cast<std::uint32_t*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(std::uint32_t), mesh.triangles.size()));
+    if (vertices == nullptr || indices == nullptr) {
+      rtcReleaseGeometry(geometry);
+      throw std::runtime_error("Embree: cannot allocate buffers for mesh " + std::to_string(m));
+    }
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+      std::memcpy(vertices + 3 * v, mesh.vertices[v].data(), 3 * sizeof(float));
+    }
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      std::memcpy(indices + 3 * t, mesh.triangles[t].data(), 3 * sizeof(std::uint32_t));
+    }
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometryByID(scene_.get(), geometry, static_cast<unsigned>(m));
+    rtcReleaseGeometry(geometry);
+  }
+  rtcCommitScene(scene_.get());
+  if (const RTCError error = rtcGetDeviceError(device_.get()); error != RTC_ERROR_NONE) {
+    throw std::runtime_error("Embree: scene build failed (error " + std::to_string(error) + ")");
+  }
+}
+
+std::optional<Hit> RayTracer::Intersect(const Eigen::Vector3f& origin,
+                                        const Eigen::Vector3f& direction,
+                                        float max_distance) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit query{};
+  query.ray.org_x = origin.x();
+  query.ray.org_y = origin.y();
+  query.ray.org_z = origin.z();
+  query.ray.dir_x = direction.x();
+  query.ray.dir_y = direction.y();
+  query.ray.dir_z = direction.z();
+  query.ray.tnear = 0.0f;
+  query.ray.tfar = max_distance;
+  query.ray.mask = std::numeric_limits<unsigned>::max();
+  query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(scene_.get(), &context, &query);
+  if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
+  Hit hit;
+  hit.distance = query.ray.tfar;
+  hit.normal = Eigen::Vector3f(query.hit.Ng_x, query.hit.Ng_y, query.hit.Ng_z).normalized();
+  hit.mesh = query.hit.geomID;
+  return hit;
+}
+
+}  // namespace sonarbench::sim

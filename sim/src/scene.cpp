@@ -1,0 +1,158 @@
+#include "sonarbench/sim/scene.hpp"
+
+#include <filesystem>
+
+#include "sonarbench/mapping/error.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+using mapping::kDegToRad;
+
+Eigen::Vector3d ToVector(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+
+Eigen::Isometry3d ReadPose(YamlReader& node) {
+  std::array<double, 3> position{0, 0, 0};
+  std::array<double, 3> rpy_deg{0, 0, 0};
+  node.Optional("position_m", position);
+  node.Optional("rpy_deg", rpy_deg);
+  return mapping::PoseFromXyzRpy(ToVector(position), ToVector(rpy_deg) * kDegToRad);
+}
+
+MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
+  MeshSpec m;
+  std::string type;
+  node.Required("name", m.name);
+  node.Required("type", type, OneOf({"tank", "box", "plane", "height_field"}));
+  m.type = type == "tank"    ? MeshSpec::Type::kTank
+           : type == "plane" ? MeshSpec::Type::kPlane
+           : type == "box"   ? MeshSpec::Type::kBox
+                             : MeshSpec::Type::kHeightField;
+  node.Required("size_m", m.size_m,
+                YamlReader::Check<std::array<double, 3>>(
+                    [](const std::array<double, 3>& s) -> std::optional<std::string> {
+                      if (s[0] > 0 && s[1] > 0 && s[2] >= 0) return std::nullopt;
+                      return "sizes x > 0, y > 0, z >= 0";
+                    }));
+  m.T_world_mesh = ReadPose(node);
+  if (m.type == MeshSpec::Type::kHeightField) {
+    node.Required("cell_m", m.cell_m, Positive());
+    node.Optional("amplitude_m", m.amplitude_m, NonNegative());
+    node.Optional("wavelength_m", m.wavelength_m, Positive());
+    node.Optional("roughness_m", m.roughness_m, NonNegative());
+  }
+  std::string material;
+  node.Required("material", material);
+  bool found = false;
+  for (std::size_t i = 0; i < materials.size(); ++i) {
+    if (materials[i].name == material) {
+      m.material = i;
+      found = true;
+    }
+  }
+  if (!found && !material.empty()) {
+    node.Fail("material", "the name of a material under 'materials', got '" + material + "'");
+  }
+  node.RejectUnknownKeys();
+  return m;
+}
+
+Trajectory ReadTrajectory(YamlReader& node) {
+  Trajectory t;
+  std::string type;
+  node.Required("type", type, OneOf({"static", "waypoints"}));
+  if (type == "static") {
+    Waypoint w;
+    std::array<double, 3> position{0, 0, 0};
+    std::array<double, 3> rpy_deg{0, 0, 0};
+    node.Required("position_m", position);
+    node.Optional("rpy_deg", rpy_deg);
+    w.position_m = ToVector(position);
+    w.rpy_rad = ToVector(rpy_deg) * kDegToRad;
+    t.waypoints.push_back(w);
+  } else {
+    for (YamlReader& item : node.Sequence("waypoints")) {
+      Waypoint w;
+      std::array<double, 3> position{0, 0, 0};
+      std::array<double, 3> rpy_deg{0, 0, 0};
+      item.Required("time_s", w.time_s, NonNegative());
+      item.Required("position_m", position);
+      item.Optional("rpy_deg", rpy_deg);
+      item.RejectUnknownKeys();
+      w.position_m = ToVector(position);
+      w.rpy_rad = ToVector(rpy_deg) * kDegToRad;
+      if (!t.waypoints.empty() && w.time_s <= t.waypoints.back().time_s) {
+        item.Fail("time_s", "a time later than the previous waypoint's");
+      }
+      t.waypoints.push_back(w);
+    }
+  }
+  node.RejectUnknownKeys();
+  return t;
+}
+
+}  // namespace
+
+Eigen::Isometry3d Trajectory::T_world_vehicle(double time_s) const {
+  auto pose_of = [](const Waypoint& w) { return mapping::PoseFromXyzRpy(w.position_m, w.rpy_rad); };
+  if (time_s <= waypoints.front().time_s) return pose_of(waypoints.front());
+  if (time_s >= waypoints.back().time_s) return pose_of(waypoints.back());
+  std::size_t i = 1;
+  while (waypoints[i].time_s < time_s) ++i;
+  const Waypoint& a = waypoints[i - 1];
+  const Waypoint& b = waypoints[i];
+  const double s = (time_s - a.time_s) / (b.time_s - a.time_s);
+  const Eigen::Quaterniond qa(pose_of(a).linear());
+  const Eigen::Quaterniond qb(pose_of(b).linear());
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = qa.slerp(s, qb).toRotationMatrix();
+  pose.translation() = (1.0 - s) * a.position_m + s * b.position_m;
+  return pose;
+}
+
+Scene LoadScene(const std::string& path) {
+  Scene scene;
+  scene.file = path;
+  YamlReader root = YamlReader::FromFile(path);
+  root.Required("name", scene.name);
+  root.Required("sensor_model", scene.sensor_model_file);
+  root.Optional("seed", scene.seed);
+  root.Required("sweeps", scene.sweeps, IntInRange(1, 100000));
+  double start_deg = 0.0;
+  root.Optional("start_head_angle_deg", start_deg, InRange(-360.0, 360.0));
+  scene.start_head_angle_rad = start_deg * kDegToRad;
+
+  for (YamlReader& item : root.Sequence("materials")) {
+    Material m;
+    item.Required("name", m.name);
+    item.Required("reflectivity", m.reflectivity, InRange(0.0, 1.0));
+    item.Optional("backscatter_exponent", m.backscatter_exponent, InRange(0.0, 100.0));
+    item.RejectUnknownKeys();
+    scene.materials.push_back(m);
+  }
+  for (YamlReader& item : root.Sequence("meshes")) {
+    scene.meshes.push_back(ReadMesh(item, scene.materials));
+  }
+  YamlReader trajectory = root.Child("trajectory");
+  scene.trajectory = ReadTrajectory(trajectory);
+  std::optional<Eigen::Isometry3d> T_vehicle_sonar;
+  if (auto mounting = root.OptionalChild("sonar_mounting")) {
+    T_vehicle_sonar = ReadPose(*mounting);
+    mounting->RejectUnknownKeys();
+  }
+  if (auto mapping = root.OptionalChild("mapping")) {
+    scene.mapping = mapping::ReadMapperConfig(*mapping);
+  }
+  root.RejectUnknownKeys();
+  root.ThrowIfErrors();
+
+  // The sensor model is its own file, read (and its errors reported) only once the scene is sound.
+  std::filesystem::path sensor_path(scene.sensor_model_file);
+  if (sensor_path.is_relative()) sensor_path = std::filesystem::path(root.Directory()) / sensor_path;
+  scene.sensor_model_file = sensor_path.lexically_normal().string();
+  scene.sensor = LoadSensorModel(scene.sensor_model_file);
+  if (T_vehicle_sonar) scene.sensor.geometry.T_vehicle_sonar = *T_vehicle_sonar;
+  return scene;
+}
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,37 @@
+#include "sonarbench/sim/sensor_model.hpp"
+
+namespace sonarbench::sim {
+
+SensorModel ReadSensorModel(YamlReader& root) {
+  SensorModel model;
+  root.Required("name", model.name);
+  YamlReader geometry = root.Child("geometry");
+  model.geometry = mapping::ReadSensorGeometry(geometry);
+  YamlReader node = root.Child("acoustics");
+  Acoustics& a = model.acoustics;
+  node.Optional("rays_horizontal", a.rays_horizontal, IntInRange(1, 1024));
+  node.Optional("rays_vertical", a.rays_vertical, IntInRange(1, 8192));
+  node.Optional("aperture_scale", a.aperture_scale, InRange(0.1, 4.0));
+  node.Optional("spreading_db_per_decade", a.spreading_db_per_decade, InRange(0.0, 80.0));
+  node.Optional("absorption_db_per_m", a.absorption_db_per_m, InRange(0.0, 100.0));
+  node.Optional("tvg_db_per_decade", a.tvg_db_per_decade, InRange(0.0, 80.0));
+  node.Optional("gain_db", a.gain_db, InRange(-200.0, 200.0));
+  node.Optional("pulse_length_m", a.pulse_length_m, Positive());
+  node.Optional("noise_level_db", a.noise_level_db, InRange(-300.0, 100.0));
+  node.Optional("speckle", a.speckle);
+  node.Optional("ad_low_db", a.ad_low_db, InRange(-300.0, 100.0));
+  node.Optional("ad_span_db", a.ad_span_db, InRange(1.0, 200.0));
+  node.Optional("self_reflection_db", a.self_reflection_db);
+  node.RejectUnknownKeys();
+  root.RejectUnknownKeys();
+  return model;
+}
+
+SensorModel LoadSensorModel(const std::string& path) {
+  YamlReader root = YamlReader::FromFile(path);
+  SensorModel model = ReadSensorModel(root);
+  root.ThrowIfErrors();
+  return model;
+}
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,123 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/mapping/mapper_config.hpp"
+#include "sonarbench/sim/scene.hpp"
+#include "test_util.hpp"
+
+namespace sonarbench {
+namespace {
+
+// The message of the InputError that `f` throws, or a failure if it throws none.
+template <typename F>
+::testing::AssertionResult ThrowsInputErrorWith(F&& f, const std::vector<std::string>& parts) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    for (const auto& part : parts) {
+      if (message.find(part) == std::string::npos) {
+        return ::testing::AssertionFailure()
+               << "message lacks \"" << part << "\"; message was:\n" << message;
+      }
+    }
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure() << "no InputError thrown";
+}
+
+mapping::MapperConfig ReadMapping(const std::string& text) {
+  YamlReader reader = YamlReader::FromString(text, "scene.yaml");
+  mapping::MapperConfig config = mapping::ReadMapperConfig(reader);
+  reader.ThrowIfErrors();
+  return config;
+}
+
+TEST(YamlReader, DefaultsComeFromTheStruct) {
+  const mapping::MapperConfig config = ReadMapping("resolution_m: 0.1\n");
+  EXPECT_DOUBLE_EQ(config.resolution_m, 0.1);
+  EXPECT_EQ(config.rays_horizontal, mapping::MapperConfig{}.rays_horizontal);
+  EXPECT_EQ(config.rays_vertical, mapping::MapperConfig{}.rays_vertical);
+}
+
+TEST(YamlReader, UnknownKeyNamesFileLineAndKey) {
+  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nray_horizontal: 3\n"); },
+                                   {"scene.yaml:2:1", "'ray_horizontal'", "unknown key"}));
+}
+
+TEST(YamlReader, OutOfRangeValueNamesKeyAndExpectation) {
+  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("rays_vertical: 0\n"); },
+                                   {"scene.yaml:1:16", "'rays_vertical'", "an integer in [1, 4096]",
+                                    "got '0'"}));
+}
+
+TEST(YamlReader, WrongTypeAndNestedKeyPath) {
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [] { (void)ReadMapping("detection:\n  threshold: high\n"); },
+      {"scene.yaml:2:14", "'detection.threshold'", "expected an integer", "got 'high'"}));
+}
+
+TEST(YamlReader, DuplicateKeyIsAnError) {
+  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nresolution_m: 0.2\n"); },
+                                   {"scene.yaml:2:1", "'resolution_m'", "duplicate key"}));
+}
+
+TEST(YamlReader, ReportsEveryBadFieldAtOnce) {
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [] { (void)ReadMapping("resolution_m: -1\nrays_vertical: 0\nbogus: 1\n"); },
+      {"'resolution_m'", "'rays_vertical'", "'bogus'"}));
+}
+
+TEST(YamlReader, NonFiniteNumbersAreRejected) {
+  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: .nan\n"); },
+                                   {"'resolution_m'", "a finite number"}));
+}
+
+TEST(YamlReader, SyntaxErrorNamesFileAndLine) {
+  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("a: [1, 2\nb: 3\n"); },
+                                   {"scene.yaml:", "invalid YAML"}));
+}
+
+TEST(SceneFile, ShippedScenesLoad) {
+  for (const char* name : {"scenes/cras-tank.yaml", "scenes/seabed.yaml"}) {
+    SCOPED_TRACE(name);
+    const sim::Scene scene = sim::LoadScene(test::SourcePath(name));
+    EXPECT_FALSE(scene.meshes.empty());
+    EXPECT_EQ(scene.sensor.geometry.num_bins, 399);
+    EXPECT_EQ(scene.sensor.geometry.BeamsPerSweep(), 200);
+  }
+}
+
+TEST(SceneFile, BadSceneNamesItsFileAndKey) {
+  test::TempDir dir;
+  const std::string path = (dir.path() / "bad.yaml").string();
+  std::ifstream in(test::SourcePath("scenes/cras-tank.yaml"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find("sweeps: 27"), 10, "sweeps: -3");
+  text.replace(text.find("sensor_model: ../sensor-models/shad-micron.yaml"), 47,
+               "sensor_model: " + test::SourcePath("sensor-models/shad-micron.yaml"));
+  std::ofstream(path) << text;
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
+                                   {path, "'sweeps'", "got '-3'"}));
+}
+
+TEST(SceneFile, UnknownMaterialIsNamed) {
+  test::TempDir dir;
+  const std::string path = (dir.path() / "bad.yaml").string();
+  std::ofstream(path) << "name: x\nsensor_model: " << test::SourcePath("sensor-models/shad-micron.yaml")
+                      << "\nsweeps: 1\nmaterials:\n  - {name: rock, reflectivity: 0.5}\n"
+                      << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: mud}\n"
+                      << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
+                                   {"bad.yaml:7:", "'meshes[0].material'", "'mud'"}));
+}
+
+TEST(SceneFile, MissingFileIsAnInputError) {
+  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)sim::LoadScene("/nonexistent/scene.yaml"); },
+                                   {"/nonexistent/scene.yaml", "cannot open"}));
+}
+
+}  // namespace
+}  // namespace sonarbench

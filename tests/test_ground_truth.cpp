@@ -1,0 +1,123 @@
+#include <gtest/gtest.h>
+
+#include "sonarbench/sim/ground_truth.hpp"
+#include "sonarbench/sim/score.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+using Eigen::Vector3d;
+
+TEST(TriangleBoxOverlap, AnalyticCases) {
+  const Vector3d centre(0, 0, 0);
+  const Vector3d half(0.5, 0.5, 0.5);
+  // Inside, crossing, far away.
+  EXPECT_TRUE(TriangleBoxOverlap(centre, half, {-0.1, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}));
+  EXPECT_TRUE(TriangleBoxOverlap(centre, half, {-5, -5, 0}, {5, -5, 0}, {0, 5, 0}));
+  EXPECT_FALSE(TriangleBoxOverlap(centre, half, {2, 2, 2}, {3, 2, 2}, {2, 3, 2}));
+  // Touching a face counts.
+  EXPECT_TRUE(TriangleBoxOverlap(centre, half, {0.5, -1, -1}, {0.5, 1, -1}, {0.5, 0, 1}));
+  EXPECT_FALSE(TriangleBoxOverlap(centre, half, {0.5001, -1, -1}, {0.5001, 1, -1}, {0.5001, 0, 1}));
+  // Bounding boxes overlap but the triangle passes beside the corner: only an edge cross-product
+  // axis separates them. The plane x + y = 1.2 misses the box (its corner has x + y = 1).
+  EXPECT_FALSE(TriangleBoxOverlap(centre, half, {1.2, 0, -1}, {0, 1.2, -1}, {0.6, 0.6, 1}));
+  EXPECT_TRUE(TriangleBoxOverlap(centre, half, {0.9, 0, -1}, {0, 0.9, -1}, {0.45, 0.45, 1}));
+}
+
+// A 0.98 m square plane at z = 0.012 m lies inside the cell layer [0, 0.05) and, spanning
+// (-0.49, 0.49), inside the 20 cells [-0.5, 0.5) per side, touching none of their faces:
+// exactly 20 × 20 cells.
+TEST(VoxelizeMeshes, PlaneCellsCanBeCounted) {
+  MeshSpec spec;
+  spec.type = MeshSpec::Type::kPlane;
+  spec.size_m = {0.98, 0.98, 0.0};
+  spec.T_world_mesh.translation() = Vector3d(0, 0, 0.012);
+  const std::vector<TriangleMesh> meshes{BuildMesh(spec, 0)};
+  const octomap::OcTree key_space(0.05);
+  const mapping::KeySet cells = VoxelizeMeshes(meshes, key_space);
+  EXPECT_EQ(cells.size(), 400u);
+  for (const auto& key : cells) {
+    const auto c = key_space.keyToCoord(key);
+    EXPECT_NEAR(c.z(), 0.025, 1e-6);
+    EXPECT_LT(std::abs(c.x()), 0.5);
+    EXPECT_LT(std::abs(c.y()), 0.5);
+  }
+}
+
+// A box 0.3 m on a side, centred in a cell block, has 6 faces of 6 × 6 cells; the shell of a
+// 6 × 6 × 6 block is 6³ - 4³ = 152 cells.
+TEST(VoxelizeMeshes, BoxShellCellsCanBeCounted) {
+  MeshSpec spec;
+  spec.type = MeshSpec::Type::kBox;
+  spec.size_m = {0.29, 0.29, 0.29};
+  spec.T_world_mesh.translation() = Vector3d(0.15, 0.15, 0.15);
+  const std::vector<TriangleMesh> meshes{BuildMesh(spec, 0)};
+  const octomap::OcTree key_space(0.05);
+  EXPECT_EQ(VoxelizeMeshes(meshes, key_space).size(), 152u);
+}
+
+octomap::OcTree MapWith(const mapping::KeySet& occupied, const mapping::KeySet& free) {
+  octomap::OcTree tree(0.05);
+  for (const auto& k : occupied) tree.updateNode(k, true);
+  for (const auto& k : free) tree.updateNode(k, false);
+  return tree;
+}
+
+mapping::KeySet Row(int from, int to) {
+  mapping::KeySet cells;
+  for (int x = from; x < to; ++x) cells.insert(octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + x), 32768, 32768));
+  return cells;
+}
+
+TEST(ScoreMap, IdenticalMapAndTruthScoreOne) {
+  const mapping::KeySet truth = Row(0, 10);
+  const MapMetrics m = ScoreMap(MapWith(truth, {}), truth, truth);
+  EXPECT_EQ(m.occupied_precision, 1.0);
+  EXPECT_EQ(m.occupied_recall, 1.0);
+  EXPECT_EQ(m.occupied_f1, 1.0);
+  EXPECT_EQ(m.coverage, 1.0);
+}
+
+TEST(ScoreMap, SwappingMapAndTruthSwapsPrecisionAndRecall) {
+  const mapping::KeySet a = Row(0, 10);
+  const mapping::KeySet b = Row(4, 20);
+  const MapMetrics ab = ScoreMap(MapWith(a, {}), b, b);
+  const MapMetrics ba = ScoreMap(MapWith(b, {}), a, a);
+  EXPECT_DOUBLE_EQ(ab.occupied_precision, 6.0 / 10.0);
+  EXPECT_DOUBLE_EQ(ab.occupied_recall, 6.0 / 16.0);
+  EXPECT_DOUBLE_EQ(ab.occupied_precision, ba.occupied_recall);
+  EXPECT_DOUBLE_EQ(ab.occupied_recall, ba.occupied_precision);
+}
+
+TEST(ScoreMap, FreeCellsCountForCoverageNotRecall) {
+  const mapping::KeySet truth = Row(0, 10);
+  const MapMetrics m = ScoreMap(MapWith(Row(0, 2), Row(2, 6)), truth, truth);
+  EXPECT_DOUBLE_EQ(m.occupied_recall, 0.2);
+  EXPECT_DOUBLE_EQ(m.coverage, 0.6);
+  EXPECT_EQ(m.free_cells, 4u);
+}
+
+TEST(ScoreMap, EmptyInputsGiveZerosNotNaN) {
+  const MapMetrics m = ScoreMap(octomap::OcTree(0.05), {}, {});
+  EXPECT_EQ(m.occupied_precision, 0.0);
+  EXPECT_EQ(m.occupied_recall, 0.0);
+  EXPECT_EQ(m.occupied_f1, 0.0);
+  EXPECT_EQ(m.coverage, 0.0);
+}
+
+TEST(CollectMapCells, PrunedNodesExpandToTheirLeafCells) {
+  octomap::OcTree tree(0.05);
+  // Eight sibling cells with equal values are pruned into one parent node.
+  for (int x = 0; x < 2; ++x)
+    for (int y = 0; y < 2; ++y)
+      for (int z = 0; z < 2; ++z)
+        tree.updateNode(octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + x), static_cast<octomap::key_type>(32768 + y),
+                                           static_cast<octomap::key_type>(32768 + z)),
+                        true);
+  tree.prune();
+  ASSERT_EQ(tree.getNumLeafNodes(), 1u);
+  EXPECT_EQ(CollectMapCells(tree).occupied.size(), 8u);
+}
+
+}  // namespace
+}  // namespace sonarbench::sim

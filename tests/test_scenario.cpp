@@ -1,0 +1,221 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+
+#include "sonarbench/sim/scenario.hpp"
+#include "test_util.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+using mapping::kDegToRad;
+
+// The default tank scenario, run once for the whole suite (≈ 15 s on 2 cores); ctest runs this
+// executable as one test so that the run is shared.
+class TankScenario : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scene_ = new Scene(LoadScene(test::SourcePath("scenes/cras-tank.yaml")));
+    result_ = new ScenarioResult(RunScenario(*scene_, RunOptions{}));
+    cells_ = new MapCells(CollectMapCells(result_->mapper->tree()));
+  }
+  static void TearDownTestSuite() {
+    delete cells_;
+    delete result_;
+    delete scene_;
+  }
+  static octomap::point3d Centre(const octomap::OcTreeKey& key) {
+    return result_->mapper->tree().keyToCoord(key);
+  }
+  static Scene* scene_;
+  static ScenarioResult* result_;
+  static MapCells* cells_;
+};
+Scene* TankScenario::scene_ = nullptr;
+ScenarioResult* TankScenario::result_ = nullptr;
+MapCells* TankScenario::cells_ = nullptr;
+
+// Nothing lies beyond the walls and the simulator has no multipath yet, so no echo starts beyond
+// a wall. An occupied end point can still pass the wall: a later run may start inside the wall's
+// echo, up to a pulse length L behind the axis range d, and the mapper puts it on every ray,
+// while off-axis rays reach the wall up to d·(1/cos(w_v/2) - 1) later; add the cell's half
+// diagonal, with d the farthest wall point (the corner). Every occupied cell must lie inside.
+TEST_F(TankScenario, NoOccupiedCellBeyondTheWalls) {
+  const auto& g = scene_->sensor.geometry;
+  const double half_side = 2.2;
+  const double corner = std::hypot(half_side, half_side);
+  const double slack = scene_->sensor.acoustics.pulse_length_m +
+                       corner * (1.0 / std::cos(g.beam_width_vertical_rad / 2) - 1.0) +
+                       0.5 * std::sqrt(3.0) * scene_->mapping.resolution_m;
+  std::size_t outside = 0;
+  for (const auto& key : cells_->occupied) {
+    const auto c = Centre(key);
+    outside += std::max(std::abs(c.x()), std::abs(c.y())) > half_side + slack ? 1 : 0;
+  }
+  EXPECT_EQ(outside, 0u) << "of " << cells_->occupied.size() << " occupied cells";
+  EXPECT_GT(cells_->occupied.size(), 0u);
+}
+
+// Each wall's columns at the sonar's height: a beam meets a wall of a centred 4.4 m tank at
+// most 45° off its normal except in the corners, where its echo per ray is still ≥ cos 45° of
+// the normal one (-1.5 dB; the analytic wall test shows the normal echo is detected with a
+// margin of tens of counts), so the axis of nearly every beam lands on the wall row. Beams are
+// 1.8° apart, 7-10 cm on the wall, and 3° wide, so they overlap: every column is inside some
+// beam. The corner cells, 2 of 88 per wall, are allowed to be missed, and speckle may drop
+// a few more: at least 90% per wall.
+TEST_F(TankScenario, EveryWallIsMappedAtTheSonarsHeight) {
+  const double sonar_z = scene_->trajectory.waypoints.front().position_m.z();
+  const double res = scene_->mapping.resolution_m;
+  struct Wall {
+    const char* name;
+    int axis;
+    double at;
+  };
+  for (const Wall wall : {Wall{"+x", 0, 2.2}, Wall{"-x", 0, -2.2}, Wall{"+y", 1, 2.2},
+                          Wall{"-y", 1, -2.2}}) {
+    SCOPED_TRACE(wall.name);
+    std::set<int> truth_columns;
+    std::set<int> mapped_columns;
+    const int along = 1 - wall.axis;
+    for (const auto& key : result_->truth) {
+      const auto c = Centre(key);
+      if (std::abs(c(wall.axis) - wall.at) < res && std::abs(c(along)) < 2.2) {
+        truth_columns.insert(key[along]);
+      }
+    }
+    for (const auto& key : cells_->occupied) {
+      const auto c = Centre(key);
+      if (std::abs(c(wall.axis) - wall.at) < 2 * res && std::abs(c.z() - sonar_z) < 2 * res) {
+        mapped_columns.insert(key[along]);
+      }
+    }
+    std::size_t hit = 0;
+    for (int column : truth_columns) hit += mapped_columns.contains(column) ? 1 : 0;
+    EXPECT_GE(truth_columns.size(), 88u);  // 4.4 m / 5 cm
+    std::printf("wall %s: %zu of %zu columns mapped\n", wall.name, hit, truth_columns.size());
+    EXPECT_GE(static_cast<double>(hit) / truth_columns.size(), 0.90)
+        << hit << " of " << truth_columns.size() << " columns";
+  }
+}
+
+// The floor enters the 35° fan where the lowest ray meets it: slant range h / sin 17.5° = 1.50 m,
+// horizontal radius h / tan 17.5° = 1.43 m for h = 0.45 m. The floor's echo is the first run of
+// nearly every beam, so the floor layer holds occupied cells around that radius in every
+// direction: at least 90% of 5° sectors, allowing for beams whose floor echo speckle hides.
+TEST_F(TankScenario, FloorRingAppearsWhereTheFanMeetsTheFloor) {
+  const double h = scene_->trajectory.waypoints.front().position_m.z();
+  const double ring = h / std::tan(scene_->sensor.geometry.beam_width_vertical_rad / 2);
+  const double res = scene_->mapping.resolution_m;
+  std::set<int> sectors;
+  for (const auto& key : cells_->occupied) {
+    const auto c = Centre(key);
+    const double radius = std::hypot(c.x(), c.y());
+    if (c.z() < res && std::abs(radius - ring) < 3 * res) {
+      sectors.insert(static_cast<int>(std::floor((std::atan2(c.y(), c.x()) + std::numbers::pi) / (5 * kDegToRad))));
+    }
+  }
+  std::printf("floor ring: %zu of 72 sectors\n", sectors.size());
+  EXPECT_GE(sectors.size(), static_cast<std::size_t>(0.9 * 72)) << sectors.size() << " of 72 sectors";
+}
+
+TEST_F(TankScenario, MetricsAreConsistentWithTheirCounts) {
+  const MapMetrics& m = result_->metrics;
+  EXPECT_EQ(m.occupied_cells, cells_->occupied.size());
+  EXPECT_LE(m.observable_cells, m.truth_cells);
+  EXPECT_DOUBLE_EQ(m.occupied_precision, static_cast<double>(m.true_positive_cells) / m.occupied_cells);
+  EXPECT_DOUBLE_EQ(m.occupied_recall, static_cast<double>(m.observed_occupied_cells) / m.observable_cells);
+  EXPECT_DOUBLE_EQ(m.coverage, static_cast<double>(m.known_observable_cells) / m.observable_cells);
+  EXPECT_EQ(result_->beams, 27u * 200u);
+}
+
+TEST_F(TankScenario, OutputsAreWrittenWithTheReportLast) {
+  test::TempDir dir;
+  WriteScenarioOutputs(dir.path().string(), *scene_, *result_);
+  for (const char* file : {"report.json", "map.bt", "polar.png", "fan.png", "map_top.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / file)) << file;
+  }
+  std::ifstream in(dir.path() / "report.json");
+  const auto report = nlohmann::json::parse(in);
+  EXPECT_EQ(report["seed"], scene_->seed);
+  EXPECT_DOUBLE_EQ(report["metrics"]["occupied_precision"].get<double>(), result_->metrics.occupied_precision);
+  EXPECT_TRUE(report["timing"].contains("map_s"));
+  EXPECT_EQ(report["parameters"]["mapping"]["rays_vertical"], 64);
+  // The map file is a real OctoMap.
+  octomap::OcTree reread(0.1);
+  ASSERT_TRUE(reread.readBinary((dir.path() / "map.bt").string()));
+  EXPECT_DOUBLE_EQ(reread.getResolution(), scene_->mapping.resolution_m);
+  std::size_t left_over = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+    left_over += entry.path().string().find(".tmp.") != std::string::npos ? 1 : 0;
+  }
+  EXPECT_EQ(left_over, 0u);
+}
+
+std::string MapBytes(const ScenarioResult& result) {
+  std::ostringstream out;
+  result.mapper->tree().writeBinaryConst(out);
+  return out.str();
+}
+
+TEST(Scenario, MapIsIdenticalForOneAndTwoThreads) {
+  Scene scene = LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  scene.sweeps = 2;
+  RunOptions one;
+  one.threads = 1;
+  RunOptions two;
+  two.threads = 2;
+  EXPECT_EQ(MapBytes(RunScenario(scene, one)), MapBytes(RunScenario(scene, two)));
+}
+
+// The command line, as a user (or CI) runs it.
+int RunCli(const std::string& arguments, std::string* output = nullptr) {
+  const std::string command = std::string(SONARBENCH_CLI) + " " + arguments + " 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  std::string text;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) text += buffer;
+  const int status = ::pclose(pipe);
+  if (output != nullptr) *output = text;
+  return WEXITSTATUS(status);
+}
+
+TEST(Cli, BadSceneExitsTwoNamingTheKeyAndWritesNothing) {
+  test::TempDir dir;
+  const auto scene = dir.path() / "bad.yaml";
+  std::ofstream(scene) << "name: x\nsensor_model: "
+                       << test::SourcePath("sensor-models/shad-micron.yaml")
+                       << "\nsweeps: 1\nsweep: 2\nmaterials: [{name: a, reflectivity: 2}]\n"
+                       << "meshes: [{name: m, type: plane, size_m: [1, 1, 0], material: a}]\n"
+                       << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+  std::string output;
+  const auto out = dir.path() / "out";
+  EXPECT_EQ(RunCli("run " + scene.string() + " --out " + out.string(), &output), 2);
+  EXPECT_NE(output.find("bad.yaml:4:1: key 'sweep': unknown key"), std::string::npos) << output;
+  EXPECT_NE(output.find("'materials[0].reflectivity'"), std::string::npos) << output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(Cli, MissingSceneAndBadOptionsExitTwo) {
+  std::string output;
+  EXPECT_EQ(RunCli("run /nonexistent.yaml", &output), 2);
+  EXPECT_NE(output.find("/nonexistent.yaml"), std::string::npos) << output;
+  EXPECT_EQ(RunCli("run " + test::SourcePath("scenes/cras-tank.yaml") + " --threads -1"), 2);
+  EXPECT_EQ(RunCli("frobnicate"), 2);
+}
+
+TEST(Cli, HelpExplainsEachSubcommand) {
+  std::string output;
+  EXPECT_EQ(RunCli("--help", &output), 0);
+  EXPECT_NE(output.find("run"), std::string::npos);
+  EXPECT_EQ(RunCli("run --help", &output), 0);
+  EXPECT_NE(output.find("--seed"), std::string::npos);
+  EXPECT_NE(output.find("--out"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sonarbench::sim
