@@ -1,12 +1,38 @@
 #include "sonarbench/mapping/detection.hpp"
 
 #include <algorithm>
+#include <opencv2/imgproc.hpp>
 
 namespace sonarbench::mapping {
+namespace {
+
+// A candidate echo along one beam: where it starts, and how strong it gets.
+struct Echo {
+  int bin;
+  double peak;
+};
+
+// The first echo always counts (nothing nearer was seen); then the strongest, so that a weak echo
+// in front (the floor at the beam's lower edge) does not hide the strongest (a wall).
+std::vector<double> ChooseEchoes(std::vector<Echo> echoes, const Beam& beam, int max_obstacles) {
+  std::vector<double> ranges;
+  if (echoes.empty()) return ranges;
+  std::vector<Echo> chosen{echoes.front()};
+  std::stable_sort(echoes.begin() + 1, echoes.end(),
+                   [](const Echo& a, const Echo& b) { return a.peak > b.peak; });
+  for (auto it = echoes.begin() + 1;
+       it != echoes.end() && static_cast<int>(chosen.size()) < max_obstacles; ++it) {
+    chosen.push_back(*it);
+  }
+  std::sort(chosen.begin(), chosen.end(), [](const Echo& a, const Echo& b) { return a.bin < b.bin; });
+  for (const Echo& e : chosen) ranges.push_back(beam.BinCentreRange(static_cast<std::size_t>(e.bin)));
+  return ranges;
+}
+
+}  // namespace
 
 std::vector<double> DetectThreshold(const Beam& beam, const SensorGeometry& sensor,
                                     const DetectionConfig& config) {
-  std::vector<double> ranges;
   const int n = static_cast<int>(beam.intensities.size());
   const int first = std::min(sensor.FirstUsableBin(), n);
   const int half = config.smoothing_bins / 2;
@@ -15,14 +41,10 @@ std::vector<double> DetectThreshold(const Beam& beam, const SensorGeometry& sens
     const int lo = std::max(first, k - half);
     const int hi = std::min(n - 1, k + half);
     int sum = 0;
-    for (int j = lo; j <= hi; ++j) sum += beam.intensities[j];
+    for (int j = lo; j <= hi; ++j) sum += beam.intensities[static_cast<std::size_t>(j)];
     return static_cast<double>(sum) / (hi - lo + 1);
   };
-  struct Run {
-    int start;
-    double peak;
-  };
-  std::vector<Run> runs;
+  std::vector<Echo> runs;
   int run_start = -1;
   double peak = 0.0;
   for (int k = first; k <= n; ++k) {
@@ -38,18 +60,74 @@ std::vector<double> DetectThreshold(const Beam& beam, const SensorGeometry& sens
       run_start = -1;
     }
   }
-  if (runs.empty()) return ranges;
-  // The first run always counts (nothing nearer was seen); the rest by peak intensity, so that a
-  // weak echo in front (the floor at the beam's lower edge) does not hide the strongest (a wall).
-  std::vector<Run> chosen{runs.front()};
-  std::vector<Run> rest(runs.begin() + 1, runs.end());
-  std::stable_sort(rest.begin(), rest.end(), [](const Run& a, const Run& b) { return a.peak > b.peak; });
-  for (const Run& run : rest) {
-    if (static_cast<int>(chosen.size()) >= config.max_obstacles) break;
-    chosen.push_back(run);
+  return ChooseEchoes(std::move(runs), beam, config.max_obstacles);
+}
+
+std::vector<std::vector<double>> DetectCanny(std::span<const Beam> beams,
+                                             const SensorGeometry& sensor,
+                                             const DetectionConfig& config) {
+  std::vector<std::vector<double>> ranges(beams.size());
+  std::size_t bins = 0;
+  for (const Beam& beam : beams) bins = std::max(bins, beam.intensities.size());
+  const int first = sensor.FirstUsableBin();
+  if (beams.empty() || static_cast<int>(bins) <= first) return ranges;
+
+  cv::Mat image(static_cast<int>(beams.size()), static_cast<int>(bins), CV_8UC1, cv::Scalar(0));
+  for (std::size_t r = 0; r < beams.size(); ++r) {
+    const auto& v = beams[r].intensities;
+    for (std::size_t k = static_cast<std::size_t>(first); k < v.size(); ++k) {
+      image.at<std::uint8_t>(static_cast<int>(r), static_cast<int>(k)) = v[k];
+    }
   }
-  std::sort(chosen.begin(), chosen.end(), [](const Run& a, const Run& b) { return a.start < b.start; });
-  for (const Run& run : chosen) ranges.push_back(beam.BinCentreRange(static_cast<std::size_t>(run.start)));
+  cv::Mat blurred;
+  // Replicate at the batch's first and last beams: a batch need not be a full revolution.
+  cv::GaussianBlur(image, blurred, cv::Size(5, 5), config.canny_blur_sigma, config.canny_blur_sigma,
+                   cv::BORDER_REPLICATE);
+  double low = config.canny_low;
+  double high = config.canny_high;
+  if (config.method == DetectionConfig::Method::kAutoCanny) {
+    std::vector<std::uint8_t> usable;
+    for (int r = 0; r < blurred.rows; ++r) {
+      const auto* row = blurred.ptr<std::uint8_t>(r);
+      usable.insert(usable.end(), row + first, row + blurred.cols);
+    }
+    std::nth_element(usable.begin(), usable.begin() + static_cast<long>(usable.size() / 2), usable.end());
+    const double median = usable[usable.size() / 2];
+    low = std::max(0.0, (1.0 - config.auto_canny_sigma) * median);
+    high = std::min(255.0, (1.0 + config.auto_canny_sigma) * median);
+  }
+  cv::Mat edges;
+  cv::Canny(blurred, edges, low, high, 3, /*L2gradient=*/true);
+  cv::Mat dx;
+  cv::Sobel(blurred, dx, CV_16S, 1, 0, 3);
+  // Blanking the self-reflection bins makes a step at the first usable bin: skip the Sobel and
+  // blur reach (2 bins) past it.
+  const int start = first + 2;
+  for (int r = 0; r < edges.rows; ++r) {
+    std::vector<Echo> echoes;
+    const auto* edge = edges.ptr<std::uint8_t>(r);
+    const auto* gradient = dx.ptr<std::int16_t>(r);
+    const auto* intensity = blurred.ptr<std::uint8_t>(r);
+    const int n = static_cast<int>(beams[static_cast<std::size_t>(r)].intensities.size());
+    for (int k = start; k < n; ++k) {
+      if (edge[k] == 0 || gradient[k] <= 0) continue;
+      if (!echoes.empty() && k - echoes.back().bin <= 1) continue;  // same edge, one bin on
+      double peak = 0.0;
+      for (int j = k; j < std::min(n, k + 5); ++j) peak = std::max<double>(peak, intensity[j]);
+      echoes.push_back({k, peak});
+    }
+    ranges[static_cast<std::size_t>(r)] =
+        ChooseEchoes(std::move(echoes), beams[static_cast<std::size_t>(r)], config.max_obstacles);
+  }
+  return ranges;
+}
+
+std::vector<std::vector<double>> DetectObstacles(std::span<const Beam> beams,
+                                                 const SensorGeometry& sensor,
+                                                 const DetectionConfig& config) {
+  if (config.method != DetectionConfig::Method::kThreshold) return DetectCanny(beams, sensor, config);
+  std::vector<std::vector<double>> ranges(beams.size());
+  for (std::size_t b = 0; b < beams.size(); ++b) ranges[b] = DetectThreshold(beams[b], sensor, config);
   return ranges;
 }
 

@@ -8,17 +8,31 @@ MapperConfig ReadMapperConfig(YamlReader& node) {
   node.Optional("rays_horizontal", c.rays_horizontal, IntInRange(1, 4096));
   node.Optional("rays_vertical", c.rays_vertical, IntInRange(1, 4096));
   if (auto detection = node.OptionalChild("detection")) {
+    DetectionConfig& d = c.detection;
     std::string method = "threshold";
-    detection->Optional("method", method, OneOf({"threshold"}));
-    detection->Optional("threshold", c.detection.threshold, IntInRange(1, 255));
-    detection->Optional("smoothing_bins", c.detection.smoothing_bins, IntInRange(1, 99));
-    detection->Optional("min_run_bins", c.detection.min_run_bins, IntInRange(1, 1000));
-    detection->Optional("max_obstacles", c.detection.max_obstacles, IntInRange(1, 100));
+    detection->Optional("method", method, OneOf({"threshold", "canny", "auto_canny"}));
+    d.method = method == "threshold" ? DetectionConfig::Method::kThreshold
+               : method == "canny"   ? DetectionConfig::Method::kCanny
+                                     : DetectionConfig::Method::kAutoCanny;
+    detection->Optional("threshold", d.threshold, IntInRange(1, 255));
+    detection->Optional("smoothing_bins", d.smoothing_bins, IntInRange(1, 99));
+    detection->Optional("min_run_bins", d.min_run_bins, IntInRange(1, 1000));
+    detection->Optional("max_obstacles", d.max_obstacles, IntInRange(1, 100));
+    detection->Optional("canny_low", d.canny_low, InRange(0.0, 2000.0));
+    detection->Optional("canny_high", d.canny_high, InRange(0.0, 2000.0));
+    detection->Optional("canny_blur_sigma", d.canny_blur_sigma, InRange(0.1, 10.0));
+    detection->Optional("auto_canny_sigma", d.auto_canny_sigma, InRange(0.0, 1.0));
     detection->RejectUnknownKeys();
-    if (c.detection.smoothing_bins % 2 == 0) {
+    if (d.smoothing_bins % 2 == 0) {
       detection->Fail("smoothing_bins", "an odd number of bins (the window is centred)");
     }
+    if (d.canny_low > d.canny_high) {
+      detection->Fail("canny_low", "a value no greater than canny_high");
+    }
   }
+  std::string key_set = "open_addressing";
+  node.Optional("key_set", key_set, OneOf({"open_addressing", "std"}));
+  c.key_set = key_set == "std" ? KeySetKind::kStd : KeySetKind::kOpenAddressing;
   node.Optional("prob_hit", c.prob_hit, InRange(0.5, 1.0));
   node.Optional("prob_miss", c.prob_miss, InRange(0.0, 0.5));
   node.Optional("clamp_min", c.clamp_min, InRange(0.0, 0.5));

@@ -95,8 +95,11 @@ void WriteTopDownImage(const std::string& path, const MapCells& map, const mappi
   for (const auto& k : observable) {
     if (truth.contains(k) && !map.occupied.contains(k)) mark(k, 2);
   }
-  for (const auto& k : map.occupied) mark(k, truth.contains(k) ? 4 : 3);
-  const cv::Vec3b palette[] = {{0, 0, 0}, {70, 70, 70}, {255, 120, 0}, {0, 0, 230}, {0, 210, 0}};
+  // Without a truth (a real log), occupied is simply occupied: drawn white.
+  const bool scored = !truth.empty();
+  for (const auto& k : map.occupied) mark(k, !scored ? 5 : truth.contains(k) ? 4 : 3);
+  const cv::Vec3b palette[] = {{0, 0, 0},   {70, 70, 70}, {255, 120, 0},
+                               {0, 0, 230}, {0, 210, 0},  {255, 255, 255}};
   cv::Mat colour(label.size(), CV_8UC3);
   for (int r = 0; r < label.rows; ++r) {
     for (int c = 0; c < label.cols; ++c) colour.at<cv::Vec3b>(r, c) = palette[label.at<uchar>(r, c)];

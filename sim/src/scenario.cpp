@@ -31,16 +31,30 @@ class Stopwatch {
 
 constexpr double kRadToDeg = 1.0 / mapping::kDegToRad;
 
+const char* DetectionMethodName(mapping::DetectionConfig::Method method) {
+  switch (method) {
+    case mapping::DetectionConfig::Method::kThreshold: return "threshold";
+    case mapping::DetectionConfig::Method::kCanny: return "canny";
+    case mapping::DetectionConfig::Method::kAutoCanny: return "auto_canny";
+  }
+  return "?";
+}
+
 nlohmann::json MappingJson(const mapping::MapperConfig& c) {
   return {{"resolution_m", c.resolution_m},
           {"rays_horizontal", c.rays_horizontal},
           {"rays_vertical", c.rays_vertical},
           {"detection",
-           {{"method", "threshold"},
+           {{"method", DetectionMethodName(c.detection.method)},
             {"threshold", c.detection.threshold},
             {"smoothing_bins", c.detection.smoothing_bins},
             {"min_run_bins", c.detection.min_run_bins},
-            {"max_obstacles", c.detection.max_obstacles}}},
+            {"max_obstacles", c.detection.max_obstacles},
+            {"canny_low", c.detection.canny_low},
+            {"canny_high", c.detection.canny_high},
+            {"canny_blur_sigma", c.detection.canny_blur_sigma},
+            {"auto_canny_sigma", c.detection.auto_canny_sigma}}},
+          {"key_set", c.key_set == mapping::KeySetKind::kStd ? "std" : "open_addressing"},
           {"prob_hit", c.prob_hit},
           {"prob_miss", c.prob_miss},
           {"clamp_min", c.clamp_min},
@@ -104,12 +118,7 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
     for (std::size_t b = start; b < std::min(start + per_sweep, synthesized.size()); ++b) {
       sweep.push_back(synthesized[b].beam);
     }
-    const mapping::BatchStats stats = result.mapper->Integrate(sweep);
-    result.mapping_totals.beams += stats.beams;
-    result.mapping_totals.beams_with_obstacle += stats.beams_with_obstacle;
-    result.mapping_totals.ray_casts += stats.ray_casts;
-    result.mapping_totals.free_cells += stats.free_cells;
-    result.mapping_totals.occupied_cells += stats.occupied_cells;
+    result.mapping_totals += result.mapper->Integrate(sweep);
     if (start == 0) result.first_sweep = sweep;
   }
   result.timings.map_s = clock.Lap();
@@ -171,6 +180,7 @@ void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
        {{"beams", result.mapping_totals.beams},
         {"beams_with_obstacle", result.mapping_totals.beams_with_obstacle},
         {"ray_casts", result.mapping_totals.ray_casts},
+        {"cell_visits", result.mapping_totals.cell_visits},
         {"free_cell_updates", result.mapping_totals.free_cells},
         {"occupied_cell_updates", result.mapping_totals.occupied_cells}}},
       {"timing",

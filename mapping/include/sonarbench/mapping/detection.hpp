@@ -1,5 +1,6 @@
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "sonarbench/mapping/beam.hpp"
@@ -16,5 +17,19 @@ namespace sonarbench::mapping {
 /// highest peaks. Empty if the beam saw nothing.
 [[nodiscard]] std::vector<double> DetectThreshold(const Beam& beam, const SensorGeometry& sensor,
                                                   const DetectionConfig& config);
+
+/// Canny detection (the seed paper, section 4) on the polar image of `beams` (one row per beam,
+/// one column per bin; the self-reflection bins are blanked): a 5×5 Gaussian blur, OpenCV's
+/// Canny with an L2 gradient, and of its edges only the rising ones along range (the near side
+/// of an echo). Per beam, the first edge and then the strongest (by blurred intensity) up to
+/// `max_obstacles`. kAutoCanny takes the thresholds from the median of the blurred usable bins.
+[[nodiscard]] std::vector<std::vector<double>> DetectCanny(std::span<const Beam> beams,
+                                                           const SensorGeometry& sensor,
+                                                           const DetectionConfig& config);
+
+/// The obstacle ranges [m] of every beam of a batch, by the configured method.
+[[nodiscard]] std::vector<std::vector<double>> DetectObstacles(std::span<const Beam> beams,
+                                                               const SensorGeometry& sensor,
+                                                               const DetectionConfig& config);
 
 }  // namespace sonarbench::mapping

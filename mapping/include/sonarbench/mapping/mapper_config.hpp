@@ -8,15 +8,36 @@ namespace sonarbench::mapping {
 
 /// How obstacles are found along a beam. See detection.hpp.
 struct DetectionConfig {
-  /// Intensity [0-255] at or above which a bin belongs to an obstacle.
-  int threshold = 90;
-  /// Width of the moving average applied along range before thresholding [bins, odd].
+  enum class Method {
+    kThreshold,  ///< runs of bins over an intensity threshold (the paper's earlier work)
+    kCanny,      ///< rising Canny edges on the sweep's polar image (the paper, section 4)
+    kAutoCanny,  ///< Canny with thresholds from the image's median (the paper's future work)
+  };
+  Method method = Method::kThreshold;
+  /// kThreshold: intensity [0-255] at or above which a bin belongs to an obstacle. 70 sits above
+  /// the real tank log's floor returns (mean 25-50) and under its walls' (60-88 where oblique,
+  /// 100-175 facing the sonar).
+  int threshold = 70;
+  /// kThreshold: width of the moving average applied along range first [bins, odd].
   int smoothing_bins = 3;
-  /// A run of bins at or above the threshold must be this long to count [bins].
+  /// kThreshold: a run of bins at or above the threshold must be this long to count [bins].
   int min_run_bins = 2;
   /// Obstacles reported per beam: 1 is the paper's "first obstacle"; more add the strongest of
-  /// the later runs (by peak intensity).
-  int max_obstacles = 1;
+  /// the later echoes (by peak intensity). 2 maps a wall behind a weaker object or the floor.
+  int max_obstacles = 2;
+  /// kCanny: hysteresis thresholds on the gradient magnitude (L2, 3×3 Sobel) [intensity/pixel].
+  double canny_low = 60.0;
+  double canny_high = 150.0;
+  /// kCanny, kAutoCanny: standard deviation of the Gaussian blur (5×5) applied first [pixels].
+  double canny_blur_sigma = 1.4;
+  /// kAutoCanny: thresholds are (1 ∓ sigma) · median of the blurred image's usable bins.
+  double auto_canny_sigma = 0.33;
+};
+
+/// The key set the mapper collects cells in; the map does not depend on it.
+enum class KeySetKind {
+  kOpenAddressing,  ///< sonarbench's OpenKeySet (quadratic probing, in-place resize)
+  kStd,             ///< std::unordered_set with OctoMap's KeyHash (OctoMap's KeySet)
 };
 
 /// Parameters of the production mapper. In-class defaults are the seed paper's choices.
@@ -39,6 +60,7 @@ struct MapperConfig {
   double free_range_m = 0.0;
   /// Worker threads for ray casting; 0 means all hardware threads. The map does not depend on it.
   int threads = 0;
+  KeySetKind key_set = KeySetKind::kOpenAddressing;
 };
 
 /// Reads a `mapping` mapping of a scene file.

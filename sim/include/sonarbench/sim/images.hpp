@@ -19,6 +19,7 @@ void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep
 /// Writes a top-down view of the map against the truth, one pixel per cell column (x right,
 /// y up): green where a column holds a true-positive cell, red where it holds only false
 /// positives, blue where it holds observable truth the map missed, grey where only free cells.
+/// With an empty `truth` (a real log), occupied columns are white.
 void WriteTopDownImage(const std::string& path, const MapCells& map, const mapping::KeySet& truth,
                        const mapping::KeySet& observable);
 

@@ -1,0 +1,33 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sonarbench/mapping/mapper.hpp"
+
+namespace sonarbench::sim {
+
+/// A recorded log run through the production mapper.
+struct LogMapResult {
+  std::string input;
+  std::size_t beams = 0;
+  std::size_t sweeps = 0;
+  std::size_t truncated_beams = 0;
+  double import_s = 0.0;
+  double map_s = 0.0;
+  mapping::BatchStats totals;
+  std::unique_ptr<mapping::Mapper> mapper;
+  std::vector<mapping::Beam> first_sweep;
+};
+
+/// Imports a real `.mat` log and maps it sweep by sweep (BeamsPerSweep() consecutive beams each;
+/// the last sweep may be partial). Throws InputError for input that is not a readable log.
+[[nodiscard]] LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
+                                  const mapping::MapperConfig& config);
+
+/// Writes `map.bt`, `map.ot`, `map_top.png`, `polar.png`, `fan.png` and `report.json` into
+/// `out_dir`, each atomically, the report last.
+void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result);
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,89 @@
+#include "sonarbench/sim/map_log.hpp"
+
+#include <chrono>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/mapping/mat_log.hpp"
+#include "sonarbench/sim/images.hpp"
+#include "sonarbench/sim/score.hpp"
+
+namespace sonarbench::sim {
+
+LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
+                    const mapping::MapperConfig& config) {
+  namespace fs = std::filesystem;
+  if (fs::is_directory(input)) {
+    throw InputError(input + ": a directory; expected a .mat log (dataset directories are not "
+                             "readable yet)");
+  }
+  LogMapResult result;
+  result.input = input;
+  auto start = std::chrono::steady_clock::now();
+  const mapping::MatLog log = mapping::ReadMatLog(input);
+  auto now = std::chrono::steady_clock::now();
+  result.import_s = std::chrono::duration<double>(now - start).count();
+  result.beams = log.beams.size();
+  result.truncated_beams = log.truncated_beams;
+
+  start = now;
+  result.mapper = std::make_unique<mapping::Mapper>(config, sensor);
+  const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
+  const std::span<const mapping::Beam> beams(log.beams);
+  for (std::size_t first = 0; first < beams.size(); first += per_sweep) {
+    const auto sweep = beams.subspan(first, std::min(per_sweep, beams.size() - first));
+    result.totals += result.mapper->Integrate(sweep);
+    ++result.sweeps;
+    if (first == 0) result.first_sweep.assign(sweep.begin(), sweep.end());
+  }
+  result.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) {
+  namespace fs = std::filesystem;
+  fs::create_directories(out_dir);
+  const fs::path dir(out_dir);
+  result.mapper->WriteBinary((dir / "map.bt").string());
+  result.mapper->WriteFull((dir / "map.ot").string());
+  const MapCells cells = CollectMapCells(result.mapper->tree());
+  WriteTopDownImage((dir / "map_top.png").string(), cells, {}, {});
+  WritePolarImage((dir / "polar.png").string(), result.first_sweep);
+  WriteFanImage((dir / "fan.png").string(), result.first_sweep, 0.01);
+  const auto& t = result.totals;
+  const auto& c = result.mapper->config();
+  const nlohmann::json report = {
+      {"schema_version", 1},
+      {"tool", {{"name", "sonarbench"}, {"version", "0.1.0"}}},
+      {"input", result.input},
+      {"beams", result.beams},
+      {"sweeps", result.sweeps},
+      {"truncated_beams", result.truncated_beams},
+      {"mapping",
+       {{"resolution_m", c.resolution_m},
+        {"rays_horizontal", c.rays_horizontal},
+        {"rays_vertical", c.rays_vertical},
+        {"threshold", c.detection.threshold},
+        {"max_obstacles", c.detection.max_obstacles}}},
+      {"map",
+       {{"occupied_cells", cells.occupied.size()},
+        {"free_cells", cells.free.size()},
+        {"beams_with_obstacle", t.beams_with_obstacle},
+        {"ray_casts", t.ray_casts},
+        {"cell_visits", t.cell_visits},
+        {"cell_updates", t.free_cells + t.occupied_cells},
+        {"visits_per_updated_cell",
+         t.free_cells + t.occupied_cells == 0
+             ? 0.0
+             : static_cast<double>(t.cell_visits) / static_cast<double>(t.free_cells + t.occupied_cells)}}},
+      {"timing", {{"import_s", result.import_s}, {"map_s", result.map_s}}},
+      {"outputs",
+       {{"map", "map.bt"}, {"map_full", "map.ot"}, {"map_top", "map_top.png"}, {"polar", "polar.png"},
+        {"fan", "fan.png"}}}};
+  WriteFileAtomically((dir / "report.json").string(),
+                      [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+}
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,200 @@
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <set>
+
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/mapping/mat_log.hpp"
+#include "sonarbench/sim/map_log.hpp"
+#include "sonarbench/sim/score.hpp"
+#include "test_util.hpp"
+
+namespace sonarbench {
+namespace {
+
+using mapping::kDegToRad;
+
+// The real log ships beside the repository, in shared/ (see shared/data/cras-tank-static).
+std::string RealLogPath() {
+  return test::SourcePath("../shared/data/cras-tank-static/dataset_static.mat");
+}
+
+#define REQUIRE_REAL_LOG()                                                             \
+  if (!std::filesystem::exists(RealLogPath())) {                                        \
+    GTEST_SKIP() << "no real log at " << RealLogPath() << " (shared/ is not beside the repo)"; \
+  }
+
+// The facts the data folder's README lists, which an importer must reproduce.
+TEST(MatLog, ReadsTheRealLogAsItsReadmeDescribes) {
+  REQUIRE_REAL_LOG();
+  const mapping::MatLog log = mapping::ReadMatLog(RealLogPath());
+  ASSERT_EQ(log.beams.size(), 5604u);
+  EXPECT_EQ(log.truncated_beams, 1u);
+  EXPECT_EQ(log.beams.back().intensities.size(), 186u);
+  EXPECT_NEAR(log.beams.front().time_s, 10.28, 0.01);
+  EXPECT_NEAR(log.beams.back().time_s, 249.96, 0.01);
+  EXPECT_NEAR(log.beams.front().head_angle_rad, 180.0 * kDegToRad, 1e-5);
+  for (std::size_t b = 0; b + 1 < log.beams.size(); ++b) {
+    const auto& beam = log.beams[b];
+    ASSERT_EQ(beam.intensities.size(), 399u) << b;
+    ASSERT_NEAR(beam.bin_size_m, 0.012531, 1e-6) << b;
+    ASSERT_LT(beam.time_s, log.beams[b + 1].time_s) << b;
+    // 1.8° steps: the angle is a multiple of 1.8° (stored as single precision).
+    const double steps = beam.head_angle_rad / (1.8 * kDegToRad);
+    ASSERT_NEAR(steps, std::round(steps), 1e-4) << b;
+  }
+  // Bins 0-2 are blank (on average: a few beams carry a little there).
+  double blank = 0.0;
+  for (const auto& beam : log.beams) blank += beam.intensities[0] + beam.intensities[1] + beam.intensities[2];
+  EXPECT_LT(blank / (3.0 * log.beams.size()), 1.0);
+  // About 23.5 beams per second.
+  const double rate = (log.beams.size() - 1) / (log.beams.back().time_s - log.beams.front().time_s);
+  EXPECT_NEAR(rate, 23.5, 0.3);
+}
+
+TEST(MatLog, CorruptOrMissingFilesAreClearErrors) {
+  test::TempDir dir;
+  const std::string garbage = (dir.path() / "garbage.mat").string();
+  std::ofstream(garbage) << "MATLAB 5.0 MAT-file, but not really";
+  for (const std::string& path : {garbage, (dir.path() / "absent.mat").string()}) {
+    try {
+      (void)mapping::ReadMatLog(path);
+      ADD_FAILURE() << "no error for " << path;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(MatLog, TruncatedCopyOfTheRealLogIsAClearError) {
+  REQUIRE_REAL_LOG();
+  test::TempDir dir;
+  const std::string cut = (dir.path() / "cut.mat").string();
+  {
+    std::ifstream in(RealLogPath(), std::ios::binary);
+    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    bytes.resize(bytes.size() / 2);
+    std::ofstream(cut, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  EXPECT_THROW((void)mapping::ReadMatLog(cut), InputError);
+}
+
+// A straight wall: the wall points of one side lie on a line. Fitted by total least squares to
+// the points within ±2 cells of a RANSAC line (so a few beams that stopped at something in front
+// of the wall do not bend it).
+struct LineFit {
+  Eigen::Vector2d point;
+  Eigen::Vector2d direction;
+  double rms_m = 0.0;
+  double inlier_fraction = 0.0;
+};
+
+LineFit FitWall(const std::vector<Eigen::Vector2d>& points, double band_m,
+               const Eigen::Vector2d& expected_normal, double max_tilt_rad) {
+  LineFit best;
+  std::size_t best_inliers = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (std::size_t j = i + 1; j < points.size(); j += 3) {
+      const Eigen::Vector2d d = (points[j] - points[i]).normalized();
+      const Eigen::Vector2d n(-d.y(), d.x());
+      if (std::abs(n.dot(expected_normal)) < std::cos(max_tilt_rad)) continue;
+      std::size_t inliers = 0;
+      for (const auto& p : points) inliers += std::abs(n.dot(p - points[i])) <= band_m ? 1 : 0;
+      if (inliers > best_inliers) {
+        best_inliers = inliers;
+        best.point = points[i];
+        best.direction = d;
+      }
+    }
+  }
+  const Eigen::Vector2d n(-best.direction.y(), best.direction.x());
+  std::vector<Eigen::Vector2d> in;
+  for (const auto& p : points) {
+    if (std::abs(n.dot(p - best.point)) <= band_m) in.push_back(p);
+  }
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& p : in) mean += p;
+  mean /= static_cast<double>(in.size());
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (const auto& p : in) scatter += (p - mean) * (p - mean).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
+  best.point = mean;
+  best.direction = eig.eigenvectors().col(1);
+  best.rms_m = std::sqrt(eig.eigenvalues()(0) / static_cast<double>(in.size()));
+  best.inlier_fraction = static_cast<double>(in.size()) / static_cast<double>(points.size());
+  return best;
+}
+
+// The real tank through `sonarbench map`'s defaults: its walls must come out straight and the
+// square closed. Wall candidates are the occupied cells at the sonar's height (|z| ≤ one cell)
+// beyond 1.6 m (inside lie the floor ring and the vehicle's own echoes), binned by 1° of bearing.
+TEST(RealLogMap, TankWallsAreStraightAndClosed) {
+  REQUIRE_REAL_LOG();
+  const auto result = sim::MapLog(RealLogPath(), mapping::SensorGeometry{}, mapping::MapperConfig{});
+  const auto& tree = result.mapper->tree();
+  const double res = tree.getResolution();
+  const sim::MapCells cells = sim::CollectMapCells(tree);
+  std::vector<std::vector<Eigen::Vector2d>> by_bearing(360);
+  for (const auto& key : cells.occupied) {
+    const auto c = tree.keyToCoord(key);
+    const double range = std::hypot(c.x(), c.y());
+    if (std::abs(c.z()) > res || range < 1.6 || range > 3.6) continue;  // 3.6 m: the far corner
+    const int bearing = static_cast<int>(std::floor(std::atan2(c.y(), c.x()) / kDegToRad + 360.0)) % 360;
+    by_bearing[static_cast<std::size_t>(bearing)].emplace_back(c.x(), c.y());
+  }
+  // Each side from the bearings within ±30° of its normal (the corners lie 37°-52° off the axes
+  // in this log, whose walls face the head's 0°, 90°, 180° and 270°): a RANSAC line within 20° of
+  // that orientation and a ±2-cell band, refined by total least squares over its inliers.
+  // Straight: inlier RMS under 1.5 cells (a cell's own quantisation is 0.29 cells RMS, the
+  // leading edge's scatter over the smoothing window about as much again, and an object standing
+  // within the ±2-cell band adds to it). Closed: at least 80% of the sector's bearings hold a cell
+  // on the line (the corners' oblique, weak echoes may fall under the threshold).
+  std::vector<LineFit> sides;
+  for (int axis = 0; axis < 360; axis += 90) {
+    std::vector<Eigen::Vector2d> points;
+    for (int b = axis - 30; b <= axis + 30; ++b) {
+      const auto& at = by_bearing[static_cast<std::size_t>((b + 360) % 360)];
+      points.insert(points.end(), at.begin(), at.end());
+    }
+    ASSERT_GE(points.size(), 61u) << "side at " << axis << "°";
+    const Eigen::Vector2d normal(std::cos(axis * kDegToRad), std::sin(axis * kDegToRad));
+    const LineFit fit = FitWall(points, 2 * res, normal, 20.0 * kDegToRad);
+    const Eigen::Vector2d n(-fit.direction.y(), fit.direction.x());
+    int supported = 0;
+    for (int b = axis - 30; b <= axis + 30; ++b) {
+      bool on_line = false;
+      for (const auto& p : by_bearing[static_cast<std::size_t>((b + 360) % 360)]) {
+        on_line |= std::abs(n.dot(p - fit.point)) <= 2 * res;
+      }
+      supported += on_line ? 1 : 0;
+    }
+    std::printf("side %3d°: %d of 61 bearings on the line, RMS %.3f m, %.2f m from the sonar\n",
+                axis, supported, fit.rms_m, std::abs(n.dot(fit.point)));
+    EXPECT_LE(fit.rms_m, 1.5 * res) << "side at " << axis << "°";
+    EXPECT_GE(supported, 49) << "side at " << axis << "°";
+    sides.push_back(fit);
+  }
+  // A square. Each side's direction is known to atan(2 cells / its 2.3 m span) ≈ 2.5°, so
+  // neighbours are perpendicular within 5°. Opposite sides: ≈ 4.4 m (the data's README; the
+  // strongest echoes here put them 4.44 m and 4.55 m apart), less up to 2 × 8 cm because the
+  // mapper marks an echo's leading edge (two smoothing bins early, and the beam's nearest point,
+  // up to 3 cm nearer than its axis at 30° incidence, plus half a cell): 4.4 ± 0.25 m.
+  for (std::size_t s = 0; s < 4; ++s) {
+    const double dot = std::abs(sides[s].direction.dot(sides[(s + 1) % 4].direction));
+    std::printf("sides %zu-%zu: %.1f° from perpendicular\n", s, (s + 1) % 4, std::asin(dot) / kDegToRad);
+    EXPECT_LE(dot, std::sin(5.0 * kDegToRad)) << "sides " << s << " and " << (s + 1) % 4;
+  }
+  for (std::size_t s = 0; s < 2; ++s) {
+    const Eigen::Vector2d n(-sides[s].direction.y(), sides[s].direction.x());
+    const double width = std::abs(n.dot(sides[s + 2].point - sides[s].point));
+    std::printf("width across sides %zu-%zu: %.2f m\n", s, s + 2, width);
+    EXPECT_NEAR(width, 4.4, 0.25);
+  }
+}
+
+}  // namespace
+}  // namespace sonarbench
