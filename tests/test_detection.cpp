@@ -94,5 +94,44 @@ TEST(DetectThreshold, TruncatedBeamIsSafe) {
   EXPECT_TRUE(DetectThreshold(beam, sensor, DetectionConfig{}).empty());
 }
 
+// A sweep whose every beam steps from 0 to 200 at bin `edge`, with a box from `box` to `box + 10`.
+std::vector<Beam> SyntheticSweep(const SensorGeometry& sensor, int edge, int box) {
+  std::vector<Beam> sweep;
+  for (int b = 0; b < 50; ++b) {
+    Beam beam = MakeBeam(sensor);
+    Fill(beam, box, box + 10, 120);
+    Fill(beam, edge, sensor.num_bins, 200);
+    sweep.push_back(beam);
+  }
+  return sweep;
+}
+
+// Canny on a 5×5-blurred step: non-maximum suppression keeps the pixel of steepest rise, within
+// the blur's reach (2 bins) of the step. Only rising edges are echoes: the box's far side is not.
+TEST(DetectCanny, FindsRisingEdgesWithinTheBlurRadius) {
+  const SensorGeometry sensor;
+  const std::vector<Beam> sweep = SyntheticSweep(sensor, 250, 120);
+  for (const auto method : {DetectionConfig::Method::kCanny, DetectionConfig::Method::kAutoCanny}) {
+    DetectionConfig config;
+    config.method = method;
+    config.max_obstacles = 5;
+    const auto ranges = DetectObstacles(sweep, sensor, config);
+    ASSERT_EQ(ranges.size(), sweep.size());
+    for (std::size_t b = 0; b < ranges.size(); ++b) {
+      ASSERT_EQ(ranges[b].size(), 2u) << "beam " << b;
+      EXPECT_NEAR(ranges[b][0], sweep[b].BinCentreRange(120), 2 * sensor.bin_size_m);
+      EXPECT_NEAR(ranges[b][1], sweep[b].BinCentreRange(250), 2 * sensor.bin_size_m);
+    }
+  }
+}
+
+TEST(DetectCanny, FlatSweepHasNoEchoes) {
+  const SensorGeometry sensor;
+  std::vector<Beam> sweep(10, MakeBeam(sensor));
+  DetectionConfig config;
+  config.method = DetectionConfig::Method::kCanny;
+  for (const auto& r : DetectObstacles(sweep, sensor, config)) EXPECT_TRUE(r.empty());
+}
+
 }  // namespace
 }  // namespace sonarbench::mapping
