@@ -156,6 +156,30 @@ TEST_F(TankScenario, OutputsAreWrittenWithTheReportLast) {
   EXPECT_EQ(left_over, 0u);
 }
 
+// The seabed survey: nothing lies above the seabed and its objects, so no occupied cell may
+// either, beyond what the sonar's geometry explains. A beam meeting a flat bed h below the sonar
+// marks its whole 35° arc at that range, whose ends rise h·(1 - cos 17.5°) above the bed
+// whatever the head angle; detection may lead the echo by the smoothing half-window (2 bins); a
+// cell centre sits up to half a cell from the point that marked it.
+TEST(SeabedScenario, NothingOccupiedAboveTheSeabed) {
+  const Scene scene = LoadScene(test::SourcePath("scenes/seabed.yaml"));
+  const ScenarioResult result = RunScenario(scene, RunOptions{});
+  const auto& tree = result.mapper->tree();
+  double truth_top = -1e9;
+  for (const auto& key : result.truth) truth_top = std::max<double>(truth_top, tree.keyToCoord(key).z());
+  const double sonar_z = (scene.trajectory.waypoints.front().position_m +
+                          scene.sensor.geometry.T_vehicle_sonar.translation()).z();
+  const double rise = sonar_z * (1.0 - std::cos(scene.sensor.geometry.beam_width_vertical_rad / 2));
+  const double lead = (scene.mapping.detection.smoothing_bins / 2) * scene.sensor.geometry.bin_size_m;
+  const double bound = truth_top + rise + lead + 0.5 * scene.mapping.resolution_m;
+  const MapCells cells = CollectMapCells(tree);
+  ASSERT_GT(cells.occupied.size(), 1000u);
+  std::size_t above = 0;
+  for (const auto& key : cells.occupied) above += tree.keyToCoord(key).z() > bound ? 1 : 0;
+  EXPECT_EQ(above, 0u) << "occupied cells above z = " << bound << " m";
+  EXPECT_GT(result.metrics.occupied_recall, 0.0);
+}
+
 std::string MapBytes(const ScenarioResult& result) {
   std::ostringstream out;
   result.mapper->tree().writeBinaryConst(out);
