@@ -48,8 +48,9 @@ TEST(CastBeam, KeysStayInsideTheWedge) {
   ASSERT_FALSE(cells.free.empty());
   ASSERT_FALSE(cells.occupied.empty());
 
-  const Eigen::Matrix3d R = beam.T_world_sonar.linear() *
-                            Eigen::AngleAxisd(beam.head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      beam.T_world_sonar.linear() *
+      Eigen::AngleAxisd(beam.head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d origin = beam.T_world_sonar.translation();
   auto check = [&](const octomap::OcTreeKey& key, bool occupied) {
     const octomap::point3d c = tree.keyToCoord(key);

@@ -19,8 +19,8 @@ template <typename F>
     const std::string message = e.what();
     for (const auto& part : parts) {
       if (message.find(part) == std::string::npos) {
-        return ::testing::AssertionFailure()
-               << "message lacks \"" << part << "\"; message was:\n" << message;
+        return ::testing::AssertionFailure() << "message lacks \"" << part << "\"; message was:\n"
+                                             << message;
       }
     }
     return ::testing::AssertionSuccess();
@@ -43,14 +43,15 @@ TEST(YamlReader, DefaultsComeFromTheStruct) {
 }
 
 TEST(YamlReader, UnknownKeyNamesFileLineAndKey) {
-  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nray_horizontal: 3\n"); },
-                                   {"scene.yaml:2:1", "'ray_horizontal'", "unknown key"}));
+  EXPECT_TRUE(
+      ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nray_horizontal: 3\n"); },
+                           {"scene.yaml:2:1", "'ray_horizontal'", "unknown key"}));
 }
 
 TEST(YamlReader, OutOfRangeValueNamesKeyAndExpectation) {
-  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("rays_vertical: 0\n"); },
-                                   {"scene.yaml:1:16", "'rays_vertical'", "an integer in [1, 4096]",
-                                    "got '0'"}));
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [] { (void)ReadMapping("rays_vertical: 0\n"); },
+      {"scene.yaml:1:16", "'rays_vertical'", "an integer in [1, 4096]", "got '0'"}));
 }
 
 TEST(YamlReader, WrongTypeAndNestedKeyPath) {
@@ -60,8 +61,9 @@ TEST(YamlReader, WrongTypeAndNestedKeyPath) {
 }
 
 TEST(YamlReader, DuplicateKeyIsAnError) {
-  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nresolution_m: 0.2\n"); },
-                                   {"scene.yaml:2:1", "'resolution_m'", "duplicate key"}));
+  EXPECT_TRUE(
+      ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nresolution_m: 0.2\n"); },
+                           {"scene.yaml:2:1", "'resolution_m'", "duplicate key"}));
 }
 
 TEST(YamlReader, ReportsEveryBadFieldAtOnce) {
@@ -99,14 +101,15 @@ TEST(SceneFile, BadSceneNamesItsFileAndKey) {
   text.replace(text.find("sensor_model: ../sensor-models/shad-micron.yaml"), 47,
                "sensor_model: " + test::SourcePath("sensor-models/shad-micron.yaml"));
   std::ofstream(path) << text;
-  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
-                                   {path, "'sweeps'", "got '-3'"}));
+  EXPECT_TRUE(
+      ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, {path, "'sweeps'", "got '-3'"}));
 }
 
 TEST(SceneFile, UnknownMaterialIsNamed) {
   test::TempDir dir;
   const std::string path = (dir.path() / "bad.yaml").string();
-  std::ofstream(path) << "name: x\nsensor_model: " << test::SourcePath("sensor-models/shad-micron.yaml")
+  std::ofstream(path) << "name: x\nsensor_model: "
+                      << test::SourcePath("sensor-models/shad-micron.yaml")
                       << "\nsweeps: 1\nmaterials:\n  - {name: rock, reflectivity: 0.5}\n"
                       << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: mud}\n"
                       << "trajectory: {type: static, position_m: [0, 0, 0]}\n";

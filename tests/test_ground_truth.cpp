@@ -65,7 +65,8 @@ octomap::OcTree MapWith(const mapping::KeySet& occupied, const mapping::KeySet& 
 
 mapping::KeySet Row(int from, int to) {
   mapping::KeySet cells;
-  for (int x = from; x < to; ++x) cells.insert(octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + x), 32768, 32768));
+  for (int x = from; x < to; ++x)
+    cells.insert(octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + x), 32768, 32768));
   return cells;
 }
 
@@ -111,7 +112,8 @@ TEST(CollectMapCells, PrunedNodesExpandToTheirLeafCells) {
   for (int x = 0; x < 2; ++x)
     for (int y = 0; y < 2; ++y)
       for (int z = 0; z < 2; ++z)
-        tree.updateNode(octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + x), static_cast<octomap::key_type>(32768 + y),
+        tree.updateNode(octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + x),
+                                           static_cast<octomap::key_type>(32768 + y),
                                            static_cast<octomap::key_type>(32768 + z)),
                         true);
   tree.prune();

@@ -22,12 +22,12 @@ template <typename Set>
   Reference seen;
   for (const auto& key : set) {
     if (!reference.contains(key)) {
-      return ::testing::AssertionFailure() << "iterates a key the reference lacks: " << key[0]
-                                           << "," << key[1] << "," << key[2];
+      return ::testing::AssertionFailure()
+             << "iterates a key the reference lacks: " << key[0] << "," << key[1] << "," << key[2];
     }
     if (!seen.insert(key).second) {
-      return ::testing::AssertionFailure() << "iterates a key twice: " << key[0] << "," << key[1]
-                                           << "," << key[2];
+      return ::testing::AssertionFailure()
+             << "iterates a key twice: " << key[0] << "," << key[1] << "," << key[2];
     }
   }
   for (const auto& key : reference) {
@@ -47,17 +47,16 @@ octomap::OcTreeKey RandomKey(std::mt19937_64& rng, bool clustered) {
 template <typename Set>
 class KeySetProperty : public ::testing::Test {};
 
-using Variants = ::testing::Types<
-    OpenKeySet<Probing::kLinear, Resize::kAllAtOnce, false>,
-    OpenKeySet<Probing::kLinear, Resize::kInPlace, false>,
-    OpenKeySet<Probing::kQuadratic, Resize::kAllAtOnce, false>,
-    OpenKeySet<Probing::kQuadratic, Resize::kInPlace, false>,
-    OpenKeySet<Probing::kDouble, Resize::kAllAtOnce, false>,
-    OpenKeySet<Probing::kDouble, Resize::kInPlace, false>,
-    OpenKeySet<Probing::kLinear, Resize::kInPlace, true>,
-    OpenKeySet<Probing::kQuadratic, Resize::kAllAtOnce, true>,
-    OpenKeySet<Probing::kQuadratic, Resize::kInPlace, true>,
-    OpenKeySet<Probing::kDouble, Resize::kInPlace, true>>;
+using Variants = ::testing::Types<OpenKeySet<Probing::kLinear, Resize::kAllAtOnce, false>,
+                                  OpenKeySet<Probing::kLinear, Resize::kInPlace, false>,
+                                  OpenKeySet<Probing::kQuadratic, Resize::kAllAtOnce, false>,
+                                  OpenKeySet<Probing::kQuadratic, Resize::kInPlace, false>,
+                                  OpenKeySet<Probing::kDouble, Resize::kAllAtOnce, false>,
+                                  OpenKeySet<Probing::kDouble, Resize::kInPlace, false>,
+                                  OpenKeySet<Probing::kLinear, Resize::kInPlace, true>,
+                                  OpenKeySet<Probing::kQuadratic, Resize::kAllAtOnce, true>,
+                                  OpenKeySet<Probing::kQuadratic, Resize::kInPlace, true>,
+                                  OpenKeySet<Probing::kDouble, Resize::kInPlace, true>>;
 TYPED_TEST_SUITE(KeySetProperty, Variants);
 
 // A long random sequence of every operation, checked against std::unordered_set after each
@@ -139,8 +138,9 @@ TYPED_TEST(KeySetProperty, NoDuplicateAfterErasures) {
 TEST(OpenKeySet, PackingRoundTripsEveryCoordinate) {
   for (const int v : {0, 1, 255, 256, 32767, 32768, 65534, 65535}) {
     const auto k = static_cast<octomap::key_type>(v);
-    for (const octomap::OcTreeKey& key : {octomap::OcTreeKey(k, 0, 0), octomap::OcTreeKey(0, k, 0),
-                                         octomap::OcTreeKey(0, 0, k), octomap::OcTreeKey(k, k, k)}) {
+    for (const octomap::OcTreeKey& key :
+         {octomap::OcTreeKey(k, 0, 0), octomap::OcTreeKey(0, k, 0), octomap::OcTreeKey(0, 0, k),
+          octomap::OcTreeKey(k, k, k)}) {
       EXPECT_EQ(UnpackKey(PackKey(key)), key);
     }
   }

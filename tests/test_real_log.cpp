@@ -23,8 +23,8 @@ std::string RealLogPath() {
   return test::SourcePath("../shared/data/cras-tank-static/dataset_static.mat");
 }
 
-#define REQUIRE_REAL_LOG()                                                             \
-  if (!std::filesystem::exists(RealLogPath())) {                                        \
+#define REQUIRE_REAL_LOG()                                                                     \
+  if (!std::filesystem::exists(RealLogPath())) {                                               \
     GTEST_SKIP() << "no real log at " << RealLogPath() << " (shared/ is not beside the repo)"; \
   }
 
@@ -49,7 +49,8 @@ TEST(MatLog, ReadsTheRealLogAsItsReadmeDescribes) {
   }
   // Bins 0-2 are blank (on average: a few beams carry a little there).
   double blank = 0.0;
-  for (const auto& beam : log.beams) blank += beam.intensities[0] + beam.intensities[1] + beam.intensities[2];
+  for (const auto& beam : log.beams)
+    blank += beam.intensities[0] + beam.intensities[1] + beam.intensities[2];
   EXPECT_LT(blank / (3.0 * log.beams.size()), 1.0);
   // About 23.5 beams per second.
   const double rate = (log.beams.size() - 1) / (log.beams.back().time_s - log.beams.front().time_s);
@@ -78,7 +79,8 @@ TEST(MatLog, TruncatedCopyOfTheRealLogIsAClearError) {
     std::ifstream in(RealLogPath(), std::ios::binary);
     std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     bytes.resize(bytes.size() / 2);
-    std::ofstream(cut, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    std::ofstream(cut, std::ios::binary)
+        .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   }
   EXPECT_THROW((void)mapping::ReadMatLog(cut), InputError);
 }
@@ -94,7 +96,7 @@ struct LineFit {
 };
 
 LineFit FitWall(const std::vector<Eigen::Vector2d>& points, double band_m,
-               const Eigen::Vector2d& expected_normal, double max_tilt_rad) {
+                const Eigen::Vector2d& expected_normal, double max_tilt_rad) {
   LineFit best;
   std::size_t best_inliers = 0;
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -134,7 +136,8 @@ LineFit FitWall(const std::vector<Eigen::Vector2d>& points, double band_m,
 // beyond 1.6 m (inside lie the floor ring and the vehicle's own echoes), binned by 1° of bearing.
 TEST(RealLogMap, TankWallsAreStraightAndClosed) {
   REQUIRE_REAL_LOG();
-  const auto result = sim::MapLog(RealLogPath(), mapping::SensorGeometry{}, mapping::MapperConfig{});
+  const auto result =
+      sim::MapLog(RealLogPath(), mapping::SensorGeometry{}, mapping::MapperConfig{});
   const auto& tree = result.mapper->tree();
   const double res = tree.getResolution();
   const sim::MapCells cells = sim::CollectMapCells(tree);
@@ -143,7 +146,8 @@ TEST(RealLogMap, TankWallsAreStraightAndClosed) {
     const auto c = tree.keyToCoord(key);
     const double range = std::hypot(c.x(), c.y());
     if (std::abs(c.z()) > res || range < 1.6 || range > 3.6) continue;  // 3.6 m: the far corner
-    const int bearing = static_cast<int>(std::floor(std::atan2(c.y(), c.x()) / kDegToRad + 360.0)) % 360;
+    const int bearing =
+        static_cast<int>(std::floor(std::atan2(c.y(), c.x()) / kDegToRad + 360.0)) % 360;
     by_bearing[static_cast<std::size_t>(bearing)].emplace_back(c.x(), c.y());
   }
   // Each side from the bearings within ±30° of its normal (the corners lie 37°-52° off the axes
@@ -185,7 +189,8 @@ TEST(RealLogMap, TankWallsAreStraightAndClosed) {
   // up to 3 cm nearer than its axis at 30° incidence, plus half a cell): 4.4 ± 0.25 m.
   for (std::size_t s = 0; s < 4; ++s) {
     const double dot = std::abs(sides[s].direction.dot(sides[(s + 1) % 4].direction));
-    std::printf("sides %zu-%zu: %.1f° from perpendicular\n", s, (s + 1) % 4, std::asin(dot) / kDegToRad);
+    std::printf("sides %zu-%zu: %.1f° from perpendicular\n", s, (s + 1) % 4,
+                std::asin(dot) / kDegToRad);
     EXPECT_LE(dot, std::sin(5.0 * kDegToRad)) << "sides " << s << " and " << (s + 1) % 4;
   }
   for (std::size_t s = 0; s < 2; ++s) {

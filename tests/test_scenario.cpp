@@ -76,8 +76,8 @@ TEST_F(TankScenario, EveryWallIsMappedAtTheSonarsHeight) {
     int axis;
     double at;
   };
-  for (const Wall wall : {Wall{"+x", 0, 2.2}, Wall{"-x", 0, -2.2}, Wall{"+y", 1, 2.2},
-                          Wall{"-y", 1, -2.2}}) {
+  for (const Wall wall :
+       {Wall{"+x", 0, 2.2}, Wall{"-x", 0, -2.2}, Wall{"+y", 1, 2.2}, Wall{"-y", 1, -2.2}}) {
     SCOPED_TRACE(wall.name);
     std::set<int> truth_columns;
     std::set<int> mapped_columns;
@@ -116,19 +116,23 @@ TEST_F(TankScenario, FloorRingAppearsWhereTheFanMeetsTheFloor) {
     const auto c = Centre(key);
     const double radius = std::hypot(c.x(), c.y());
     if (c.z() < res && std::abs(radius - ring) < 3 * res) {
-      sectors.insert(static_cast<int>(std::floor((std::atan2(c.y(), c.x()) + std::numbers::pi) / (5 * kDegToRad))));
+      sectors.insert(static_cast<int>(
+          std::floor((std::atan2(c.y(), c.x()) + std::numbers::pi) / (5 * kDegToRad))));
     }
   }
   std::printf("floor ring: %zu of 72 sectors\n", sectors.size());
-  EXPECT_GE(sectors.size(), static_cast<std::size_t>(0.9 * 72)) << sectors.size() << " of 72 sectors";
+  EXPECT_GE(sectors.size(), static_cast<std::size_t>(0.9 * 72))
+      << sectors.size() << " of 72 sectors";
 }
 
 TEST_F(TankScenario, MetricsAreConsistentWithTheirCounts) {
   const MapMetrics& m = result_->metrics;
   EXPECT_EQ(m.occupied_cells, cells_->occupied.size());
   EXPECT_LE(m.observable_cells, m.truth_cells);
-  EXPECT_DOUBLE_EQ(m.occupied_precision, static_cast<double>(m.true_positive_cells) / m.occupied_cells);
-  EXPECT_DOUBLE_EQ(m.occupied_recall, static_cast<double>(m.observed_occupied_cells) / m.observable_cells);
+  EXPECT_DOUBLE_EQ(m.occupied_precision,
+                   static_cast<double>(m.true_positive_cells) / m.occupied_cells);
+  EXPECT_DOUBLE_EQ(m.occupied_recall,
+                   static_cast<double>(m.observed_occupied_cells) / m.observable_cells);
   EXPECT_DOUBLE_EQ(m.coverage, static_cast<double>(m.known_observable_cells) / m.observable_cells);
   EXPECT_EQ(result_->beams, 27u * 200u);
 }
@@ -142,7 +146,8 @@ TEST_F(TankScenario, OutputsAreWrittenWithTheReportLast) {
   std::ifstream in(dir.path() / "report.json");
   const auto report = nlohmann::json::parse(in);
   EXPECT_EQ(report["seed"], scene_->seed);
-  EXPECT_DOUBLE_EQ(report["metrics"]["occupied_precision"].get<double>(), result_->metrics.occupied_precision);
+  EXPECT_DOUBLE_EQ(report["metrics"]["occupied_precision"].get<double>(),
+                   result_->metrics.occupied_precision);
   EXPECT_TRUE(report["timing"].contains("map_s"));
   EXPECT_EQ(report["parameters"]["mapping"]["rays_vertical"], 64);
   // The map file is a real OctoMap.
@@ -166,11 +171,14 @@ TEST(SeabedScenario, NothingOccupiedAboveTheSeabed) {
   const ScenarioResult result = RunScenario(scene, RunOptions{});
   const auto& tree = result.mapper->tree();
   double truth_top = -1e9;
-  for (const auto& key : result.truth) truth_top = std::max<double>(truth_top, tree.keyToCoord(key).z());
+  for (const auto& key : result.truth)
+    truth_top = std::max<double>(truth_top, tree.keyToCoord(key).z());
   const double sonar_z = (scene.trajectory.waypoints.front().position_m +
-                          scene.sensor.geometry.T_vehicle_sonar.translation()).z();
+                          scene.sensor.geometry.T_vehicle_sonar.translation())
+                             .z();
   const double rise = sonar_z * (1.0 - std::cos(scene.sensor.geometry.beam_width_vertical_rad / 2));
-  const double lead = (scene.mapping.detection.smoothing_bins / 2) * scene.sensor.geometry.bin_size_m;
+  const double lead =
+      (scene.mapping.detection.smoothing_bins / 2) * scene.sensor.geometry.bin_size_m;
   const double bound = truth_top + rise + lead + 0.5 * scene.mapping.resolution_m;
   const MapCells cells = CollectMapCells(tree);
   ASSERT_GT(cells.occupied.size(), 1000u);

@@ -105,19 +105,46 @@ void BM_Merge(benchmark::State& state) {
 constexpr std::int64_t kMin = 1 << 16;
 constexpr std::int64_t kMax = 1 << 22;  // ≈ 4 M, the paper's insert count
 
-#define SONARBENCH_SETS(BM)                                   \
-  BENCHMARK_TEMPLATE(BM, Linear)->RangeMultiplier(4)->Range(kMin, kMax)->Unit(benchmark::kMillisecond); \
-  BENCHMARK_TEMPLATE(BM, Quadratic)->RangeMultiplier(4)->Range(kMin, kMax)->Unit(benchmark::kMillisecond); \
-  BENCHMARK_TEMPLATE(BM, Double)->RangeMultiplier(4)->Range(kMin, kMax)->Unit(benchmark::kMillisecond); \
-  BENCHMARK_TEMPLATE(BM, QuadraticAllAtOnce)->RangeMultiplier(4)->Range(kMin, kMax)->Unit(benchmark::kMillisecond); \
-  BENCHMARK_TEMPLATE(BM, QuadraticCached)->RangeMultiplier(4)->Range(kMin, kMax)->Unit(benchmark::kMillisecond); \
-  BENCHMARK_TEMPLATE(BM, KeySet)->RangeMultiplier(4)->Range(kMin, kMax)->Unit(benchmark::kMillisecond); \
-  BENCHMARK_TEMPLATE(BM, AbslKeySet)->RangeMultiplier(4)->Range(kMin, kMax)->Unit(benchmark::kMillisecond);
+#define SONARBENCH_SETS(BM)                  \
+  BENCHMARK_TEMPLATE(BM, Linear)             \
+      ->RangeMultiplier(4)                   \
+      ->Range(kMin, kMax)                    \
+      ->Unit(benchmark::kMillisecond);       \
+  BENCHMARK_TEMPLATE(BM, Quadratic)          \
+      ->RangeMultiplier(4)                   \
+      ->Range(kMin, kMax)                    \
+      ->Unit(benchmark::kMillisecond);       \
+  BENCHMARK_TEMPLATE(BM, Double)             \
+      ->RangeMultiplier(4)                   \
+      ->Range(kMin, kMax)                    \
+      ->Unit(benchmark::kMillisecond);       \
+  BENCHMARK_TEMPLATE(BM, QuadraticAllAtOnce) \
+      ->RangeMultiplier(4)                   \
+      ->Range(kMin, kMax)                    \
+      ->Unit(benchmark::kMillisecond);       \
+  BENCHMARK_TEMPLATE(BM, QuadraticCached)    \
+      ->RangeMultiplier(4)                   \
+      ->Range(kMin, kMax)                    \
+      ->Unit(benchmark::kMillisecond);       \
+  BENCHMARK_TEMPLATE(BM, KeySet)             \
+      ->RangeMultiplier(4)                   \
+      ->Range(kMin, kMax)                    \
+      ->Unit(benchmark::kMillisecond);       \
+  BENCHMARK_TEMPLATE(BM, AbslKeySet)         \
+      ->RangeMultiplier(4)                   \
+      ->Range(kMin, kMax)                    \
+      ->Unit(benchmark::kMillisecond);
 
 SONARBENCH_SETS(BM_Insert)
 SONARBENCH_SETS(BM_InsertReserved)
-BENCHMARK_TEMPLATE(BM_Merge, Quadratic, true)->RangeMultiplier(4)->Range(kMin, kMax / 4)->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(BM_Merge, Quadratic, false)->RangeMultiplier(4)->Range(kMin, kMax / 4)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Merge, Quadratic, true)
+    ->RangeMultiplier(4)
+    ->Range(kMin, kMax / 4)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(BM_Merge, Quadratic, false)
+    ->RangeMultiplier(4)
+    ->Range(kMin, kMax / 4)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace sonarbench::mapping::bench

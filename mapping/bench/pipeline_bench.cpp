@@ -7,7 +7,8 @@
 //
 // Every mapper variant must produce the same map, byte for byte (checked; a mismatch is an
 // error). The naive pipeline is: one thread, per beam OctoMap's computeRayKeys into its KeySet,
-// then updateNode per key: a cell seen by k beams of a sweep is updated k times, so its map differs.
+// then updateNode per key: a cell seen by k beams of a sweep is updated k times, so its map
+// differs.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -84,10 +85,11 @@ std::string RunNaive(const std::vector<Beam>& beams, const SensorGeometry& senso
     KeySet occupied_cells;
     for (const Eigen::Vector3d& d : directions) {
       const Eigen::Vector3d end = free_end * (R * d);
-      if (tree.computeRayKeys(octomap::point3d(0, 0, 0),
-                              octomap::point3d(static_cast<float>(end.x()), static_cast<float>(end.y()),
-                                               static_cast<float>(end.z())),
-                              ray)) {
+      if (tree.computeRayKeys(
+              octomap::point3d(0, 0, 0),
+              octomap::point3d(static_cast<float>(end.x()), static_cast<float>(end.y()),
+                               static_cast<float>(end.z())),
+              ray)) {
         free_cells.insert(ray.begin(), ray.end());
       }
       for (const double r : obstacles) {
@@ -150,7 +152,8 @@ int Main(int argc, char** argv) {
       if (v == 4 && r > 0) totals = BatchStats{};
       const auto start = std::chrono::steady_clock::now();
       bytes = variants[v].run();
-      runs.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      runs.push_back(
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
     if (v == 1) reference = bytes;
     if (v > 1 && bytes != reference) {
@@ -166,9 +169,10 @@ int Main(int argc, char** argv) {
                 times[v], times[0] / times[v], times[1] / times[v]);
   }
   const double updated = static_cast<double>(totals.free_cells + totals.occupied_cells);
-  std::printf("\nall mapper variants built the identical map\n"
-              "cell visits %zu, cells updated (per sweep, summed) %.0f: %.1f visits per updated cell\n",
-              totals.cell_visits, updated, static_cast<double>(totals.cell_visits) / updated);
+  std::printf(
+      "\nall mapper variants built the identical map\n"
+      "cell visits %zu, cells updated (per sweep, summed) %.0f: %.1f visits per updated cell\n",
+      totals.cell_visits, updated, static_cast<double>(totals.cell_visits) / updated);
   return 0;
 }
 

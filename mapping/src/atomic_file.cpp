@@ -11,8 +11,7 @@
 
 namespace sonarbench {
 
-void WriteFileAtomically(const std::string& path,
-                         const std::function<void(std::ostream&)>& write) {
+void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
   const std::string temp = path + ".tmp." + std::to_string(::getpid());
   try {
     {

@@ -24,8 +24,10 @@ std::vector<double> ChooseEchoes(std::vector<Echo> echoes, const Beam& beam, int
        it != echoes.end() && static_cast<int>(chosen.size()) < max_obstacles; ++it) {
     chosen.push_back(*it);
   }
-  std::sort(chosen.begin(), chosen.end(), [](const Echo& a, const Echo& b) { return a.bin < b.bin; });
-  for (const Echo& e : chosen) ranges.push_back(beam.BinCentreRange(static_cast<std::size_t>(e.bin)));
+  std::sort(chosen.begin(), chosen.end(),
+            [](const Echo& a, const Echo& b) { return a.bin < b.bin; });
+  for (const Echo& e : chosen)
+    ranges.push_back(beam.BinCentreRange(static_cast<std::size_t>(e.bin)));
   return ranges;
 }
 
@@ -91,7 +93,8 @@ std::vector<std::vector<double>> DetectCanny(std::span<const Beam> beams,
       const auto* row = blurred.ptr<std::uint8_t>(r);
       usable.insert(usable.end(), row + first, row + blurred.cols);
     }
-    std::nth_element(usable.begin(), usable.begin() + static_cast<long>(usable.size() / 2), usable.end());
+    std::nth_element(usable.begin(), usable.begin() + static_cast<long>(usable.size() / 2),
+                     usable.end());
     const double median = usable[usable.size() / 2];
     low = std::max(0.0, (1.0 - config.auto_canny_sigma) * median);
     high = std::min(255.0, (1.0 + config.auto_canny_sigma) * median);
@@ -125,9 +128,11 @@ std::vector<std::vector<double>> DetectCanny(std::span<const Beam> beams,
 std::vector<std::vector<double>> DetectObstacles(std::span<const Beam> beams,
                                                  const SensorGeometry& sensor,
                                                  const DetectionConfig& config) {
-  if (config.method != DetectionConfig::Method::kThreshold) return DetectCanny(beams, sensor, config);
+  if (config.method != DetectionConfig::Method::kThreshold)
+    return DetectCanny(beams, sensor, config);
   std::vector<std::vector<double>> ranges(beams.size());
-  for (std::size_t b = 0; b < beams.size(); ++b) ranges[b] = DetectThreshold(beams[b], sensor, config);
+  for (std::size_t b = 0; b < beams.size(); ++b)
+    ranges[b] = DetectThreshold(beams[b], sensor, config);
   return ranges;
 }
 

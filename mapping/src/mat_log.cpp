@@ -31,15 +31,24 @@ std::size_t ElementCount(const matvar_t* var) {
 std::optional<double> NumericAt(const matvar_t* var, std::size_t k) {
   if (var->isComplex || var->data == nullptr || k >= ElementCount(var)) return std::nullopt;
   switch (var->class_type) {
-    case MAT_C_DOUBLE: return static_cast<const double*>(var->data)[k];
-    case MAT_C_SINGLE: return static_cast<const float*>(var->data)[k];
-    case MAT_C_UINT8: return static_cast<const std::uint8_t*>(var->data)[k];
-    case MAT_C_INT8: return static_cast<const std::int8_t*>(var->data)[k];
-    case MAT_C_UINT16: return static_cast<const std::uint16_t*>(var->data)[k];
-    case MAT_C_INT16: return static_cast<const std::int16_t*>(var->data)[k];
-    case MAT_C_UINT32: return static_cast<const std::uint32_t*>(var->data)[k];
-    case MAT_C_INT32: return static_cast<const std::int32_t*>(var->data)[k];
-    default: return std::nullopt;
+    case MAT_C_DOUBLE:
+      return static_cast<const double*>(var->data)[k];
+    case MAT_C_SINGLE:
+      return static_cast<const float*>(var->data)[k];
+    case MAT_C_UINT8:
+      return static_cast<const std::uint8_t*>(var->data)[k];
+    case MAT_C_INT8:
+      return static_cast<const std::int8_t*>(var->data)[k];
+    case MAT_C_UINT16:
+      return static_cast<const std::uint16_t*>(var->data)[k];
+    case MAT_C_INT16:
+      return static_cast<const std::int16_t*>(var->data)[k];
+    case MAT_C_UINT32:
+      return static_cast<const std::uint32_t*>(var->data)[k];
+    case MAT_C_INT32:
+      return static_cast<const std::int32_t*>(var->data)[k];
+    default:
+      return std::nullopt;
   }
 }
 

@@ -41,9 +41,9 @@ SensorGeometry ReadSensorGeometry(YamlReader& node) {
     mounting->Optional("position_m", position);
     mounting->Optional("rpy_deg", rpy_deg);
     mounting->RejectUnknownKeys();
-    g.T_vehicle_sonar = PoseFromXyzRpy({position[0], position[1], position[2]},
-                                       Eigen::Vector3d(rpy_deg[0], rpy_deg[1], rpy_deg[2]) *
-                                           kDegToRad);
+    g.T_vehicle_sonar =
+        PoseFromXyzRpy({position[0], position[1], position[2]},
+                       Eigen::Vector3d(rpy_deg[0], rpy_deg[1], rpy_deg[2]) * kDegToRad);
   }
   node.RejectUnknownKeys();
   g.beam_width_horizontal_rad = width_h_deg * kDegToRad;

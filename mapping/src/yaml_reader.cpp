@@ -205,8 +205,8 @@ template <typename T>
 void YamlReader::Required(const std::string& key, T& out, Check<T> check) {
   const YAML::Node value = Lookup(key);
   if (!value.IsDefined()) {
-    state_->errors.push_back(Where(node_) + ": key '" + KeyPath(key) +
-                             "': missing (expected " + Decoder<T>::kWhat + ")");
+    state_->errors.push_back(Where(node_) + ": key '" + KeyPath(key) + "': missing (expected " +
+                             Decoder<T>::kWhat + ")");
     return;
   }
   Read(key, value, out, check);
@@ -320,8 +320,8 @@ YamlReader::Check<std::string> OneOf(std::vector<std::string> choices) {
   };
 }
 
-#define SONARBENCH_INSTANTIATE(T)                                                     \
-  template void YamlReader::Required<T>(const std::string&, T&, Check<T>);            \
+#define SONARBENCH_INSTANTIATE(T)                                          \
+  template void YamlReader::Required<T>(const std::string&, T&, Check<T>); \
   template void YamlReader::Optional<T>(const std::string&, T&, Check<T>);
 SONARBENCH_INSTANTIATE(double)
 SONARBENCH_INSTANTIATE(int)

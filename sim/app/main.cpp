@@ -26,14 +26,12 @@ void PrintSummary(const sonarbench::sim::ScenarioResult& r, const std::string& o
   const auto& m = r.metrics;
   const auto& t = r.timings;
   std::cout << "beams " << r.beams << ", seed " << r.seed << ", threads " << r.threads << "\n"
-            << "occupied precision " << m.occupied_precision << " (" << m.true_positive_cells
-            << "/" << m.occupied_cells << "), recall " << m.occupied_recall << " ("
+            << "occupied precision " << m.occupied_precision << " (" << m.true_positive_cells << "/"
+            << m.occupied_cells << "), recall " << m.occupied_recall << " ("
             << m.observed_occupied_cells << "/" << m.observable_cells << "), coverage "
-            << m.coverage << " (" << m.known_observable_cells << "/" << m.observable_cells
-            << ")\n"
-            << "timing [s]: scene " << t.build_scene_s << ", simulate " << t.simulate_s
-            << ", map " << t.map_s << ", ground truth " << t.ground_truth_s << ", score "
-            << t.score_s << "\n"
+            << m.coverage << " (" << m.known_observable_cells << "/" << m.observable_cells << ")\n"
+            << "timing [s]: scene " << t.build_scene_s << ", simulate " << t.simulate_s << ", map "
+            << t.map_s << ", ground truth " << t.ground_truth_s << ", score " << t.score_s << "\n"
             << "wrote " << out << "/report.json\n";
 }
 
@@ -103,9 +101,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run_cmd->add_option("-s,--seed", run.seed,
                       "Seed of every random draw; overrides the scene's 'seed'");
-  run_cmd->add_option("-j,--threads", run.threads,
-                      "Threads for simulation and mapping; 0 = all cores. Outputs are identical "
-                      "for any value.")
+  run_cmd
+      ->add_option("-j,--threads", run.threads,
+                   "Threads for simulation and mapping; 0 = all cores. Outputs are identical "
+                   "for any value.")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
 
@@ -120,17 +119,22 @@ int main(int argc, char** argv) {
   map_cmd->add_option("input", map.input, "The log (.mat)")->required()->check(CLI::ExistingPath);
   map_cmd->add_option("-o,--out", map.out, "Output directory (created if needed)")
       ->capture_default_str();
-  auto* scene_opt = map_cmd->add_option(
-      "--scene", map.scene, "Take the sensor model and the mapping section from this scene")
-      ->check(CLI::ExistingFile);
+  auto* scene_opt =
+      map_cmd
+          ->add_option("--scene", map.scene,
+                       "Take the sensor model and the mapping section from this scene")
+          ->check(CLI::ExistingFile);
   map_cmd->add_option("--sensor", map.sensor, "Sensor model YAML (its geometry is used)")
       ->check(CLI::ExistingFile)
       ->excludes(scene_opt);
-  map_cmd->add_option("--mapping", map.mapping,
-                      "YAML file of mapping parameters (the keys of a scene's 'mapping' section)")
+  map_cmd
+      ->add_option("--mapping", map.mapping,
+                   "YAML file of mapping parameters (the keys of a scene's 'mapping' section)")
       ->check(CLI::ExistingFile)
       ->excludes(scene_opt);
-  map_cmd->add_option("-j,--threads", map.threads, "Threads; 0 = all cores. The map is identical for any value.")
+  map_cmd
+      ->add_option("-j,--threads", map.threads,
+                   "Threads; 0 = all cores. The map is identical for any value.")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
 

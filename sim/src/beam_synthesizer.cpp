@@ -39,7 +39,8 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const Eigen::Vector3f origin = T_world_sonar.translation().cast<float>();
   const double width_h = a.aperture_scale * g.beam_width_horizontal_rad;
   const double width_v = a.aperture_scale * g.beam_width_vertical_rad;
-  const double k_h = 4.0 * std::log(2.0) / (g.beam_width_horizontal_rad * g.beam_width_horizontal_rad);
+  const double k_h =
+      4.0 * std::log(2.0) / (g.beam_width_horizontal_rad * g.beam_width_horizontal_rad);
   const double k_v = 4.0 * std::log(2.0) / (g.beam_width_vertical_rad * g.beam_width_vertical_rad);
   const double pulse_bins = a.pulse_length_m / g.bin_size_m;
 
@@ -70,7 +71,8 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       // [r, r + L), so each bin gets the power times the fraction of the bin that span covers.
       const double start = range / g.bin_size_m;
       const double end = start + pulse_bins;
-      for (auto k = static_cast<std::size_t>(start); k < bins && static_cast<double>(k) < end; ++k) {
+      for (auto k = static_cast<std::size_t>(start); k < bins && static_cast<double>(k) < end;
+           ++k) {
         const double overlap =
             std::min(static_cast<double>(k + 1), end) - std::max(static_cast<double>(k), start);
         out.echo_power[k] += power * overlap;
@@ -79,9 +81,9 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   }
   for (double& p : out.echo_power) p /= weight_sum;
 
-  if (const auto axis = tracer_.Intersect(
-          origin, (R_world_beam * Eigen::Vector3d::UnitX()).cast<float>(),
-          static_cast<float>(max_range))) {
+  if (const auto axis =
+          tracer_.Intersect(origin, (R_world_beam * Eigen::Vector3d::UnitX()).cast<float>(),
+                            static_cast<float>(max_range))) {
     out.truth.axis_hit_range_m = axis->distance;
   }
 

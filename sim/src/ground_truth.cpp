@@ -17,7 +17,8 @@ bool Separates(const Vector3d& axis, const Vector3d& v0, const Vector3d& v1, con
   const double p0 = axis.dot(v0);
   const double p1 = axis.dot(v1);
   const double p2 = axis.dot(v2);
-  const double r = h.x() * std::abs(axis.x()) + h.y() * std::abs(axis.y()) + h.z() * std::abs(axis.z());
+  const double r =
+      h.x() * std::abs(axis.x()) + h.y() * std::abs(axis.y()) + h.z() * std::abs(axis.z());
   return std::min({p0, p1, p2}) > r || std::max({p0, p1, p2}) < -r;
 }
 
@@ -101,8 +102,9 @@ mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer, std::span<const 
   for (std::int64_t b = 0; b < count; ++b) {
     const BeamPose& pose = beams[static_cast<std::size_t>(b)];
     mapping::KeySet& cells = per_thread[static_cast<std::size_t>(omp_get_thread_num())];
-    const Eigen::Matrix3d R = pose.T_world_sonar.linear() *
-                              Eigen::AngleAxisd(pose.head_angle_rad, Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Matrix3d R =
+        pose.T_world_sonar.linear() *
+        Eigen::AngleAxisd(pose.head_angle_rad, Vector3d::UnitZ()).toRotationMatrix();
     const Eigen::Vector3f origin = pose.T_world_sonar.translation().cast<float>();
     for (const Vector3d& d : directions) {
       const Eigen::Vector3f direction = (R * d).cast<float>();

@@ -16,7 +16,8 @@ void WritePng(const std::string& path, const cv::Mat& image) {
   std::vector<uchar> bytes;
   if (!cv::imencode(".png", image, bytes)) throw std::runtime_error(path + ": PNG encoding failed");
   WriteFileAtomically(path, [&](std::ostream& out) {
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
   });
 }
 
@@ -55,7 +56,8 @@ void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep
       const mapping::Beam* nearest = nullptr;
       double best = 1e9;
       for (const auto& beam : sweep) {
-        const double d = std::abs(std::remainder(beam.head_angle_rad - bearing, 2 * std::numbers::pi));
+        const double d =
+            std::abs(std::remainder(beam.head_angle_rad - bearing, 2 * std::numbers::pi));
         if (d < best) {
           best = d;
           nearest = &beam;
@@ -102,7 +104,8 @@ void WriteTopDownImage(const std::string& path, const MapCells& map, const mappi
                                {0, 0, 230}, {0, 210, 0},  {255, 255, 255}};
   cv::Mat colour(label.size(), CV_8UC3);
   for (int r = 0; r < label.rows; ++r) {
-    for (int c = 0; c < label.cols; ++c) colour.at<cv::Vec3b>(r, c) = palette[label.at<uchar>(r, c)];
+    for (int c = 0; c < label.cols; ++c)
+      colour.at<cv::Vec3b>(r, c) = palette[label.at<uchar>(r, c)];
   }
   const double scale = std::max(1.0, 400.0 / std::max(label.rows, label.cols));
   cv::resize(colour, colour, cv::Size(), scale, scale, cv::INTER_NEAREST);

@@ -16,8 +16,9 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
                     const mapping::MapperConfig& config) {
   namespace fs = std::filesystem;
   if (fs::is_directory(input)) {
-    throw InputError(input + ": a directory; expected a .mat log (dataset directories are not "
-                             "readable yet)");
+    throw InputError(input +
+                     ": a directory; expected a .mat log (dataset directories are not "
+                     "readable yet)");
   }
   LogMapResult result;
   result.input = input;
@@ -77,10 +78,14 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) 
         {"visits_per_updated_cell",
          t.free_cells + t.occupied_cells == 0
              ? 0.0
-             : static_cast<double>(t.cell_visits) / static_cast<double>(t.free_cells + t.occupied_cells)}}},
+             : static_cast<double>(t.cell_visits) /
+                   static_cast<double>(t.free_cells + t.occupied_cells)}}},
       {"timing", {{"import_s", result.import_s}, {"map_s", result.map_s}}},
       {"outputs",
-       {{"map", "map.bt"}, {"map_full", "map.ot"}, {"map_top", "map_top.png"}, {"polar", "polar.png"},
+       {{"map", "map.bt"},
+        {"map_full", "map.ot"},
+        {"map_top", "map_top.png"},
+        {"polar", "polar.png"},
         {"fan", "fan.png"}}}};
   WriteFileAtomically((dir / "report.json").string(),
                       [&](std::ostream& out) { out << report.dump(2) << "\n"; });

@@ -26,7 +26,9 @@ TriangleMesh BuildMesh(const MeshSpec& spec, std::uint64_t seed) {
   const double hx = 0.5 * spec.size_m[0];
   const double hy = 0.5 * spec.size_m[1];
   const double sz = spec.size_m[2];
-  auto p = [&](double x, double y, double z) -> Eigen::Vector3d { return T * Eigen::Vector3d(x, y, z); };
+  auto p = [&](double x, double y, double z) -> Eigen::Vector3d {
+    return T * Eigen::Vector3d(x, y, z);
+  };
   switch (spec.type) {
     case MeshSpec::Type::kPlane:
       AddQuad(mesh, p(-hx, -hy, 0), p(hx, -hy, 0), p(hx, hy, 0), p(-hx, hy, 0));

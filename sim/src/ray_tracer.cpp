@@ -7,8 +7,7 @@
 
 namespace sonarbench::sim {
 
-RayTracer::RayTracer(std::span<const TriangleMesh> meshes)
-    : device_(rtcNewDevice(nullptr)) {
+RayTracer::RayTracer(std::span<const TriangleMesh> meshes) : device_(rtcNewDevice(nullptr)) {
   if (!device_) {
     throw std::runtime_error("Embree: cannot create a device (error " +
                              std::to_string(rtcGetDeviceError(nullptr)) + ")");
@@ -18,9 +17,9 @@ RayTracer::RayTracer(std::span<const TriangleMesh> meshes)
   for (std::size_t m = 0; m < meshes.size(); ++m) {
     const TriangleMesh& mesh = meshes[m];
     RTCGeometry geometry = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-        mesh.vertices.size()));
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                3 * sizeof(float), mesh.vertices.size()));
     auto* indices = static_cast<std::uint32_t*>(
         rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                 3 * sizeof(std::uint32_t), mesh.triangles.size()));

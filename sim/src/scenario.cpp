@@ -33,9 +33,12 @@ constexpr double kRadToDeg = 1.0 / mapping::kDegToRad;
 
 const char* DetectionMethodName(mapping::DetectionConfig::Method method) {
   switch (method) {
-    case mapping::DetectionConfig::Method::kThreshold: return "threshold";
-    case mapping::DetectionConfig::Method::kCanny: return "canny";
-    case mapping::DetectionConfig::Method::kAutoCanny: return "auto_canny";
+    case mapping::DetectionConfig::Method::kThreshold:
+      return "threshold";
+    case mapping::DetectionConfig::Method::kCanny:
+      return "canny";
+    case mapping::DetectionConfig::Method::kAutoCanny:
+      return "auto_canny";
   }
   return "?";
 }
@@ -154,7 +157,8 @@ void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
   const nlohmann::json report = {
       {"schema_version", 1},
       {"tool", {{"name", "sonarbench"}, {"version", "0.1.0"}}},
-      {"scene", {{"name", scene.name}, {"file", scene.file}, {"sensor_model", scene.sensor_model_file}}},
+      {"scene",
+       {{"name", scene.name}, {"file", scene.file}, {"sensor_model", scene.sensor_model_file}}},
       {"seed", result.seed},
       {"threads", result.threads},
       {"parameters",
@@ -191,7 +195,10 @@ void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
         {"score_s", t.score_s},
         {"total_s", t.build_scene_s + t.simulate_s + t.map_s + t.ground_truth_s + t.score_s}}},
       {"outputs",
-       {{"map", "map.bt"}, {"polar", "polar.png"}, {"fan", "fan.png"}, {"map_top", "map_top.png"}}}};
+       {{"map", "map.bt"},
+        {"polar", "polar.png"},
+        {"fan", "fan.png"},
+        {"map_top", "map_top.png"}}}};
   WriteFileAtomically((dir / "report.json").string(),
                       [&](std::ostream& out) { out << report.dump(2) << "\n"; });
 }

@@ -148,7 +148,8 @@ Scene LoadScene(const std::string& path) {
 
   // The sensor model is its own file, read (and its errors reported) only once the scene is sound.
   std::filesystem::path sensor_path(scene.sensor_model_file);
-  if (sensor_path.is_relative()) sensor_path = std::filesystem::path(root.Directory()) / sensor_path;
+  if (sensor_path.is_relative())
+    sensor_path = std::filesystem::path(root.Directory()) / sensor_path;
   scene.sensor_model_file = sensor_path.lexically_normal().string();
   scene.sensor = LoadSensorModel(scene.sensor_model_file);
   if (T_vehicle_sonar) scene.sensor.geometry.T_vehicle_sonar = *T_vehicle_sonar;

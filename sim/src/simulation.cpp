@@ -18,8 +18,7 @@ ScheduledBeam ScheduleBeam(const Scene& scene, std::size_t index) {
   const mapping::SensorGeometry& g = scene.sensor.geometry;
   ScheduledBeam out;
   out.time_s = static_cast<double>(index) / g.beams_per_second;
-  const double angle =
-      scene.start_head_angle_rad + static_cast<double>(index) * g.step_angle_rad;
+  const double angle = scene.start_head_angle_rad + static_cast<double>(index) * g.step_angle_rad;
   out.pose.head_angle_rad = std::remainder(angle - std::numbers::pi, 2.0 * std::numbers::pi) +
                             std::numbers::pi;  // in [0, 2π)
   out.pose.T_world_sonar = scene.trajectory.T_world_vehicle(out.time_s) * g.T_vehicle_sonar;
@@ -29,7 +28,8 @@ ScheduledBeam ScheduleBeam(const Scene& scene, std::size_t index) {
 std::vector<SynthesizedBeam> SimulateScene(const Scene& scene, const RayTracer& tracer,
                                            std::uint64_t seed, int threads) {
   std::vector<Material> materials_by_mesh;
-  for (const MeshSpec& mesh : scene.meshes) materials_by_mesh.push_back(scene.materials[mesh.material]);
+  for (const MeshSpec& mesh : scene.meshes)
+    materials_by_mesh.push_back(scene.materials[mesh.material]);
   const BeamSynthesizer synthesizer(scene.sensor, tracer, std::move(materials_by_mesh));
   const std::size_t count = ScenarioBeamCount(scene);
   std::vector<SynthesizedBeam> beams(count);

@@ -44,7 +44,7 @@ struct BasicBeamCells {
     std::uint64_t& slot = recent_free[(packed * 0x9e3779b97f4a7c15ULL) >> 53];
     if (slot == packed) return;
     slot = packed;
-    if constexpr (requires(Set& s) { s.insert_packed(packed); }) {
+    if constexpr (requires(Set & s) { s.insert_packed(packed); }) {
       free.insert_packed(packed);
     } else {
       free.insert(UnpackKey(packed));

@@ -6,8 +6,8 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cstdint>
-#include <utility>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "sonarbench/mapping/beam_volume.hpp"
@@ -68,7 +68,7 @@ BatchStats IntegrateBatch(octomap::OcTree& tree, std::span<const Beam> beams,
   }
   BasicBeamCells<Set> merged = std::move(per_thread.front());
   for (std::size_t t = 1; t < per_thread.size(); ++t) {
-    if constexpr (requires(Set& s, const Set& o) { s.merge(o); }) {
+    if constexpr (requires(Set & s, const Set& o) { s.merge(o); }) {
       merged.free.merge(per_thread[t].free);
       merged.occupied.merge(per_thread[t].occupied);
     } else {

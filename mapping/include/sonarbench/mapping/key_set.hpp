@@ -61,7 +61,8 @@ class OpenKeySet {
     Allocate(other.capacity_);
     if (capacity_ > 0) {
       std::memcpy(slots_, other.slots_, capacity_ * sizeof(std::uint64_t));
-      if constexpr (kCacheHash) std::memcpy(hashes_, other.hashes_, capacity_ * sizeof(std::uint64_t));
+      if constexpr (kCacheHash)
+        std::memcpy(hashes_, other.hashes_, capacity_ * sizeof(std::uint64_t));
     }
     size_ = other.size_;
     tombstones_ = other.tombstones_;
@@ -89,9 +90,7 @@ class OpenKeySet {
   bool erase(const octomap::OcTreeKey& key) {
     const std::size_t slot = FindPacked(PackKey(key));
     if (slot == kNotFound) return false;
-    slots_[slot] = kTombstone;
-    --size_;
-    ++tombstones_;
+    Bury(slot);
     return true;
   }
 
@@ -99,30 +98,24 @@ class OpenKeySet {
   /// (section 2.4.4), so at most one resize happens.
   void merge(const OpenKeySet& other) {
     reserve(size_ + other.size_);
-    other.ForEachPacked([this](std::uint64_t packed, std::uint64_t hash) { InsertHashed(packed, hash); });
+    other.ForEachPacked(
+        [this](std::uint64_t packed, std::uint64_t hash) { InsertHashed(packed, hash); });
   }
   /// The same merge without the reserve, for measuring what the reserve saves.
   void merge_without_reserve(const OpenKeySet& other) {
-    other.ForEachPacked([this](std::uint64_t packed, std::uint64_t hash) { InsertHashed(packed, hash); });
+    other.ForEachPacked(
+        [this](std::uint64_t packed, std::uint64_t hash) { InsertHashed(packed, hash); });
   }
   /// Removes every key that `other` holds.
   void difference(const OpenKeySet& other) {
     if (other.size_ < size_) {
       other.ForEachPacked([this](std::uint64_t packed, std::uint64_t) {
         const std::size_t slot = FindPacked(packed);
-        if (slot != kNotFound) {
-          slots_[slot] = kTombstone;
-          --size_;
-          ++tombstones_;
-        }
+        if (slot != kNotFound) Bury(slot);
       });
     } else {
       for (std::size_t i = 0; i < capacity_; ++i) {
-        if (IsKey(slots_[i]) && other.FindPacked(slots_[i]) != kNotFound) {
-          slots_[i] = kTombstone;
-          --size_;
-          ++tombstones_;
-        }
+        if (IsKey(slots_[i]) && other.FindPacked(slots_[i]) != kNotFound) Bury(i);
       }
     }
   }
@@ -196,6 +189,12 @@ class OpenKeySet {
   static constexpr std::size_t kLoadDenominator = 2;
 
   static bool IsKey(std::uint64_t slot) { return slot < kTombstone; }
+  // Erases the key in `slot`, leaving a tombstone so that probe paths through it stay whole.
+  void Bury(std::size_t slot) {
+    slots_[slot] = kTombstone;
+    --size_;
+    ++tombstones_;
+  }
   static std::uint64_t Hash(std::uint64_t packed) { return packed * 0x9e3779b97f4a7c15ULL; }
   static std::size_t CapacityFor(std::size_t count) {
     const std::size_t min_slots = count * kLoadDenominator / kLoadNumerator + 1;
@@ -271,7 +270,8 @@ class OpenKeySet {
       bigger.Allocate(new_capacity);
       bigger.collisions_ = collisions_;
       peak_bytes_ = std::max(peak_bytes_, Bytes(capacity_) + Bytes(new_capacity));
-      ForEachPacked([&](std::uint64_t packed, std::uint64_t hash) { bigger.PlaceNew(packed, hash); });
+      ForEachPacked(
+          [&](std::uint64_t packed, std::uint64_t hash) { bigger.PlaceNew(packed, hash); });
       bigger.peak_bytes_ = peak_bytes_;
       Swap(bigger);
     } else {
@@ -327,8 +327,10 @@ class OpenKeySet {
           }
           if (!moved[slot]) {
             std::swap(carry, slots_[slot]);
-            if constexpr (kCacheHash) std::swap(carry_hash, hashes_[slot]);
-            else carry_hash = Hash(carry);
+            if constexpr (kCacheHash)
+              std::swap(carry_hash, hashes_[slot]);
+            else
+              carry_hash = Hash(carry);
             moved[slot] = true;
             break;  // carry the displaced key from its own home
           }
@@ -358,12 +360,14 @@ class OpenKeySet {
   }
 
   void Reallocate(std::size_t capacity) {
-    auto* slots = static_cast<std::uint64_t*>(std::realloc(slots_, capacity * sizeof(std::uint64_t)));
+    auto* slots =
+        static_cast<std::uint64_t*>(std::realloc(slots_, capacity * sizeof(std::uint64_t)));
     if (slots == nullptr) throw std::bad_alloc();
     slots_ = slots;
     std::memset(slots_ + capacity_, 0xff, (capacity - capacity_) * sizeof(std::uint64_t));
     if constexpr (kCacheHash) {
-      auto* hashes = static_cast<std::uint64_t*>(std::realloc(hashes_, capacity * sizeof(std::uint64_t)));
+      auto* hashes =
+          static_cast<std::uint64_t*>(std::realloc(hashes_, capacity * sizeof(std::uint64_t)));
       if (hashes == nullptr) throw std::bad_alloc();
       hashes_ = hashes;
     }

@@ -50,8 +50,8 @@ bool ForEachRayKey(const octomap::OcTree& tree, const octomap::point3d& origin,
     }
   }
   while (true) {
-    const unsigned dim = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0u : 2u)
-                                             : (t_max[1] < t_max[2] ? 1u : 2u);
+    const unsigned dim =
+        t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0u : 2u) : (t_max[1] < t_max[2] ? 1u : 2u);
     current += packed_step[dim];
     t_max[dim] += t_delta[dim];
     if (current == last) return true;

@@ -29,7 +29,8 @@ struct Acoustics {
   double pulse_length_m = 0.0375;
   /// Mean background noise power at the receiver output [dB].
   double noise_level_db = -40.0;
-  /// Multiplicative speckle: echo power scaled by an exponential draw of mean 1 (Rayleigh amplitude).
+  /// Multiplicative speckle: echo power scaled by an exponential draw of mean 1 (Rayleigh
+  /// amplitude).
   bool speckle = true;
   /// Level mapped to intensity 0, and the span [dB] mapped onto 0..255 (the Micron's ADLow/ADSpan).
   double ad_low_db = -40.0;
