@@ -121,5 +121,49 @@ TEST(CollectMapCells, PrunedNodesExpandToTheirLeafCells) {
   EXPECT_EQ(CollectMapCells(tree).occupied.size(), 8u);
 }
 
+TEST(PointTriangleDistance, AnalyticCases) {
+  const Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  EXPECT_DOUBLE_EQ(PointTriangleDistance({0.2, 0.2, 0.5}, a, b, c), 0.5);  // above the face
+  EXPECT_DOUBLE_EQ(PointTriangleDistance({-3, -4, 0}, a, b, c), 5.0);      // nearest a vertex
+  EXPECT_DOUBLE_EQ(PointTriangleDistance({0.5, -2, 0}, a, b, c), 2.0);     // nearest an edge
+  EXPECT_NEAR(PointTriangleDistance({1, 1, 0}, a, b, c), std::sqrt(0.5), 1e-12);  // hypotenuse
+}
+
+// A plane at z = 0.012 m and occupied cells in the layers k = 0, 1, 3 above it (centres at
+// 0.025 + 0.05 k): each cell's distance to the mesh is its centre's height above the plane,
+// exactly; the surface cells' distance back to the nearest occupied cell is 0 where the map
+// holds them.
+TEST(ScoreMap, SurfaceDistancesOfKnownOffsets) {
+  MeshSpec spec;
+  spec.type = MeshSpec::Type::kPlane;
+  spec.size_m = {0.98, 0.98, 0.0};
+  spec.T_world_mesh.translation() = Vector3d(0, 0, 0.012);
+  const std::vector<TriangleMesh> meshes{BuildMesh(spec, 0)};
+  const octomap::OcTree key_space(0.05);
+  const mapping::KeySet truth = VoxelizeMeshes(meshes, key_space);
+  mapping::KeySet occupied;
+  const octomap::key_type z0 = key_space.coordToKey(0.012);
+  for (const int layer : {0, 1, 3}) {
+    occupied.insert(octomap::OcTreeKey(32768, 32768, static_cast<octomap::key_type>(z0 + layer)));
+  }
+  const MapMetrics m = ScoreMap(MapWith(occupied, {}), truth, truth, meshes);
+  ASSERT_EQ(m.map_to_mesh.count, 3u);
+  EXPECT_NEAR(m.map_to_mesh.max_m, 0.025 + 0.15 - 0.012, 1e-6);
+  EXPECT_NEAR(m.map_to_mesh.mean_m, (0.013 + 0.063 + 0.163) / 3.0, 1e-6);
+  ASSERT_EQ(m.mesh_to_map.count, truth.size());
+  // The farthest surface cell is a corner of the 20 × 20 layer, 10 and 9 or 10 cells away in x
+  // and y from the one occupied column (at keys 32768 = cells [0, 0.05)).
+  EXPECT_NEAR(m.mesh_to_map.max_m, 0.05 * std::hypot(10.0, 10.0), 1e-6);
+}
+
+TEST(ScoreMap, FreeCellsOnTheSurfaceLowerFreeAccuracy) {
+  const mapping::KeySet truth = Row(0, 10);
+  const MapMetrics m = ScoreMap(MapWith({}, Row(5, 25)), truth, truth);
+  EXPECT_EQ(m.free_on_surface_cells, 5u);
+  EXPECT_DOUBLE_EQ(m.free_accuracy, 1.0 - 5.0 / 20.0);
+  EXPECT_DOUBLE_EQ(m.coverage_absolute, 0.5);
+  EXPECT_EQ(m.mesh_to_map.count, 0u);  // no occupied cell: no distance, and no NaN
+}
+
 }  // namespace
 }  // namespace sonarbench::sim

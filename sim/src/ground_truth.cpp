@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 namespace sonarbench::sim {
 namespace {
@@ -52,39 +53,43 @@ bool TriangleBoxOverlap(const Vector3d& box_centre, const Vector3d& box_half_siz
   return true;
 }
 
+void ForEachTriangleCell(const Vector3d& a, const Vector3d& b, const Vector3d& c,
+                         const octomap::OcTree& key_space,
+                         const std::function<void(const octomap::OcTreeKey&)>& visit) {
+  const double resolution = key_space.getResolution();
+  const Vector3d half(0.5 * resolution, 0.5 * resolution, 0.5 * resolution);
+  const Vector3d lo = a.cwiseMin(b).cwiseMin(c);
+  const Vector3d hi = a.cwiseMax(b).cwiseMax(c);
+  octomap::OcTreeKey key_lo;
+  octomap::OcTreeKey key_hi;
+  if (!key_space.coordToKeyChecked(lo.x(), lo.y(), lo.z(), key_lo) ||
+      !key_space.coordToKeyChecked(hi.x(), hi.y(), hi.z(), key_hi)) {
+    return;  // outside OctoMap's ±(2^15 · resolution) world
+  }
+  // A vertex on a cell face touches the neighbour too: widen the candidate range by one.
+  for (int x = key_lo[0] - 1; x <= key_hi[0] + 1; ++x) {
+    for (int y = key_lo[1] - 1; y <= key_hi[1] + 1; ++y) {
+      for (int z = key_lo[2] - 1; z <= key_hi[2] + 1; ++z) {
+        const octomap::OcTreeKey key(static_cast<octomap::key_type>(x),
+                                     static_cast<octomap::key_type>(y),
+                                     static_cast<octomap::key_type>(z));
+        const octomap::point3d centre = key_space.keyToCoord(key);
+        if (TriangleBoxOverlap(Vector3d(centre.x(), centre.y(), centre.z()), half, a, b, c)) {
+          visit(key);
+        }
+      }
+    }
+  }
+}
+
 mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
                                const octomap::OcTree& key_space) {
   mapping::KeySet cells;
-  const double resolution = key_space.getResolution();
-  const Vector3d half(0.5 * resolution, 0.5 * resolution, 0.5 * resolution);
   for (const TriangleMesh& mesh : meshes) {
-    for (const auto& triangle : mesh.triangles) {
-      const Vector3d a = mesh.vertices[triangle[0]].cast<double>();
-      const Vector3d b = mesh.vertices[triangle[1]].cast<double>();
-      const Vector3d c = mesh.vertices[triangle[2]].cast<double>();
-      const Vector3d lo = a.cwiseMin(b).cwiseMin(c);
-      const Vector3d hi = a.cwiseMax(b).cwiseMax(c);
-      octomap::OcTreeKey key_lo;
-      octomap::OcTreeKey key_hi;
-      if (!key_space.coordToKeyChecked(lo.x(), lo.y(), lo.z(), key_lo) ||
-          !key_space.coordToKeyChecked(hi.x(), hi.y(), hi.z(), key_hi)) {
-        continue;  // outside OctoMap's ±(2^15 · resolution) world
-      }
-      // A vertex on a cell face touches the neighbour too: widen the candidate range by one.
-      octomap::OcTreeKey key;
-      for (int x = key_lo[0] - 1; x <= key_hi[0] + 1; ++x) {
-        for (int y = key_lo[1] - 1; y <= key_hi[1] + 1; ++y) {
-          for (int z = key_lo[2] - 1; z <= key_hi[2] + 1; ++z) {
-            key = octomap::OcTreeKey(static_cast<octomap::key_type>(x),
-                                     static_cast<octomap::key_type>(y),
-                                     static_cast<octomap::key_type>(z));
-            const octomap::point3d centre = key_space.keyToCoord(key);
-            if (TriangleBoxOverlap(Vector3d(centre.x(), centre.y(), centre.z()), half, a, b, c)) {
-              cells.insert(key);
-            }
-          }
-        }
-      }
+    for (const auto& t : mesh.triangles) {
+      ForEachTriangleCell(mesh.vertices[t[0]].cast<double>(), mesh.vertices[t[1]].cast<double>(),
+                          mesh.vertices[t[2]].cast<double>(), key_space,
+                          [&cells](const octomap::OcTreeKey& key) { cells.insert(key); });
     }
   }
   return cells;

@@ -31,6 +31,10 @@ class Stopwatch {
 
 constexpr double kRadToDeg = 1.0 / mapping::kDegToRad;
 
+nlohmann::json DistanceJson(const DistanceStats& d) {
+  return {{"count", d.count}, {"mean_m", d.mean_m}, {"p95_m", d.p95_m}, {"max_m", d.max_m}};
+}
+
 const char* DetectionMethodName(mapping::DetectionConfig::Method method) {
   switch (method) {
     case mapping::DetectionConfig::Method::kThreshold:
@@ -136,7 +140,7 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
                                              2 * a.rays_horizontal, 2 * a.rays_vertical, map);
   result.timings.ground_truth_s = clock.Lap();
 
-  result.metrics = ScoreMap(map, result.truth, result.observable);
+  result.metrics = ScoreMap(map, result.truth, result.observable, meshes);
   result.timings.score_s = clock.Lap();
   return result;
 }
@@ -172,6 +176,11 @@ void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
         {"occupied_recall", m.occupied_recall},
         {"occupied_f1", m.occupied_f1},
         {"coverage", m.coverage},
+        {"coverage_absolute", m.coverage_absolute},
+        {"free_accuracy", m.free_accuracy},
+        {"surface_distance",
+         {{"map_to_mesh", DistanceJson(m.map_to_mesh)},
+          {"mesh_to_map", DistanceJson(m.mesh_to_map)}}},
         {"counts",
          {{"truth_cells", m.truth_cells},
           {"observable_cells", m.observable_cells},
@@ -179,7 +188,8 @@ void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
           {"free_cells", m.free_cells},
           {"true_positive_cells", m.true_positive_cells},
           {"observed_occupied_cells", m.observed_occupied_cells},
-          {"known_observable_cells", m.known_observable_cells}}}}},
+          {"known_observable_cells", m.known_observable_cells},
+          {"free_on_surface_cells", m.free_on_surface_cells}}}}},
       {"mapping_totals",
        {{"beams", result.mapping_totals.beams},
         {"beams_with_obstacle", result.mapping_totals.beams_with_obstacle},

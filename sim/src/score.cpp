@@ -1,5 +1,12 @@
 #include "sonarbench/sim/score.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+#include <vector>
+
+#include "sonarbench/sim/ground_truth.hpp"
+
 namespace sonarbench::sim {
 namespace {
 
@@ -7,7 +14,82 @@ double Ratio(std::size_t numerator, std::size_t denominator) {
   return denominator == 0 ? 0.0 : static_cast<double>(numerator) / static_cast<double>(denominator);
 }
 
+DistanceStats Summarise(std::vector<double> d) {
+  DistanceStats s;
+  s.count = d.size();
+  if (d.empty()) return s;
+  std::sort(d.begin(), d.end());
+  double sum = 0.0;
+  for (const double v : d) sum += v;
+  s.mean_m = sum / static_cast<double>(d.size());
+  s.p95_m = d[std::min(d.size() - 1, static_cast<std::size_t>(std::ceil(0.95 * d.size())) - 1)];
+  s.max_m = d.back();
+  return s;
+}
+
+using Key = octomap::OcTreeKey;
+
+// Visits the cells at Chebyshev distance exactly `ring` from `centre`.
+template <typename F>
+void ForEachInRing(const Key& centre, int ring, F&& f) {
+  for (int dx = -ring; dx <= ring; ++dx) {
+    for (int dy = -ring; dy <= ring; ++dy) {
+      for (int dz = -ring; dz <= ring; ++dz) {
+        if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != ring) continue;
+        const int x = centre[0] + dx, y = centre[1] + dy, z = centre[2] + dz;
+        if (x < 0 || y < 0 || z < 0 || x > 65535 || y > 65535 || z > 65535) continue;
+        f(Key(static_cast<octomap::key_type>(x), static_cast<octomap::key_type>(y),
+              static_cast<octomap::key_type>(z)));
+      }
+    }
+  }
+}
+
+// Searches rings outwards from `from`'s cell; `visit(cell)` returns the distance to what that
+// cell holds, or a negative number. A cell `ring` rings out is at least (ring - 1) cells away,
+// so the search stops once that exceeds the best distance found, or at `max_ring`.
+template <typename Visit>
+double NearestByRings(const Key& from, double resolution, int max_ring, Visit&& visit) {
+  double best = -1.0;
+  for (int ring = 0; ring <= max_ring; ++ring) {
+    if (best >= 0.0 && (ring - 1) * resolution > best) break;
+    ForEachInRing(from, ring, [&](const Key& cell) {
+      const double d = visit(cell);
+      if (d >= 0.0 && (best < 0.0 || d < best)) best = d;
+    });
+  }
+  return best;
+}
+
+Eigen::Vector3d Centre(const octomap::OcTree& map, const Key& key) {
+  const octomap::point3d c = map.keyToCoord(key);
+  return {c.x(), c.y(), c.z()};
+}
+
 }  // namespace
+
+double PointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                             const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return (p - a).norm();
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return (p - b).norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return (p - c).norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+  }
+  const double denom = 1.0 / (va + vb + vc);
+  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
+}
 
 MapCells CollectMapCells(const octomap::OcTree& map) {
   MapCells cells;
@@ -30,7 +112,7 @@ MapCells CollectMapCells(const octomap::OcTree& map) {
 }
 
 MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
-                    const mapping::KeySet& observable) {
+                    const mapping::KeySet& observable, std::span<const TriangleMesh> meshes) {
   const MapCells cells = CollectMapCells(map);
   MapMetrics m;
   m.truth_cells = truth.size();
@@ -52,6 +134,61 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
   const double sum = m.occupied_precision + m.occupied_recall;
   m.occupied_f1 = sum > 0.0 ? 2.0 * m.occupied_precision * m.occupied_recall / sum : 0.0;
   m.coverage = Ratio(m.known_observable_cells, m.observable_cells);
+  std::size_t known_truth = 0;
+  for (const auto& key : truth) {
+    known_truth += (cells.occupied.contains(key) || cells.free.contains(key)) ? 1 : 0;
+  }
+  m.coverage_absolute = Ratio(known_truth, truth.size());
+  for (const auto& key : cells.free) m.free_on_surface_cells += truth.contains(key) ? 1 : 0;
+  m.free_accuracy = cells.free.empty() ? 0.0 : 1.0 - Ratio(m.free_on_surface_cells, m.free_cells);
+
+  const double res = map.getResolution();
+  constexpr int kMaxRing = 200;  // 10 m at 5 cm: beyond that a distance is not worth a search
+  if (!meshes.empty()) {
+    // Each triangle is listed in the cells it overlaps, so the nearest triangle to a point lies
+    // in a cell no farther out than the nearest listed cell's ring plus one.
+    std::unordered_map<Key, std::vector<std::pair<std::size_t, std::size_t>>, Key::KeyHash> listed;
+    for (std::size_t m_i = 0; m_i < meshes.size(); ++m_i) {
+      for (std::size_t t = 0; t < meshes[m_i].triangles.size(); ++t) {
+        const auto& tri = meshes[m_i].triangles[t];
+        const auto& v = meshes[m_i].vertices;
+        ForEachTriangleCell(v[tri[0]].cast<double>(), v[tri[1]].cast<double>(),
+                            v[tri[2]].cast<double>(), map,
+                            [&](const Key& key) { listed[key].emplace_back(m_i, t); });
+      }
+    }
+    std::vector<double> d;
+    for (const auto& key : cells.occupied) {
+      const Eigen::Vector3d p = Centre(map, key);
+      const double best = NearestByRings(key, res, kMaxRing, [&](const Key& cell) {
+        const auto it = listed.find(cell);
+        if (it == listed.end()) return -1.0;
+        double nearest = -1.0;
+        for (const auto& [mi, ti] : it->second) {
+          const auto& tri = meshes[mi].triangles[ti];
+          const double dist = PointTriangleDistance(p, meshes[mi].vertices[tri[0]].cast<double>(),
+                                                    meshes[mi].vertices[tri[1]].cast<double>(),
+                                                    meshes[mi].vertices[tri[2]].cast<double>());
+          if (nearest < 0.0 || dist < nearest) nearest = dist;
+        }
+        return nearest;
+      });
+      if (best >= 0.0) d.push_back(best);
+    }
+    m.map_to_mesh = Summarise(std::move(d));
+  }
+  if (!cells.occupied.empty()) {
+    std::vector<double> d;
+    for (const auto& key : observable) {
+      if (!truth.contains(key)) continue;
+      const Eigen::Vector3d p = Centre(map, key);
+      const double best = NearestByRings(key, res, kMaxRing, [&](const Key& cell) {
+        return cells.occupied.contains(cell) ? (Centre(map, cell) - p).norm() : -1.0;
+      });
+      if (best >= 0.0) d.push_back(best);
+    }
+    m.mesh_to_map = Summarise(std::move(d));
+  }
   return m;
 }
 

@@ -3,10 +3,21 @@
 #include <octomap/OcTree.h>
 
 #include <cstddef>
+#include <span>
 
 #include "sonarbench/mapping/beam_volume.hpp"
+#include "sonarbench/sim/mesh.hpp"
 
 namespace sonarbench::sim {
+
+/// Distances [m] from one set of points to another surface: mean, 95th percentile and maximum
+/// (the one-sided Hausdorff distance), over `count` points; all 0 when `count` is 0.
+struct DistanceStats {
+  std::size_t count = 0;
+  double mean_m = 0.0;
+  double p95_m = 0.0;
+  double max_m = 0.0;
+};
 
 /// How a map compares with the ground truth. Cells are leaf cells at the map's resolution; a
 /// pruned inner node counts as all the leaf cells it stands for. Unknown cells (never updated)
@@ -28,12 +39,28 @@ struct MapMetrics {
   double occupied_f1 = 0.0;
   /// known ∩ observable / observable: the share of visible surface the map has any belief about.
   double coverage = 0.0;
+  /// (occupied ∪ free) ∩ truth / truth: the same against every surface cell, seen or not.
+  double coverage_absolute = 0.0;
+  /// Free cells that lie on a surface, and 1 - that / free: how often "free" is wrong.
+  std::size_t free_on_surface_cells = 0;
+  double free_accuracy = 0.0;
+  /// From each occupied cell's centre to the nearest mesh triangle (exact point-triangle
+  /// distance), and from each observable surface cell's centre to the nearest occupied cell's.
+  DistanceStats map_to_mesh;
+  DistanceStats mesh_to_map;
 };
 
 /// Scores `map` against the surface cells `truth` and the subset `observable` a perfect sensor
-/// could see (cells of `observable` outside `truth` are ignored).
+/// could see (cells of `observable` outside `truth` are ignored); `meshes` give the exact surface
+/// for distances (none: distances are not computed).
 [[nodiscard]] MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
-                                  const mapping::KeySet& observable);
+                                  const mapping::KeySet& observable,
+                                  std::span<const TriangleMesh> meshes = {});
+
+/// Exact distance [m] from `p` to the triangle a, b, c (Ericson, Real-Time Collision Detection,
+/// 5.1.5).
+[[nodiscard]] double PointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                           const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 
 /// Leaf cells of `map` at its finest resolution, split by occupancy.
 struct MapCells {
