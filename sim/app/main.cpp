@@ -6,9 +6,13 @@
 #include <string>
 
 #include "sonarbench/mapping/error.hpp"
+#include "sonarbench/mapping/mat_log.hpp"
+#include "sonarbench/sim/fidelity.hpp"
 #include "sonarbench/sim/map_log.hpp"
+#include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/scenario.hpp"
 #include "sonarbench/sim/scene.hpp"
+#include "sonarbench/sim/simulation.hpp"
 
 namespace {
 
@@ -66,6 +70,43 @@ int Map(const MapArgs& args) {
             << result.sweeps << " sweeps; " << t.beams_with_obstacle << " with an obstacle\n"
             << "timing [s]: import " << result.import_s << ", map " << result.map_s << "\n"
             << "wrote " << args.out << "/report.json, map.bt, map.ot, map_top.png\n";
+  return 0;
+}
+
+struct FidelityArgs {
+  std::string scene;
+  std::string log;
+  std::string out = "out/fidelity";
+  std::optional<std::uint64_t> seed;
+  int threads = 0;
+  double wall_min_range_m = 1.6;
+};
+
+int Fidelity(const FidelityArgs& args) {
+  namespace sim = sonarbench::sim;
+  const sim::Scene scene = sim::LoadScene(args.scene);
+  const sonarbench::mapping::MatLog log = sonarbench::mapping::ReadMatLog(args.log);
+  const auto meshes = sim::BuildSceneMeshes(scene);
+  const sim::RayTracer tracer(meshes);
+  const auto synthesized =
+      sim::SimulateScene(scene, tracer, args.seed.value_or(scene.seed), args.threads);
+  std::vector<sonarbench::mapping::Beam> beams;
+  beams.reserve(synthesized.size());
+  for (const auto& s : synthesized) beams.push_back(s.beam);
+  const auto& g = scene.sensor.geometry;
+  const auto report = sim::CompareWithLog(beams, log.beams, g, args.wall_min_range_m);
+  const auto per_sweep = static_cast<std::size_t>(g.BeamsPerSweep());
+  const std::span<const sonarbench::mapping::Beam> sim_all(beams);
+  const std::span<const sonarbench::mapping::Beam> real_all(log.beams);
+  sim::WriteFidelityOutputs(args.out, report, sim_all.first(std::min(per_sweep, sim_all.size())),
+                            real_all.first(std::min(per_sweep, real_all.size())), g, args.scene,
+                            args.log);
+  std::cout << "mean intensity vs range: correlation " << report.profile_correlation_all
+            << " (all bins), " << report.profile_correlation_usable << " (past self-reflection)\n"
+            << "wall range: median difference " << report.median_wall_difference_bins
+            << " bins over " << report.wall_angles_compared << " head angles\n"
+            << "intensity histograms: intersection " << report.histogram_intersection << "\n"
+            << "wrote " << args.out << "/fidelity.json\n";
   return 0;
 }
 
@@ -138,6 +179,31 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
 
+  FidelityArgs fidelity;
+  CLI::App* fidelity_cmd = app.add_subcommand(
+      "fidelity",
+      "Compare a simulated scene with a real log of the same place: mean intensity against range "
+      "(correlation), the strongest echo's range per head angle (median difference in bins), "
+      "intensity histograms (intersection), and the first sweeps side by side (sim left, real "
+      "right). Writes fidelity.json, profile.csv/.png, wall_range.csv, histogram.csv, polar.png "
+      "and fan.png into --out.");
+  fidelity_cmd->add_option("scene", fidelity.scene, "Scene YAML file")
+      ->required()
+      ->check(CLI::ExistingFile);
+  fidelity_cmd->add_option("log", fidelity.log, "Real log (.mat)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  fidelity_cmd->add_option("-o,--out", fidelity.out, "Output directory")->capture_default_str();
+  fidelity_cmd->add_option("-s,--seed", fidelity.seed, "Overrides the scene's seed");
+  fidelity_cmd->add_option("-j,--threads", fidelity.threads, "Threads; 0 = all cores")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  fidelity_cmd
+      ->add_option("--wall-min-range", fidelity.wall_min_range_m,
+                   "Strongest echoes are sought beyond this range [m] (past the floor's)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -148,6 +214,7 @@ int main(int argc, char** argv) {
   try {
     if (*run_cmd) return Run(run);
     if (*map_cmd) return Map(map);
+    if (*fidelity_cmd) return Fidelity(fidelity);
   } catch (const sonarbench::InputError& e) {
     std::cerr << "sonarbench: error: " << e.what() << "\n";
     return kExitBadInput;

@@ -10,8 +10,6 @@
 #include "sonarbench/mapping/atomic_file.hpp"
 
 namespace sonarbench::sim {
-namespace {
-
 void WritePng(const std::string& path, const cv::Mat& image) {
   std::vector<uchar> bytes;
   if (!cv::imencode(".png", image, bytes)) throw std::runtime_error(path + ": PNG encoding failed");
@@ -21,9 +19,7 @@ void WritePng(const std::string& path, const cv::Mat& image) {
   });
 }
 
-}  // namespace
-
-void WritePolarImage(const std::string& path, std::span<const mapping::Beam> sweep) {
+cv::Mat RenderPolarImage(std::span<const mapping::Beam> sweep) {
   std::size_t bins = 0;
   for (const auto& beam : sweep) bins = std::max(bins, beam.intensities.size());
   cv::Mat gray(static_cast<int>(sweep.size()), static_cast<int>(bins), CV_8UC1, cv::Scalar(0));
@@ -34,20 +30,21 @@ void WritePolarImage(const std::string& path, std::span<const mapping::Beam> swe
   cv::Mat colour;
   cv::applyColorMap(gray, colour, cv::COLORMAP_INFERNO);
   cv::resize(colour, colour, cv::Size(), 2.0, 2.0, cv::INTER_NEAREST);
-  WritePng(path, colour);
+  return colour;
 }
 
-void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep, double pixel_m) {
+void WritePolarImage(const std::string& path, std::span<const mapping::Beam> sweep) {
+  WritePng(path, RenderPolarImage(sweep));
+}
+
+cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m) {
   double max_range = 0.0;
   for (const auto& beam : sweep) {
     max_range = std::max(max_range, beam.bin_size_m * static_cast<double>(beam.intensities.size()));
   }
   const int half = static_cast<int>(std::ceil(max_range / pixel_m));
   cv::Mat gray(2 * half + 1, 2 * half + 1, CV_8UC1, cv::Scalar(0));
-  if (sweep.empty()) {
-    WritePng(path, gray);
-    return;
-  }
+  if (sweep.empty()) return gray;
   for (int row = 0; row < gray.rows; ++row) {
     for (int col = 0; col < gray.cols; ++col) {
       const double x = (col - half) * pixel_m;
@@ -69,7 +66,11 @@ void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep
   }
   cv::Mat colour;
   cv::applyColorMap(gray, colour, cv::COLORMAP_INFERNO);
-  WritePng(path, colour);
+  return colour;
+}
+
+void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep, double pixel_m) {
+  WritePng(path, RenderFanImage(sweep, pixel_m));
 }
 
 void WriteTopDownImage(const std::string& path, const MapCells& map, const mapping::KeySet& truth,

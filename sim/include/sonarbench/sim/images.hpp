@@ -1,5 +1,6 @@
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <span>
 #include <string>
 
@@ -8,12 +9,19 @@
 
 namespace sonarbench::sim {
 
-/// Writes one sweep as a polar image: one row per beam (in time order), one column per range
-/// bin (range grows to the right), intensity on a perceptual colour map. PNG, atomically.
+/// Writes `image` as a PNG file, atomically.
+void WritePng(const std::string& path, const cv::Mat& image);
+
+/// Renders one sweep as a polar image: one row per beam (in time order), one column per range
+/// bin (range grows to the right), intensity on a perceptual colour map.
+[[nodiscard]] cv::Mat RenderPolarImage(std::span<const mapping::Beam> sweep);
+/// RenderPolarImage, written as a PNG file atomically.
 void WritePolarImage(const std::string& path, std::span<const mapping::Beam> sweep);
 
-/// Writes one sweep as a top-down Cartesian fan: the sonar at the centre, x to the right, y up,
+/// Renders one sweep as a top-down Cartesian fan: the sonar at the centre, x to the right, y up,
 /// `pixel_m` per pixel; each pixel shows the bin at its range on the beam nearest its bearing.
+[[nodiscard]] cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m);
+/// RenderFanImage, written as a PNG file atomically.
 void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep, double pixel_m);
 
 /// Writes a top-down view of the map against the truth, one pixel per cell column (x right,

@@ -1,0 +1,202 @@
+#include "sonarbench/sim/fidelity.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/sim/images.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+std::vector<double> MeanProfile(std::span<const mapping::Beam> beams, std::size_t bins) {
+  std::vector<double> sum(bins, 0.0);
+  std::vector<double> count(bins, 0.0);
+  for (const auto& beam : beams) {
+    for (std::size_t k = 0; k < std::min(bins, beam.intensities.size()); ++k) {
+      sum[k] += beam.intensities[k];
+      count[k] += 1.0;
+    }
+  }
+  for (std::size_t k = 0; k < bins; ++k) sum[k] = count[k] > 0 ? sum[k] / count[k] : 0.0;
+  return sum;
+}
+
+std::vector<std::optional<double>> WallRanges(std::span<const mapping::Beam> beams,
+                                              const mapping::SensorGeometry& sensor,
+                                              double min_range_m) {
+  const int steps = sensor.BeamsPerSweep();
+  std::vector<std::vector<double>> per_angle(static_cast<std::size_t>(steps));
+  for (const auto& beam : beams) {
+    const auto first = static_cast<std::size_t>(std::ceil(min_range_m / beam.bin_size_m));
+    if (first >= beam.intensities.size()) continue;
+    const auto strongest = std::max_element(beam.intensities.begin() + static_cast<long>(first),
+                                            beam.intensities.end());
+    const long step = std::lround(beam.head_angle_rad / sensor.step_angle_rad);
+    const auto index = static_cast<std::size_t>(((step % steps) + steps) % steps);
+    per_angle[index].push_back(
+        beam.BinCentreRange(static_cast<std::size_t>(strongest - beam.intensities.begin())));
+  }
+  std::vector<std::optional<double>> out(per_angle.size());
+  for (std::size_t a = 0; a < per_angle.size(); ++a) {
+    auto& v = per_angle[a];
+    if (v.empty()) continue;
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+    out[a] = v[v.size() / 2];
+  }
+  return out;
+}
+
+std::array<double, 256> Histogram(std::span<const mapping::Beam> beams, std::size_t first) {
+  std::array<double, 256> h{};
+  double total = 0.0;
+  for (const auto& beam : beams) {
+    for (std::size_t k = first; k < beam.intensities.size(); ++k) {
+      h[beam.intensities[k]] += 1.0;
+      total += 1.0;
+    }
+  }
+  if (total > 0) {
+    for (double& v : h) v /= total;
+  }
+  return h;
+}
+
+void WriteText(const std::string& path, const std::string& text) {
+  WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
+}
+
+// Two images side by side (the right one scaled to the left one's size).
+cv::Mat SideBySide(const cv::Mat& left, const cv::Mat& right) {
+  cv::Mat right_sized;
+  cv::resize(right, right_sized, left.size(), 0, 0, cv::INTER_NEAREST);
+  cv::Mat joined;
+  cv::hconcat(left, right_sized, joined);
+  return joined;
+}
+
+}  // namespace
+
+double PearsonCorrelation(std::span<const double> a, std::span<const double> b) {
+  const std::size_t n = std::min(a.size(), b.size());
+  if (n == 0) return 0.0;
+  double ma = 0.0, mb = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    ma += a[i];
+    mb += b[i];
+  }
+  ma /= static_cast<double>(n);
+  mb /= static_cast<double>(n);
+  double sab = 0.0, saa = 0.0, sbb = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sab += (a[i] - ma) * (b[i] - mb);
+    saa += (a[i] - ma) * (a[i] - ma);
+    sbb += (b[i] - mb) * (b[i] - mb);
+  }
+  return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
+}
+
+FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
+                              std::span<const mapping::Beam> real,
+                              const mapping::SensorGeometry& sensor, double wall_min_range_m) {
+  FidelityReport r;
+  const auto bins = static_cast<std::size_t>(sensor.num_bins);
+  r.sim_mean = MeanProfile(sim, bins);
+  r.real_mean = MeanProfile(real, bins);
+  r.profile_correlation_all = PearsonCorrelation(r.sim_mean, r.real_mean);
+  const auto first = static_cast<std::size_t>(sensor.FirstUsableBin());
+  r.profile_correlation_usable = PearsonCorrelation(std::span(r.sim_mean).subspan(first),
+                                                    std::span(r.real_mean).subspan(first));
+  r.sim_wall_m = WallRanges(sim, sensor, wall_min_range_m);
+  r.real_wall_m = WallRanges(real, sensor, wall_min_range_m);
+  std::vector<double> differences;
+  for (std::size_t a = 0; a < r.sim_wall_m.size(); ++a) {
+    if (r.sim_wall_m[a] && r.real_wall_m[a]) {
+      differences.push_back(std::abs(*r.sim_wall_m[a] - *r.real_wall_m[a]) / sensor.bin_size_m);
+    }
+  }
+  r.wall_angles_compared = differences.size();
+  if (!differences.empty()) {
+    std::nth_element(differences.begin(),
+                     differences.begin() + static_cast<long>(differences.size() / 2),
+                     differences.end());
+    r.median_wall_difference_bins = differences[differences.size() / 2];
+  }
+  r.sim_histogram = Histogram(sim, first);
+  r.real_histogram = Histogram(real, first);
+  for (std::size_t v = 0; v < 256; ++v) {
+    r.histogram_intersection += std::min(r.sim_histogram[v], r.real_histogram[v]);
+  }
+  return r;
+}
+
+void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
+                          std::span<const mapping::Beam> sim_sweep,
+                          std::span<const mapping::Beam> real_sweep,
+                          const mapping::SensorGeometry& sensor, const std::string& scene_file,
+                          const std::string& log_file) {
+  namespace fs = std::filesystem;
+  fs::create_directories(out_dir);
+  const fs::path dir(out_dir);
+  std::ostringstream profile;
+  profile << "bin,range_m,sim_mean,real_mean\n";
+  for (std::size_t k = 0; k < r.sim_mean.size(); ++k) {
+    profile << k << "," << (k + 0.5) * sensor.bin_size_m << "," << r.sim_mean[k] << ","
+            << r.real_mean[k] << "\n";
+  }
+  WriteText((dir / "profile.csv").string(), profile.str());
+  std::ostringstream walls;
+  walls << "head_angle_deg,sim_wall_m,real_wall_m\n";
+  for (std::size_t a = 0; a < r.sim_wall_m.size(); ++a) {
+    walls << a * sensor.step_angle_rad * 180.0 / std::numbers::pi << ","
+          << (r.sim_wall_m[a] ? std::to_string(*r.sim_wall_m[a]) : "") << ","
+          << (r.real_wall_m[a] ? std::to_string(*r.real_wall_m[a]) : "") << "\n";
+  }
+  WriteText((dir / "wall_range.csv").string(), walls.str());
+  std::ostringstream hist;
+  hist << "intensity,sim_fraction,real_fraction\n";
+  for (std::size_t v = 0; v < 256; ++v) {
+    hist << v << "," << r.sim_histogram[v] << "," << r.real_histogram[v] << "\n";
+  }
+  WriteText((dir / "histogram.csv").string(), hist.str());
+
+  // The two mean profiles against range: sim orange, real white, 2 px per bin, 0..255 up.
+  const int width = 2 * static_cast<int>(r.sim_mean.size());
+  cv::Mat plot(300, width, CV_8UC3, cv::Scalar(30, 30, 30));
+  auto draw = [&](const std::vector<double>& profile_values, const cv::Scalar& colour) {
+    for (std::size_t k = 1; k < profile_values.size(); ++k) {
+      cv::line(plot, {2 * static_cast<int>(k - 1), 280 - static_cast<int>(profile_values[k - 1])},
+               {2 * static_cast<int>(k), 280 - static_cast<int>(profile_values[k])}, colour, 1,
+               cv::LINE_AA);
+    }
+  };
+  draw(r.real_mean, cv::Scalar(255, 255, 255));
+  draw(r.sim_mean, cv::Scalar(0, 140, 255));
+  WritePng((dir / "profile.png").string(), plot);
+
+  WritePng((dir / "polar.png").string(),
+           SideBySide(RenderPolarImage(sim_sweep), RenderPolarImage(real_sweep)));
+  WritePng((dir / "fan.png").string(),
+           SideBySide(RenderFanImage(sim_sweep, 0.01), RenderFanImage(real_sweep, 0.01)));
+
+  const nlohmann::json report = {
+      {"schema_version", 1},
+      {"scene", scene_file},
+      {"log", log_file},
+      {"profile_correlation_all_bins", r.profile_correlation_all},
+      {"profile_correlation_usable_bins", r.profile_correlation_usable},
+      {"median_wall_range_difference_bins", r.median_wall_difference_bins},
+      {"wall_angles_compared", r.wall_angles_compared},
+      {"histogram_intersection", r.histogram_intersection},
+      {"outputs",
+       {"profile.csv", "profile.png", "wall_range.csv", "histogram.csv", "polar.png", "fan.png"}}};
+  WriteText((dir / "fidelity.json").string(), report.dump(2) + "\n");
+}
+
+}  // namespace sonarbench::sim
