@@ -115,6 +115,42 @@ TEST(BeamSynthesis, EchoFollowsSpreadingAndAbsorptionWithRange) {
   EXPECT_NEAR(10.0 * std::log10(far / near), expected_db, 0.01);
 }
 
+// Multipath: a mirror that scatters nothing back (reflectivity 0, specular 1) at 45° one metre
+// ahead turns the beam towards a plane one metre to the side. The mirror's image of that plane
+// lies two metres ahead, so the ghost's echo starts in bin floor(2.0 / bin) exactly as a wall at
+// 2 m would; without the specular reflection there is no echo at all.
+TEST(BeamSynthesis, SpecularBounceEchoesAtTheSummedRange) {
+  const SensorModel sensor = QuietSensor();
+  MeshSpec mirror;
+  mirror.type = MeshSpec::Type::kPlane;
+  mirror.size_m = {10.0, 10.0, 0.0};
+  mirror.T_world_mesh = mapping::PoseFromXyzRpy({1.0, 0, 0}, {0, 0, 0}) *
+                        Eigen::AngleAxisd(-std::numbers::pi / 4, Eigen::Vector3d::UnitZ()) *
+                        Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitY());
+  MeshSpec target;
+  target.type = MeshSpec::Type::kPlane;
+  target.size_m = {20.0, 20.0, 0.0};
+  target.T_world_mesh = mapping::PoseFromXyzRpy({0, 1.0, 0}, {std::numbers::pi / 2, 0, 0});
+  const std::vector<TriangleMesh> meshes{BuildMesh(mirror, 0), BuildMesh(target, 0)};
+  const RayTracer tracer(meshes);
+  Material glass;
+  glass.reflectivity = 0.0;
+  glass.specular = 1.0;
+  Material wall;
+  wall.reflectivity = 0.5;
+  const BeamSynthesizer with_multipath(sensor, tracer, {glass, wall});
+  const SynthesizedBeam beam =
+      with_multipath.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 3);
+  const auto first = std::find_if(beam.echo_power.begin(), beam.echo_power.end(),
+                                  [](double p) { return p > 0.0; });
+  ASSERT_NE(first, beam.echo_power.end());
+  EXPECT_EQ(first - beam.echo_power.begin(),
+            static_cast<long>(std::floor(2.0 / sensor.geometry.bin_size_m)));
+  glass.specular = 0.0;
+  const BeamSynthesizer without(sensor, tracer, {glass, wall});
+  EXPECT_EQ(TotalPower(without.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 3)), 0.0);
+}
+
 TEST(BeamSynthesis, NothingInRangeGivesOnlyTheNoiseFloor) {
   const SensorModel sensor = QuietSensor();
   const SynthesizedBeam beam = Ping(sensor, Wall(sensor.geometry.MaxRangeM() + 1.0, 0.0));

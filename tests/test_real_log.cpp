@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +10,7 @@
 
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mat_log.hpp"
+#include "sonarbench/sim/fidelity.hpp"
 #include "sonarbench/sim/map_log.hpp"
 #include "sonarbench/sim/score.hpp"
 #include "test_util.hpp"
@@ -199,6 +201,38 @@ TEST(RealLogMap, TankWallsAreStraightAndClosed) {
     std::printf("width across sides %zu-%zu: %.2f m\n", s, s + 2, width);
     EXPECT_NEAR(width, 4.4, 0.25);
   }
+}
+
+}  // namespace
+}  // namespace sonarbench
+
+namespace sonarbench {
+namespace {
+
+// Comparing a run with itself is perfect agreement; with a copy shifted by k bins, the wall
+// ranges differ by exactly k bins.
+TEST(Fidelity, SelfComparisonAgreesAndShiftsAreMeasuredInBins) {
+  const mapping::SensorGeometry sensor;
+  std::vector<mapping::Beam> beams;
+  for (int b = 0; b < 2 * sensor.BeamsPerSweep(); ++b) {
+    mapping::Beam beam;
+    beam.head_angle_rad = b * sensor.step_angle_rad;
+    beam.bin_size_m = sensor.bin_size_m;
+    beam.intensities.assign(static_cast<std::size_t>(sensor.num_bins), 10);
+    for (int k = 0; k < 40; ++k) beam.intensities[static_cast<std::size_t>(k)] = 100;
+    beam.intensities[static_cast<std::size_t>(170 + b % 7)] = 200;
+    beams.push_back(beam);
+  }
+  const auto same = sim::CompareWithLog(beams, beams, sensor, 1.6);
+  EXPECT_NEAR(same.profile_correlation_all, 1.0, 1e-12);
+  EXPECT_NEAR(same.histogram_intersection, 1.0, 1e-12);
+  EXPECT_EQ(same.median_wall_difference_bins, 0.0);
+  EXPECT_EQ(same.wall_angles_compared, static_cast<std::size_t>(sensor.BeamsPerSweep()));
+  std::vector<mapping::Beam> shifted = beams;
+  for (auto& beam : shifted)
+    std::rotate(beam.intensities.rbegin(), beam.intensities.rbegin() + 3, beam.intensities.rend());
+  EXPECT_NEAR(sim::CompareWithLog(shifted, beams, sensor, 1.6).median_wall_difference_bins, 3.0,
+              1e-9);
 }
 
 }  // namespace

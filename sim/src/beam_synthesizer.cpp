@@ -44,6 +44,21 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const double k_v = 4.0 * std::log(2.0) / (g.beam_width_vertical_rad * g.beam_width_vertical_rad);
   const double pulse_bins = a.pulse_length_m / g.bin_size_m;
 
+  // Adds an echo of strength `strength` (before range losses) from range `range` [m]: the echo
+  // of a point lasts while the pulse passes it, so it is heard at every range in [r, r + L), and
+  // each bin gets the power times the fraction of the bin that span covers.
+  auto deposit = [&](double range, double strength) {
+    const double loss_db = (a.spreading_db_per_decade - a.tvg_db_per_decade) * std::log10(range) +
+                           a.absorption_db_per_m * range;
+    const double power = strength * std::pow(10.0, -loss_db / 10.0);
+    const double start = range / g.bin_size_m;
+    const double end = start + pulse_bins;
+    for (auto k = static_cast<std::size_t>(start); k < bins && static_cast<double>(k) < end; ++k) {
+      const double overlap =
+          std::min(static_cast<double>(k + 1), end) - std::max(static_cast<double>(k), start);
+      out.echo_power[k] += power * overlap;
+    }
+  };
   double weight_sum = 0.0;
   for (int i = 0; i < a.rays_horizontal; ++i) {
     for (int j = 0; j < a.rays_vertical; ++j) {
@@ -62,20 +77,23 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       }
       const Material& material = materials_by_mesh_[hit->mesh];
       const double cos_incidence = std::abs(hit->normal.dot(direction));
-      const double loss_db = (a.spreading_db_per_decade - a.tvg_db_per_decade) * std::log10(range) +
-                             a.absorption_db_per_m * range;
-      const double power = pattern * material.reflectivity *
-                           std::pow(cos_incidence, material.backscatter_exponent) *
-                           std::pow(10.0, -loss_db / 10.0);
-      // The echo of a point at r lasts while the pulse passes it: it is heard at every range in
-      // [r, r + L), so each bin gets the power times the fraction of the bin that span covers.
-      const double start = range / g.bin_size_m;
-      const double end = start + pulse_bins;
-      for (auto k = static_cast<std::size_t>(start); k < bins && static_cast<double>(k) < end;
-           ++k) {
-        const double overlap =
-            std::min(static_cast<double>(k + 1), end) - std::max(static_cast<double>(k), start);
-        out.echo_power[k] += power * overlap;
+      deposit(range, pattern * material.reflectivity *
+                         std::pow(cos_incidence, material.backscatter_exponent));
+      // One specular bounce: the mirrored ray's first hit echoes back along the same path, so it
+      // is heard at range d1 + d2, through two specular reflections at the first surface.
+      if (material.specular > 0.0) {
+        const Eigen::Vector3f mirrored =
+            direction - 2.0f * direction.dot(hit->normal) * hit->normal;
+        const Eigen::Vector3f from = origin + hit->distance * direction + 1e-4f * mirrored;
+        const auto second =
+            tracer_.Intersect(from, mirrored.normalized(), static_cast<float>(max_range - range));
+        if (second) {
+          const Material& far = materials_by_mesh_[second->mesh];
+          const double cos_far = std::abs(second->normal.dot(mirrored.normalized()));
+          deposit(range + second->distance, pattern * material.specular * material.specular *
+                                                far.reflectivity *
+                                                std::pow(cos_far, far.backscatter_exponent));
+        }
       }
     }
   }

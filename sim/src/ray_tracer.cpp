@@ -1,5 +1,7 @@
 #include "sonarbench/sim/ray_tracer.hpp"
 
+#include "sonarbench/sim/score.hpp"
+
 #include <cstring>
 #include <limits>
 #include <stdexcept>
@@ -67,6 +69,52 @@ std::optional<Hit> RayTracer::Intersect(const Eigen::Vector3f& origin,
   hit.normal = Eigen::Vector3f(query.hit.Ng_x, query.hit.Ng_y, query.hit.Ng_z).normalized();
   hit.mesh = query.hit.geomID;
   return hit;
+}
+
+namespace {
+
+struct NearestQuery {
+  RTCScene scene;
+  Eigen::Vector3d point;
+  double best = -1.0;
+};
+
+// Embree calls this for every triangle whose bounds meet the query sphere; shrinking the radius
+// to the best distance so far prunes the rest of the BVH.
+bool NearestTriangle(RTCPointQueryFunctionArguments* args) {
+  auto* q = static_cast<NearestQuery*>(args->userPtr);
+  RTCGeometry geometry = rtcGetGeometry(q->scene, args->geomID);
+  const auto* v = static_cast<const float*>(rtcGetGeometryBufferData(geometry, RTC_BUFFER_TYPE_VERTEX, 0));
+  const auto* t = static_cast<const std::uint32_t*>(rtcGetGeometryBufferData(geometry, RTC_BUFFER_TYPE_INDEX, 0));
+  auto vertex = [&](std::uint32_t i) {
+    return Eigen::Vector3d(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+  };
+  const std::uint32_t* tri = t + 3 * args->primID;
+  const double d = PointTriangleDistance(q->point, vertex(tri[0]), vertex(tri[1]), vertex(tri[2]));
+  if (d < args->query->radius) {
+    args->query->radius = static_cast<float>(d);
+    q->best = d;
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::optional<double> RayTracer::NearestSurfaceDistance(const Eigen::Vector3d& point,
+                                                        double max_distance) const {
+  RTCPointQuery query;
+  query.x = static_cast<float>(point.x());
+  query.y = static_cast<float>(point.y());
+  query.z = static_cast<float>(point.z());
+  query.time = 0.0f;
+  query.radius = static_cast<float>(max_distance);
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  NearestQuery nearest{scene_.get(), point, -1.0};
+  rtcPointQuery(scene_.get(), &query, &context, NearestTriangle, &nearest);
+  if (nearest.best < 0.0) return std::nullopt;
+  return nearest.best;
 }
 
 }  // namespace sonarbench::sim

@@ -127,6 +127,7 @@ Scene LoadScene(const std::string& path) {
     item.Required("name", m.name);
     item.Required("reflectivity", m.reflectivity, InRange(0.0, 1.0));
     item.Optional("backscatter_exponent", m.backscatter_exponent, InRange(0.0, 100.0));
+    item.Optional("specular", m.specular, InRange(0.0, 1.0));
     item.RejectUnknownKeys();
     scene.materials.push_back(m);
   }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "sonarbench/sim/ground_truth.hpp"
+#include "sonarbench/sim/ray_tracer.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -143,47 +144,40 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
   m.free_accuracy = cells.free.empty() ? 0.0 : 1.0 - Ratio(m.free_on_surface_cells, m.free_cells);
 
   const double res = map.getResolution();
-  constexpr int kMaxRing = 200;  // 10 m at 5 cm: beyond that a distance is not worth a search
   if (!meshes.empty()) {
-    // Each triangle is listed in the cells it overlaps, so the nearest triangle to a point lies
-    // in a cell no farther out than the nearest listed cell's ring plus one.
-    std::unordered_map<Key, std::vector<std::pair<std::size_t, std::size_t>>, Key::KeyHash> listed;
-    for (std::size_t m_i = 0; m_i < meshes.size(); ++m_i) {
-      for (std::size_t t = 0; t < meshes[m_i].triangles.size(); ++t) {
-        const auto& tri = meshes[m_i].triangles[t];
-        const auto& v = meshes[m_i].vertices;
-        ForEachTriangleCell(v[tri[0]].cast<double>(), v[tri[1]].cast<double>(),
-                            v[tri[2]].cast<double>(), map,
-                            [&](const Key& key) { listed[key].emplace_back(m_i, t); });
-      }
-    }
+    const RayTracer tracer(meshes);
     std::vector<double> d;
+    d.reserve(cells.occupied.size());
     for (const auto& key : cells.occupied) {
-      const Eigen::Vector3d p = Centre(map, key);
-      const double best = NearestByRings(key, res, kMaxRing, [&](const Key& cell) {
-        const auto it = listed.find(cell);
-        if (it == listed.end()) return -1.0;
-        double nearest = -1.0;
-        for (const auto& [mi, ti] : it->second) {
-          const auto& tri = meshes[mi].triangles[ti];
-          const double dist = PointTriangleDistance(p, meshes[mi].vertices[tri[0]].cast<double>(),
-                                                    meshes[mi].vertices[tri[1]].cast<double>(),
-                                                    meshes[mi].vertices[tri[2]].cast<double>());
-          if (nearest < 0.0 || dist < nearest) nearest = dist;
-        }
-        return nearest;
-      });
-      if (best >= 0.0) d.push_back(best);
+      if (const auto best = tracer.NearestSurfaceDistance(Centre(map, key), 1e3)) d.push_back(*best);
     }
     m.map_to_mesh = Summarise(std::move(d));
   }
   if (!cells.occupied.empty()) {
+    // Occupied cells bucketed in blocks of 8³ cells: rings of blocks around a query skip empty
+    // space 8 cells at a time. A block `ring` blocks out is at least (ring - 1) blocks away.
+    constexpr int kBlock = 8;
+    std::unordered_map<Key, std::vector<Key>, Key::KeyHash> blocks;
+    for (const auto& key : cells.occupied) {
+      blocks[Key(static_cast<octomap::key_type>(key[0] / kBlock), static_cast<octomap::key_type>(key[1] / kBlock),
+                 static_cast<octomap::key_type>(key[2] / kBlock))]
+          .push_back(key);
+    }
     std::vector<double> d;
     for (const auto& key : observable) {
       if (!truth.contains(key)) continue;
       const Eigen::Vector3d p = Centre(map, key);
-      const double best = NearestByRings(key, res, kMaxRing, [&](const Key& cell) {
-        return cells.occupied.contains(cell) ? (Centre(map, cell) - p).norm() : -1.0;
+      const Key block(static_cast<octomap::key_type>(key[0] / kBlock), static_cast<octomap::key_type>(key[1] / kBlock),
+                      static_cast<octomap::key_type>(key[2] / kBlock));
+      const double best = NearestByRings(block, kBlock * res, 65536 / kBlock, [&](const Key& b) {
+        const auto it = blocks.find(b);
+        if (it == blocks.end()) return -1.0;
+        double nearest = -1.0;
+        for (const auto& cell : it->second) {
+          const double dist = (Centre(map, cell) - p).norm();
+          if (nearest < 0.0 || dist < nearest) nearest = dist;
+        }
+        return nearest;
       });
       if (best >= 0.0) d.push_back(best);
     }

@@ -26,6 +26,11 @@ class RayTracer {
  public:
   explicit RayTracer(std::span<const TriangleMesh> meshes);
 
+  /// Distance [m] from `point` to the nearest triangle of any mesh, if one lies within
+  /// `max_distance` (Embree's BVH point query; exact point-triangle distances).
+  [[nodiscard]] std::optional<double> NearestSurfaceDistance(const Eigen::Vector3d& point,
+                                                             double max_distance) const;
+
   /// The first hit along `direction` (unit) from `origin` within `max_distance` [m].
   [[nodiscard]] std::optional<Hit> Intersect(const Eigen::Vector3f& origin,
                                              const Eigen::Vector3f& direction,

@@ -18,6 +18,9 @@ struct Material {
   double reflectivity = 0.5;
   /// Per-ray echo falls as cos^n of the incidence angle (n = 1 is Lambert's law per ray).
   double backscatter_exponent = 1.0;
+  /// Fraction of the incident energy reflected specularly [0-1]: a ray that hits goes on in the
+  /// mirror direction, and what it meets echoes back along the same path (multipath).
+  double specular = 0.0;
 };
 
 /// A procedural mesh, as the scene file describes it.
