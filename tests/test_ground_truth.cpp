@@ -8,6 +8,15 @@ namespace {
 
 using Eigen::Vector3d;
 
+// A 0.98 m square plane at z = 0.012 m, centred over the origin.
+TriangleMesh SmallPlane() {
+  MeshSpec spec;
+  spec.type = MeshSpec::Type::kPlane;
+  spec.size_m = {0.98, 0.98, 0.0};
+  spec.T_world_mesh.translation() = Vector3d(0, 0, 0.012);
+  return BuildMesh(spec, 0);
+}
+
 TEST(TriangleBoxOverlap, AnalyticCases) {
   const Vector3d centre(0, 0, 0);
   const Vector3d half(0.5, 0.5, 0.5);
@@ -28,11 +37,7 @@ TEST(TriangleBoxOverlap, AnalyticCases) {
 // (-0.49, 0.49), inside the 20 cells [-0.5, 0.5) per side, touching none of their faces:
 // exactly 20 × 20 cells.
 TEST(VoxelizeMeshes, PlaneCellsCanBeCounted) {
-  MeshSpec spec;
-  spec.type = MeshSpec::Type::kPlane;
-  spec.size_m = {0.98, 0.98, 0.0};
-  spec.T_world_mesh.translation() = Vector3d(0, 0, 0.012);
-  const std::vector<TriangleMesh> meshes{BuildMesh(spec, 0)};
+  const std::vector<TriangleMesh> meshes{SmallPlane()};
   const octomap::OcTree key_space(0.05);
   const mapping::KeySet cells = VoxelizeMeshes(meshes, key_space);
   EXPECT_EQ(cells.size(), 400u);
@@ -134,11 +139,7 @@ TEST(PointTriangleDistance, AnalyticCases) {
 // exactly; the surface cells' distance back to the nearest occupied cell is 0 where the map
 // holds them.
 TEST(ScoreMap, SurfaceDistancesOfKnownOffsets) {
-  MeshSpec spec;
-  spec.type = MeshSpec::Type::kPlane;
-  spec.size_m = {0.98, 0.98, 0.0};
-  spec.T_world_mesh.translation() = Vector3d(0, 0, 0.012);
-  const std::vector<TriangleMesh> meshes{BuildMesh(spec, 0)};
+  const std::vector<TriangleMesh> meshes{SmallPlane()};
   const octomap::OcTree key_space(0.05);
   const mapping::KeySet truth = VoxelizeMeshes(meshes, key_space);
   mapping::KeySet occupied;

@@ -110,6 +110,15 @@ int Fidelity(const FidelityArgs& args) {
   return 0;
 }
 
+// The --threads option every subcommand has.
+void AddThreadsOption(CLI::App* command, int& threads) {
+  command
+      ->add_option("-j,--threads", threads,
+                   "Threads; 0 = all cores. Outputs are identical for any value.")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+}
+
 int Run(const RunArgs& args) {
   const sonarbench::sim::Scene scene = sonarbench::sim::LoadScene(args.scene);
   sonarbench::sim::RunOptions options;
@@ -142,12 +151,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   run_cmd->add_option("-s,--seed", run.seed,
                       "Seed of every random draw; overrides the scene's 'seed'");
-  run_cmd
-      ->add_option("-j,--threads", run.threads,
-                   "Threads for simulation and mapping; 0 = all cores. Outputs are identical "
-                   "for any value.")
-      ->check(CLI::Range(0, 1024))
-      ->capture_default_str();
+  AddThreadsOption(run_cmd, run.threads);
 
   MapArgs map;
   CLI::App* map_cmd = app.add_subcommand(
@@ -173,11 +177,7 @@ int main(int argc, char** argv) {
                    "YAML file of mapping parameters (the keys of a scene's 'mapping' section)")
       ->check(CLI::ExistingFile)
       ->excludes(scene_opt);
-  map_cmd
-      ->add_option("-j,--threads", map.threads,
-                   "Threads; 0 = all cores. The map is identical for any value.")
-      ->check(CLI::Range(0, 1024))
-      ->capture_default_str();
+  AddThreadsOption(map_cmd, map.threads);
 
   FidelityArgs fidelity;
   CLI::App* fidelity_cmd = app.add_subcommand(
@@ -195,9 +195,7 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   fidelity_cmd->add_option("-o,--out", fidelity.out, "Output directory")->capture_default_str();
   fidelity_cmd->add_option("-s,--seed", fidelity.seed, "Overrides the scene's seed");
-  fidelity_cmd->add_option("-j,--threads", fidelity.threads, "Threads; 0 = all cores")
-      ->check(CLI::Range(0, 1024))
-      ->capture_default_str();
+  AddThreadsOption(fidelity_cmd, fidelity.threads);
   fidelity_cmd
       ->add_option("--wall-min-range", fidelity.wall_min_range_m,
                    "Strongest echoes are sought beyond this range [m] (past the floor's)")

@@ -11,6 +11,7 @@
 
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/sim/images.hpp"
+#include "sonarbench/sim/report.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -185,17 +186,17 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
   WritePng((dir / "fan.png").string(),
            SideBySide(RenderFanImage(sim_sweep, 0.01), RenderFanImage(real_sweep, 0.01)));
 
-  const nlohmann::json report = {
-      {"schema_version", 1},
-      {"scene", scene_file},
-      {"log", log_file},
-      {"profile_correlation_all_bins", r.profile_correlation_all},
-      {"profile_correlation_usable_bins", r.profile_correlation_usable},
-      {"median_wall_range_difference_bins", r.median_wall_difference_bins},
-      {"wall_angles_compared", r.wall_angles_compared},
-      {"histogram_intersection", r.histogram_intersection},
-      {"outputs",
-       {"profile.csv", "profile.png", "wall_range.csv", "histogram.csv", "polar.png", "fan.png"}}};
+  nlohmann::json report = ReportHeader();
+  report.update({{"scene", scene_file},
+                 {"log", log_file},
+                 {"profile_correlation_all_bins", r.profile_correlation_all},
+                 {"profile_correlation_usable_bins", r.profile_correlation_usable},
+                 {"median_wall_range_difference_bins", r.median_wall_difference_bins},
+                 {"wall_angles_compared", r.wall_angles_compared},
+                 {"histogram_intersection", r.histogram_intersection},
+                 {"outputs",
+                  {"profile.csv", "profile.png", "wall_range.csv", "histogram.csv", "polar.png",
+                   "fan.png"}}});
   WriteText((dir / "fidelity.json").string(), report.dump(2) + "\n");
 }
 

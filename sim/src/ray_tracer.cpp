@@ -1,11 +1,11 @@
 #include "sonarbench/sim/ray_tracer.hpp"
 
-#include "sonarbench/sim/score.hpp"
-
 #include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
+
+#include "sonarbench/sim/score.hpp"
 
 namespace sonarbench::sim {
 
@@ -84,8 +84,10 @@ struct NearestQuery {
 bool NearestTriangle(RTCPointQueryFunctionArguments* args) {
   auto* q = static_cast<NearestQuery*>(args->userPtr);
   RTCGeometry geometry = rtcGetGeometry(q->scene, args->geomID);
-  const auto* v = static_cast<const float*>(rtcGetGeometryBufferData(geometry, RTC_BUFFER_TYPE_VERTEX, 0));
-  const auto* t = static_cast<const std::uint32_t*>(rtcGetGeometryBufferData(geometry, RTC_BUFFER_TYPE_INDEX, 0));
+  const auto* v =
+      static_cast<const float*>(rtcGetGeometryBufferData(geometry, RTC_BUFFER_TYPE_VERTEX, 0));
+  const auto* t = static_cast<const std::uint32_t*>(
+      rtcGetGeometryBufferData(geometry, RTC_BUFFER_TYPE_INDEX, 0));
   auto vertex = [&](std::uint32_t i) {
     return Eigen::Vector3d(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
   };

@@ -149,7 +149,8 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
     std::vector<double> d;
     d.reserve(cells.occupied.size());
     for (const auto& key : cells.occupied) {
-      if (const auto best = tracer.NearestSurfaceDistance(Centre(map, key), 1e3)) d.push_back(*best);
+      if (const auto best = tracer.NearestSurfaceDistance(Centre(map, key), 1e3))
+        d.push_back(*best);
     }
     m.map_to_mesh = Summarise(std::move(d));
   }
@@ -159,7 +160,8 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
     constexpr int kBlock = 8;
     std::unordered_map<Key, std::vector<Key>, Key::KeyHash> blocks;
     for (const auto& key : cells.occupied) {
-      blocks[Key(static_cast<octomap::key_type>(key[0] / kBlock), static_cast<octomap::key_type>(key[1] / kBlock),
+      blocks[Key(static_cast<octomap::key_type>(key[0] / kBlock),
+                 static_cast<octomap::key_type>(key[1] / kBlock),
                  static_cast<octomap::key_type>(key[2] / kBlock))]
           .push_back(key);
     }
@@ -167,7 +169,8 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
     for (const auto& key : observable) {
       if (!truth.contains(key)) continue;
       const Eigen::Vector3d p = Centre(map, key);
-      const Key block(static_cast<octomap::key_type>(key[0] / kBlock), static_cast<octomap::key_type>(key[1] / kBlock),
+      const Key block(static_cast<octomap::key_type>(key[0] / kBlock),
+                      static_cast<octomap::key_type>(key[1] / kBlock),
                       static_cast<octomap::key_type>(key[2] / kBlock));
       const double best = NearestByRings(block, kBlock * res, 65536 / kBlock, [&](const Key& b) {
         const auto it = blocks.find(b);
