@@ -7,7 +7,8 @@ bash ci/install-deps.sh
 build_dir=${SONARBENCH_BUILD_DIR:-build}
 werror=OFF
 if [ "${CI:-}" = "true" ]; then werror=ON; fi
+mkdir -p "$build_dir"
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE="${SONARBENCH_BUILD_TYPE:-Release}" \
-  -DSONARBENCH_WERROR="$werror" "$@" > "$build_dir.configure.log" 2>&1 || {
-  cat "$build_dir.configure.log"; exit 1; }
+  -DSONARBENCH_WERROR="$werror" "$@" > "$build_dir/configure.log" 2>&1 || {
+  cat "$build_dir/configure.log"; exit 1; }
 cmake --build "$build_dir" -j "$(nproc)"
