@@ -9,7 +9,23 @@ namespace sonarbench::sim {
 
 BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tracer,
                                  std::vector<Material> materials_by_mesh)
-    : sensor_(sensor), tracer_(tracer), materials_by_mesh_(std::move(materials_by_mesh)) {}
+    : sensor_(sensor), tracer_(tracer), materials_by_mesh_(std::move(materials_by_mesh)) {
+  for (const double db : sensor_.acoustics.self_reflection_db) {
+    self_reflection_power_.push_back(std::pow(10.0, db / 10.0));
+  }
+}
+
+namespace {
+
+// cosⁿ, with the exponents scenes use most spared a pow().
+double CosPower(double c, double n) {
+  if (n == 1.0) return c;
+  if (n == 0.5) return std::sqrt(c);
+  if (n == 2.0) return c * c;
+  return std::pow(c, n);
+}
+
+}  // namespace
 
 std::uint8_t BeamSynthesizer::Quantise(double level_db) const {
   const Acoustics& a = sensor_.acoustics;
@@ -47,10 +63,14 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   // Adds an echo of strength `strength` (before range losses) from range `range` [m]: the echo
   // of a point lasts while the pulse passes it, so it is heard at every range in [r, r + L), and
   // each bin gets the power times the fraction of the bin that span covers.
+  // Range loss 10^(-((S - G)·log10 r + α·r)/10) = exp(-(S - G)/10 · ln r - α·ln10/10 · r).
+  const double spreading_exponent = (a.spreading_db_per_decade - a.tvg_db_per_decade) / 10.0;
+  const double absorption_per_m = a.absorption_db_per_m * std::log(10.0) / 10.0;
   auto deposit = [&](double range, double strength) {
-    const double loss_db = (a.spreading_db_per_decade - a.tvg_db_per_decade) * std::log10(range) +
-                           a.absorption_db_per_m * range;
-    const double power = strength * std::pow(10.0, -loss_db / 10.0);
+    const double exponent =
+        (spreading_exponent != 0.0 ? spreading_exponent * std::log(range) : 0.0) +
+        absorption_per_m * range;
+    const double power = strength * std::exp(-exponent);
     const double start = range / g.bin_size_m;
     const double end = start + pulse_bins;
     for (auto k = static_cast<std::size_t>(start); k < bins && static_cast<double>(k) < end; ++k) {
@@ -78,7 +98,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       const Material& material = materials_by_mesh_[hit->mesh];
       const double cos_incidence = std::abs(hit->normal.dot(direction));
       deposit(range, pattern * material.reflectivity *
-                         std::pow(cos_incidence, material.backscatter_exponent));
+                         CosPower(cos_incidence, material.backscatter_exponent));
       // One specular bounce: the mirrored ray's first hit echoes back along the same path, so it
       // is heard at range d1 + d2, through two specular reflections at the first surface.
       if (material.specular > 0.0) {
@@ -92,7 +112,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
           const double cos_far = std::abs(second->normal.dot(mirrored.normalized()));
           deposit(range + second->distance, pattern * material.specular * material.specular *
                                                 far.reflectivity *
-                                                std::pow(cos_far, far.backscatter_exponent));
+                                                CosPower(cos_far, far.backscatter_exponent));
         }
       }
     }
@@ -110,7 +130,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const double gain = std::pow(10.0, a.gain_db / 10.0);
   for (std::size_t k = 0; k < bins; ++k) {
     double signal = gain * out.echo_power[k];
-    if (k < a.self_reflection_db.size()) signal += std::pow(10.0, a.self_reflection_db[k] / 10.0);
+    if (k < self_reflection_power_.size()) signal += self_reflection_power_[k];
     if (a.speckle) signal *= rng.Exponential();
     const double power = signal + noise_power * rng.Exponential();
     out.beam.intensities[k] = Quantise(10.0 * std::log10(std::max(power, 1e-30)));

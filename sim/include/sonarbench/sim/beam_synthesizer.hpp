@@ -57,6 +57,8 @@ class BeamSynthesizer {
   SensorModel sensor_;
   const RayTracer& tracer_;
   std::vector<Material> materials_by_mesh_;
+  /// The self-reflection profile as linear power per bin.
+  std::vector<double> self_reflection_power_;
 };
 
 }  // namespace sonarbench::sim
