@@ -44,8 +44,8 @@ std::string Bytes(const octomap::OcTree& tree) {
   return out.str();
 }
 
-octomap::OcTree MakeTree(const MapperConfig& config) {
-  octomap::OcTree tree(config.resolution_m);
+MapTree MakeTree(const MapperConfig& config) {
+  MapTree tree(config.resolution_m);
   tree.setProbHit(config.prob_hit);
   tree.setProbMiss(config.prob_miss);
   tree.setClampingThresMin(config.clamp_min);
@@ -57,7 +57,7 @@ octomap::OcTree MakeTree(const MapperConfig& config) {
 template <typename Set>
 std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sensor,
                       const MapperConfig& config, int threads, BatchStats* totals) {
-  octomap::OcTree tree = MakeTree(config);
+  MapTree tree = MakeTree(config);
   const auto directions = BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical);
   const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
   const std::span<const Beam> all(beams);
@@ -73,7 +73,7 @@ std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sens
 
 std::string RunNaive(const std::vector<Beam>& beams, const SensorGeometry& sensor,
                      const MapperConfig& config) {
-  octomap::OcTree tree = MakeTree(config);
+  MapTree tree = MakeTree(config);
   const auto directions = BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical);
   octomap::KeyRay ray;
   for (const Beam& beam : beams) {

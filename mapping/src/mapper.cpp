@@ -17,7 +17,7 @@ Mapper::Mapper(const MapperConfig& config, const SensorGeometry& sensor)
                                                    : sensor.MaxRangeM()),
       threads_(config.threads > 0 ? config.threads : omp_get_max_threads()),
       directions_(BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical)),
-      tree_(std::make_unique<octomap::OcTree>(config.resolution_m)) {
+      tree_(std::make_unique<MapTree>(config.resolution_m)) {
   tree_->setProbHit(config.prob_hit);
   tree_->setProbMiss(config.prob_miss);
   tree_->setClampingThresMin(config.clamp_min);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sonarbench/mapping/beam_volume.hpp"
+#include "sonarbench/mapping/map_tree.hpp"
 
 namespace sonarbench::mapping {
 
@@ -54,7 +55,7 @@ struct BatchStats {
 /// log-odds update per cell. The result does not depend on `threads` or on `Set`: a set's content
 /// does not depend on insertion order, and each cell gets exactly one update.
 template <typename Set>
-BatchStats IntegrateBatch(octomap::OcTree& tree, std::span<const Beam> beams,
+BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
                           std::span<const std::vector<double>> obstacles,
                           std::span<const Eigen::Vector3d> directions, double free_range_m,
                           int threads) {
@@ -86,7 +87,28 @@ BatchStats IntegrateBatch(octomap::OcTree& tree, std::span<const Beam> beams,
   for (const auto& key : merged.occupied) updates.emplace_back((MortonCode(key) << 1) | 1, key);
   std::sort(updates.begin(), updates.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (const auto& [code, key] : updates) tree.updateNode(key, (code & 1) != 0, /*lazy_eval=*/true);
+  // The Morton code's top three bits name the root's child (octant) a key lies in, so the sorted
+  // updates fall into up to eight runs of disjoint subtrees, updated in parallel. The first key
+  // of each run is updated serially, which creates the root and that child: afterwards no update
+  // touches a node another thread may create. OctoMap's node count is then recounted.
+  std::vector<std::size_t> starts;
+  for (std::size_t i = 0; i < updates.size(); ++i) {
+    if (i == 0 || (updates[i].first >> 46) != (updates[i - 1].first >> 46)) starts.push_back(i);
+  }
+  starts.push_back(updates.size());
+  for (std::size_t r = 0; r + 1 < starts.size(); ++r) {
+    const auto& [code, key] = updates[starts[r]];
+    tree.updateNode(key, (code & 1) != 0, /*lazy_eval=*/true);
+  }
+  const auto runs = static_cast<std::int64_t>(starts.size()) - 1;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+  for (std::int64_t r = 0; r < runs; ++r) {
+    for (std::size_t i = starts[static_cast<std::size_t>(r)] + 1;
+         i < starts[static_cast<std::size_t>(r) + 1]; ++i) {
+      tree.updateNode(updates[i].second, (updates[i].first & 1) != 0, /*lazy_eval=*/true);
+    }
+  }
+  tree.RecountNodes();
   tree.updateInnerOccupancy();
 
   BatchStats stats;

@@ -8,6 +8,7 @@
 
 #include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/mapping/integrate.hpp"
+#include "sonarbench/mapping/map_tree.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
@@ -15,7 +16,8 @@ namespace sonarbench::mapping {
 
 /// The production mapper: detection, beam-volume ray casting and OctoMap log-odds updates.
 /// Threading: Integrate() casts the rays of a batch on `config.threads` threads, each into its
-/// own key sets, merged afterwards; the resulting map is identical for any thread count. A Mapper
+/// own key sets, merged afterwards, and updates the root's octants in parallel; the resulting
+/// map is identical for any thread count. A Mapper
 /// is not safe to call from several threads at once.
 class Mapper {
  public:
@@ -41,7 +43,7 @@ class Mapper {
   double free_range_m_ = 0.0;
   int threads_ = 1;
   std::vector<Eigen::Vector3d> directions_;
-  std::unique_ptr<octomap::OcTree> tree_;
+  std::unique_ptr<MapTree> tree_;
 };
 
 }  // namespace sonarbench::mapping
