@@ -2,6 +2,8 @@
 
 #include <omp.h>
 
+#include <algorithm>
+
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/beam_volume.hpp"
 #include "sonarbench/mapping/detection.hpp"
@@ -27,6 +29,15 @@ Mapper::Mapper(const MapperConfig& config, const SensorGeometry& sensor)
 BatchStats Mapper::Integrate(std::span<const Beam> beams) {
   const auto obstacles = DetectObstacles(beams, sensor_, config_.detection);
   return Integrate(beams, obstacles);
+}
+
+BatchStats Mapper::IntegrateSweeps(std::span<const Beam> beams) {
+  const auto per_sweep = static_cast<std::size_t>(sensor_.BeamsPerSweep());
+  BatchStats totals;
+  for (std::size_t first = 0; first < beams.size(); first += per_sweep) {
+    totals += Integrate(beams.subspan(first, std::min(per_sweep, beams.size() - first)));
+  }
+  return totals;
 }
 
 BatchStats Mapper::Integrate(std::span<const Beam> beams,

@@ -90,9 +90,7 @@ int Fidelity(const FidelityArgs& args) {
   const sim::RayTracer tracer(meshes);
   const auto synthesized =
       sim::SimulateScene(scene, tracer, args.seed.value_or(scene.seed), args.threads);
-  std::vector<sonarbench::mapping::Beam> beams;
-  beams.reserve(synthesized.size());
-  for (const auto& s : synthesized) beams.push_back(s.beam);
+  const std::vector<sonarbench::mapping::Beam> beams = sim::BeamsOf(synthesized);
   const auto& g = scene.sensor.geometry;
   const auto report = sim::CompareWithLog(beams, log.beams, g, args.wall_min_range_m);
   const auto per_sweep = static_cast<std::size_t>(g.BeamsPerSweep());

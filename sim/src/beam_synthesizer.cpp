@@ -103,13 +103,13 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       // is heard at range d1 + d2, through two specular reflections at the first surface.
       if (material.specular > 0.0) {
         const Eigen::Vector3f mirrored =
-            direction - 2.0f * direction.dot(hit->normal) * hit->normal;
+            (direction - 2.0f * direction.dot(hit->normal) * hit->normal).normalized();
         const Eigen::Vector3f from = origin + hit->distance * direction + 1e-4f * mirrored;
         const auto second =
-            tracer_.Intersect(from, mirrored.normalized(), static_cast<float>(max_range - range));
+            tracer_.Intersect(from, mirrored, static_cast<float>(max_range - range));
         if (second) {
           const Material& far = materials_by_mesh_[second->mesh];
-          const double cos_far = std::abs(second->normal.dot(mirrored.normalized()));
+          const double cos_far = std::abs(second->normal.dot(mirrored));
           deposit(range + second->distance, pattern * material.specular * material.specular *
                                                 far.reflectivity *
                                                 CosPower(cos_far, far.backscatter_exponent));

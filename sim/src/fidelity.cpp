@@ -197,7 +197,7 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"outputs",
                   {"profile.csv", "profile.png", "wall_range.csv", "histogram.csv", "polar.png",
                    "fan.png"}}});
-  WriteText((dir / "fidelity.json").string(), report.dump(2) + "\n");
+  WriteJson((dir / "fidelity.json").string(), report);
 }
 
 }  // namespace sonarbench::sim

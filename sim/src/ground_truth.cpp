@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 
 namespace sonarbench::sim {
 namespace {
@@ -21,6 +20,35 @@ bool Separates(const Vector3d& axis, const Vector3d& v0, const Vector3d& v1, con
   const double r =
       h.x() * std::abs(axis.x()) + h.y() * std::abs(axis.y()) + h.z() * std::abs(axis.z());
   return std::min({p0, p1, p2}) > r || std::max({p0, p1, p2}) < -r;
+}
+
+// Adds to `cells` every cell whose box the triangle a, b, c crosses or touches.
+void AddTriangleCells(const Vector3d& a, const Vector3d& b, const Vector3d& c,
+                      const octomap::OcTree& key_space, mapping::KeySet& cells) {
+  const double resolution = key_space.getResolution();
+  const Vector3d half(0.5 * resolution, 0.5 * resolution, 0.5 * resolution);
+  const Vector3d lo = a.cwiseMin(b).cwiseMin(c);
+  const Vector3d hi = a.cwiseMax(b).cwiseMax(c);
+  octomap::OcTreeKey key_lo;
+  octomap::OcTreeKey key_hi;
+  if (!key_space.coordToKeyChecked(lo.x(), lo.y(), lo.z(), key_lo) ||
+      !key_space.coordToKeyChecked(hi.x(), hi.y(), hi.z(), key_hi)) {
+    return;  // outside OctoMap's ±(2^15 · resolution) world
+  }
+  // A vertex on a cell face touches the neighbour too: widen the candidate range by one.
+  for (int x = key_lo[0] - 1; x <= key_hi[0] + 1; ++x) {
+    for (int y = key_lo[1] - 1; y <= key_hi[1] + 1; ++y) {
+      for (int z = key_lo[2] - 1; z <= key_hi[2] + 1; ++z) {
+        const octomap::OcTreeKey key(static_cast<octomap::key_type>(x),
+                                     static_cast<octomap::key_type>(y),
+                                     static_cast<octomap::key_type>(z));
+        const octomap::point3d centre = key_space.keyToCoord(key);
+        if (TriangleBoxOverlap(Vector3d(centre.x(), centre.y(), centre.z()), half, a, b, c)) {
+          cells.insert(key);
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -53,43 +81,13 @@ bool TriangleBoxOverlap(const Vector3d& box_centre, const Vector3d& box_half_siz
   return true;
 }
 
-void ForEachTriangleCell(const Vector3d& a, const Vector3d& b, const Vector3d& c,
-                         const octomap::OcTree& key_space,
-                         const std::function<void(const octomap::OcTreeKey&)>& visit) {
-  const double resolution = key_space.getResolution();
-  const Vector3d half(0.5 * resolution, 0.5 * resolution, 0.5 * resolution);
-  const Vector3d lo = a.cwiseMin(b).cwiseMin(c);
-  const Vector3d hi = a.cwiseMax(b).cwiseMax(c);
-  octomap::OcTreeKey key_lo;
-  octomap::OcTreeKey key_hi;
-  if (!key_space.coordToKeyChecked(lo.x(), lo.y(), lo.z(), key_lo) ||
-      !key_space.coordToKeyChecked(hi.x(), hi.y(), hi.z(), key_hi)) {
-    return;  // outside OctoMap's ±(2^15 · resolution) world
-  }
-  // A vertex on a cell face touches the neighbour too: widen the candidate range by one.
-  for (int x = key_lo[0] - 1; x <= key_hi[0] + 1; ++x) {
-    for (int y = key_lo[1] - 1; y <= key_hi[1] + 1; ++y) {
-      for (int z = key_lo[2] - 1; z <= key_hi[2] + 1; ++z) {
-        const octomap::OcTreeKey key(static_cast<octomap::key_type>(x),
-                                     static_cast<octomap::key_type>(y),
-                                     static_cast<octomap::key_type>(z));
-        const octomap::point3d centre = key_space.keyToCoord(key);
-        if (TriangleBoxOverlap(Vector3d(centre.x(), centre.y(), centre.z()), half, a, b, c)) {
-          visit(key);
-        }
-      }
-    }
-  }
-}
-
 mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
                                const octomap::OcTree& key_space) {
   mapping::KeySet cells;
   for (const TriangleMesh& mesh : meshes) {
     for (const auto& t : mesh.triangles) {
-      ForEachTriangleCell(mesh.vertices[t[0]].cast<double>(), mesh.vertices[t[1]].cast<double>(),
-                          mesh.vertices[t[2]].cast<double>(), key_space,
-                          [&cells](const octomap::OcTreeKey& key) { cells.insert(key); });
+      AddTriangleCells(mesh.vertices[t[0]].cast<double>(), mesh.vertices[t[1]].cast<double>(),
+                       mesh.vertices[t[2]].cast<double>(), key_space, cells);
     }
   }
   return cells;

@@ -45,21 +45,48 @@ cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m) {
   const int half = static_cast<int>(std::ceil(max_range / pixel_m));
   cv::Mat gray(2 * half + 1, 2 * half + 1, CV_8UC1, cv::Scalar(0));
   if (sweep.empty()) return gray;
+  // Beams sorted by head angle in [0, 2π): the beam nearest a bearing is in the group of equal
+  // angles just below it or just above it (circularly); among those the smallest angular
+  // distance wins, then the earliest beam, as a scan in sweep order would choose.
+  constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  auto wrapped = [&](double angle) { return angle - kTwoPi * std::floor(angle / kTwoPi); };
+  std::vector<std::pair<double, std::size_t>> by_angle;
+  for (std::size_t i = 0; i < sweep.size(); ++i)
+    by_angle.emplace_back(wrapped(sweep[i].head_angle_rad), i);
+  std::sort(by_angle.begin(), by_angle.end());
+  const std::size_t n = by_angle.size();
+  auto nearest_beam = [&](double bearing) {
+    const double b = wrapped(bearing);
+    const std::size_t above =
+        static_cast<std::size_t>(
+            std::lower_bound(by_angle.begin(), by_angle.end(), std::make_pair(b, std::size_t{0})) -
+            by_angle.begin()) %
+        n;
+    const std::size_t below = (above + n - 1) % n;
+    std::size_t best = sweep.size();
+    double best_distance = 0.0;
+    for (const std::size_t start : {below, above}) {
+      // The whole group of beams sharing this angle.
+      std::size_t k = start;
+      while (by_angle[(k + n - 1) % n].first == by_angle[start].first && (k + n - 1) % n != start)
+        k = (k + n - 1) % n;
+      for (std::size_t step = 0; step < n && by_angle[k].first == by_angle[start].first;
+           ++step, k = (k + 1) % n) {
+        const std::size_t i = by_angle[k].second;
+        const double d = std::abs(std::remainder(sweep[i].head_angle_rad - bearing, kTwoPi));
+        if (best == sweep.size() || d < best_distance || (d == best_distance && i < best)) {
+          best = i;
+          best_distance = d;
+        }
+      }
+    }
+    return &sweep[best];
+  };
   for (int row = 0; row < gray.rows; ++row) {
     for (int col = 0; col < gray.cols; ++col) {
       const double x = (col - half) * pixel_m;
       const double y = (half - row) * pixel_m;
-      const double bearing = std::atan2(y, x);
-      const mapping::Beam* nearest = nullptr;
-      double best = 1e9;
-      for (const auto& beam : sweep) {
-        const double d =
-            std::abs(std::remainder(beam.head_angle_rad - bearing, 2 * std::numbers::pi));
-        if (d < best) {
-          best = d;
-          nearest = &beam;
-        }
-      }
+      const mapping::Beam* nearest = nearest_beam(std::atan2(y, x));
       const auto bin = static_cast<std::size_t>(std::hypot(x, y) / nearest->bin_size_m);
       if (bin < nearest->intensities.size()) gray.at<uchar>(row, col) = nearest->intensities[bin];
     }

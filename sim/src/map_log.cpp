@@ -32,14 +32,12 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
 
   start = now;
   result.mapper = std::make_unique<mapping::Mapper>(config, sensor);
+  result.totals = result.mapper->IntegrateSweeps(log.beams);
   const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
-  const std::span<const mapping::Beam> beams(log.beams);
-  for (std::size_t first = 0; first < beams.size(); first += per_sweep) {
-    const auto sweep = beams.subspan(first, std::min(per_sweep, beams.size() - first));
-    result.totals += result.mapper->Integrate(sweep);
-    ++result.sweeps;
-    if (first == 0) result.first_sweep.assign(sweep.begin(), sweep.end());
-  }
+  result.sweeps = (log.beams.size() + per_sweep - 1) / per_sweep;
+  result.first_sweep.assign(
+      log.beams.begin(),
+      log.beams.begin() + static_cast<long>(std::min(per_sweep, log.beams.size())));
   result.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
@@ -86,8 +84,7 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) 
                    {"map_top", "map_top.png"},
                    {"polar", "polar.png"},
                    {"fan", "fan.png"}}}});
-  WriteFileAtomically((dir / "report.json").string(),
-                      [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+  WriteJson((dir / "report.json").string(), report);
 }
 
 }  // namespace sonarbench::sim

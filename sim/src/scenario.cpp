@@ -119,16 +119,11 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
   mapping::MapperConfig mapper_config = scene.mapping;
   mapper_config.threads = result.threads;
   result.mapper = std::make_unique<mapping::Mapper>(mapper_config, scene.sensor.geometry);
+  const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
+  result.mapping_totals = result.mapper->IntegrateSweeps(beams);
   const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
-  std::vector<mapping::Beam> sweep;
-  for (std::size_t start = 0; start < synthesized.size(); start += per_sweep) {
-    sweep.clear();
-    for (std::size_t b = start; b < std::min(start + per_sweep, synthesized.size()); ++b) {
-      sweep.push_back(synthesized[b].beam);
-    }
-    result.mapping_totals += result.mapper->Integrate(sweep);
-    if (start == 0) result.first_sweep = sweep;
-  }
+  result.first_sweep.assign(beams.begin(),
+                            beams.begin() + static_cast<long>(std::min(per_sweep, beams.size())));
   result.timings.map_s = clock.Lap();
 
   const octomap::OcTree& map = result.mapper->tree();
@@ -209,8 +204,7 @@ void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
          {"polar", "polar.png"},
          {"fan", "fan.png"},
          {"map_top", "map_top.png"}}}});
-  WriteFileAtomically((dir / "report.json").string(),
-                      [&](std::ostream& out) { out << report.dump(2) << "\n"; });
+  WriteJson((dir / "report.json").string(), report);
 }
 
 }  // namespace sonarbench::sim

@@ -44,4 +44,11 @@ std::vector<SynthesizedBeam> SimulateScene(const Scene& scene, const RayTracer& 
   return beams;
 }
 
+std::vector<mapping::Beam> BeamsOf(std::span<const SynthesizedBeam> synthesized) {
+  std::vector<mapping::Beam> beams;
+  beams.reserve(synthesized.size());
+  for (const SynthesizedBeam& s : synthesized) beams.push_back(s.beam);
+  return beams;
+}
+
 }  // namespace sonarbench::sim

@@ -26,6 +26,9 @@ class Mapper {
   /// Integrates a batch of beams (one sweep: Canny detection works on the sweep's image) as one
   /// update: each cell is updated at most once per batch, occupied winning over free.
   BatchStats Integrate(std::span<const Beam> beams);
+  /// Integrates a run of beams sweep by sweep: batches of BeamsPerSweep() consecutive beams (the
+  /// last may be partial), each as one Integrate(). Returns the summed counts.
+  BatchStats IntegrateSweeps(std::span<const Beam> beams);
   /// The same, with obstacle ranges already detected (one list per beam).
   BatchStats Integrate(std::span<const Beam> beams, std::span<const std::vector<double>> obstacles);
 

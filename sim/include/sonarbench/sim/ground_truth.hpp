@@ -3,7 +3,6 @@
 #include <octomap/OcTree.h>
 
 #include <Eigen/Core>
-#include <functional>
 #include <span>
 
 #include "sonarbench/mapping/beam_volume.hpp"
@@ -18,12 +17,6 @@ namespace sonarbench::sim {
                                       const Eigen::Vector3d& box_half_size,
                                       const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                       const Eigen::Vector3d& c);
-
-/// Calls `visit(key)` for every cell of `key_space`'s grid whose box the triangle a, b, c
-/// crosses or touches.
-void ForEachTriangleCell(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                         const Eigen::Vector3d& c, const octomap::OcTree& key_space,
-                         const std::function<void(const octomap::OcTreeKey&)>& visit);
 
 /// Every cell of `key_space`'s grid whose box the surface of a mesh crosses.
 [[nodiscard]] mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "sonarbench/sim/beam_synthesizer.hpp"
@@ -26,5 +27,8 @@ struct ScheduledBeam {
 [[nodiscard]] std::vector<SynthesizedBeam> SimulateScene(const Scene& scene,
                                                          const RayTracer& tracer,
                                                          std::uint64_t seed, int threads);
+
+/// The beams alone, as the mapper takes them.
+[[nodiscard]] std::vector<mapping::Beam> BeamsOf(std::span<const SynthesizedBeam> synthesized);
 
 }  // namespace sonarbench::sim
