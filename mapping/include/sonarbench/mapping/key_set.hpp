@@ -345,9 +345,7 @@ class OpenKeySet {
   }
 
   void Allocate(std::size_t capacity) {
-    capacity_ = capacity;
-    mask_ = capacity - 1;
-    shift_ = capacity > 1 ? 64 - std::countr_zero(capacity) : 63;
+    SetCapacity(capacity);
     if (capacity == 0) return;
     slots_ = static_cast<std::uint64_t*>(std::malloc(capacity * sizeof(std::uint64_t)));
     if (slots_ == nullptr) throw std::bad_alloc();
@@ -371,10 +369,16 @@ class OpenKeySet {
       if (hashes == nullptr) throw std::bad_alloc();
       hashes_ = hashes;
     }
-    capacity_ = capacity;
-    mask_ = capacity - 1;
-    shift_ = 64 - std::countr_zero(capacity);
+    SetCapacity(capacity);
     peak_bytes_ = std::max(peak_bytes_, Bytes(capacity));
+  }
+
+  // The table size and what derives from it: the index mask and the hash shift (the top
+  // log2(capacity) bits of the hash index the table).
+  void SetCapacity(std::size_t capacity) {
+    capacity_ = capacity;
+    mask_ = capacity > 0 ? capacity - 1 : 0;
+    shift_ = capacity > 1 ? 64 - std::countr_zero(capacity) : 63;
   }
 
   void Release() {
@@ -382,7 +386,7 @@ class OpenKeySet {
     std::free(hashes_);
     slots_ = nullptr;
     hashes_ = nullptr;
-    capacity_ = 0;
+    SetCapacity(0);
     size_ = 0;
     tombstones_ = 0;
   }
