@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job: installs what is missing, builds, runs the default tank scenario end to end and
-# writes its report to out/cras-tank/ (report.json, map.bt, polar.png, fan.png, map_top.png).
+# writes its report to out/cras-tank/ (report.json, junit.xml, report.html, map.bt, images). Exits 1
+# when the scene's criteria fail.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash ci/build.sh

@@ -2,12 +2,14 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
 #include <sstream>
 
 #include "sonarbench/sim/scenario.hpp"
+#include "sonarbench/sim/scenario_report.hpp"
 #include "test_util.hpp"
 
 namespace sonarbench::sim {
@@ -146,7 +148,8 @@ TEST_F(TankScenario, MetricsAreConsistentWithTheirCounts) {
 TEST_F(TankScenario, OutputsAreWrittenWithTheReportLast) {
   test::TempDir dir;
   WriteScenarioOutputs(dir.path().string(), *scene_, *result_);
-  for (const char* file : {"report.json", "map.bt", "polar.png", "fan.png", "map_top.png"}) {
+  for (const char* file : {"report.json", "junit.xml", "report.html", "map.bt", "polar.png",
+                           "fan.png", "map_top.png", "map_side.png"}) {
     EXPECT_TRUE(std::filesystem::exists(dir.path() / file)) << file;
   }
   std::ifstream in(dir.path() / "report.json");
@@ -165,6 +168,14 @@ TEST_F(TankScenario, OutputsAreWrittenWithTheReportLast) {
     left_over += entry.path().string().find(".tmp.") != std::string::npos ? 1 : 0;
   }
   EXPECT_EQ(left_over, 0u);
+}
+
+TEST_F(TankScenario, BinaryMapIsByteForByteOctomapsOwn) {
+  std::ostringstream ours;
+  std::ostringstream octomaps;
+  mapping::WriteOctomapBinary(result_->mapper->tree(), ours);
+  ASSERT_TRUE(result_->mapper->tree().writeBinaryConst(octomaps));
+  EXPECT_EQ(ours.str(), octomaps.str());
 }
 
 // The seabed survey: nothing lies above the seabed and its objects, so no occupied cell may
@@ -222,20 +233,119 @@ int RunCli(const std::string& arguments, std::string* output = nullptr) {
   return WEXITSTATUS(status);
 }
 
-TEST(Cli, BadSceneExitsTwoNamingTheKeyAndWritesNothing) {
+std::string ReadFile(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A one-sweep copy of the tank scene with the given criteria section, in `dir`.
+std::filesystem::path TankSceneWithCriteria(const std::filesystem::path& dir,
+                                            const std::string& criteria) {
+  std::string text = ReadFile(test::SourcePath("scenes/cras-tank.yaml"));
+  auto replace_line = [&](const std::string& key, const std::string& line) {
+    const auto at = text.find("\n" + key);
+    ASSERT_NE(at, std::string::npos) << key;
+    text.replace(at + 1, text.find('\n', at + 1) - at - 1, line);
+  };
+  replace_line("sweeps:", "sweeps: 1");
+  replace_line("sensor_model:",
+               "sensor_model: " + test::SourcePath("sensor-models/shad-micron.yaml"));
+  const auto at = text.find("\ncriteria:");
+  if (at != std::string::npos) text.erase(at + 1);
+  const auto path = dir / "tank.yaml";
+  std::ofstream(path) << text << "\n" << criteria;
+  return path;
+}
+
+// Exit status of xmllint on `file`, or -1 when xmllint is not installed.
+int XmlLint(const std::filesystem::path& file) {
+  if (std::system("command -v xmllint > /dev/null 2>&1") != 0) return -1;
+  return WEXITSTATUS(std::system(("xmllint --noout " + file.string()).c_str()));
+}
+
+TEST(Cli, MissedCriterionExitsOneAndSaysWhyEverywhere) {
+  test::TempDir dir;
+  const auto scene = TankSceneWithCriteria(
+      dir.path(),
+      "criteria:\n  metrics:\n    occupied_recall: {min: 0.99}\n    coverage: {min: 0.0}\n");
+  const auto out = dir.path() / "out";
+  std::string output;
+  EXPECT_EQ(RunCli("run " + scene.string() + " --out " + out.string(), &output), 1);
+  EXPECT_NE(output.find("FAIL cras-tank: 1/2 criteria met"), std::string::npos) << output;
+  EXPECT_NE(output.find("occupied_recall = "), std::string::npos) << output;
+  EXPECT_NE(output.find("expected >= 0.99"), std::string::npos) << output;
+
+  const auto report = nlohmann::json::parse(ReadFile(out / "report.json"));
+  EXPECT_EQ(report["schema_version"], kScenarioReportSchema);
+  EXPECT_FALSE(report["verdict"]["passed"].get<bool>());
+  const auto& recall = report["criteria"]["results"][0];
+  EXPECT_EQ(recall["metric"], "occupied_recall");
+  EXPECT_EQ(recall["status"], "fail");
+  EXPECT_NEAR(recall["margin"].get<double>(), recall["actual"].get<double>() - 0.99, 1e-12);
+  EXPECT_EQ(report["criteria"]["results"][1]["status"], "pass");
+
+  const std::string junit = ReadFile(out / "junit.xml");
+  EXPECT_NE(junit.find("tests=\"3\" failures=\"1\" errors=\"0\""), std::string::npos) << junit;
+  EXPECT_NE(junit.find("<failure type=\"criterion\" message=\"occupied_recall = "),
+            std::string::npos)
+      << junit;
+  EXPECT_NE(XmlLint(out / "junit.xml"), 1);  // 0 when well-formed, -1 without xmllint
+
+  const std::string html = ReadFile(out / "report.html");
+  EXPECT_NE(html.find("<title>sonarbench: cras-tank FAIL</title>"), std::string::npos);
+  EXPECT_EQ(html.find("src=\"polar.png\""), std::string::npos) << "images must be embedded";
+  std::size_t embedded = 0;
+  for (auto at = html.find("data:image/png;base64,"); at != std::string::npos;
+       at = html.find("data:image/png;base64,", at + 1))
+    ++embedded;
+  EXPECT_EQ(embedded, 4u);
+}
+
+TEST(Cli, ExpectFailPassesOnlyWhenACriterionFails) {
+  test::TempDir dir;
+  const auto out = dir.path() / "out";
+  std::string output;
+  const auto missing = TankSceneWithCriteria(
+      dir.path(), "criteria:\n  expect: fail\n  metrics: {occupied_recall: {min: 0.99}}\n");
+  EXPECT_EQ(RunCli("run " + missing.string() + " --out " + out.string(), &output), 0) << output;
+  EXPECT_NE(output.find("PASS cras-tank"), std::string::npos) << output;
+  EXPECT_NE(ReadFile(out / "junit.xml").find("failures=\"0\""), std::string::npos);
+
+  const auto met = TankSceneWithCriteria(
+      dir.path(), "criteria:\n  expect: fail\n  metrics: {occupied_recall: {min: 0.0}}\n");
+  EXPECT_EQ(RunCli("run " + met.string() + " --out " + out.string(), &output), 1) << output;
+  EXPECT_NE(output.find("expect: fail"), std::string::npos) << output;
+  EXPECT_NE(ReadFile(out / "junit.xml").find("<failure type=\"expectation\""), std::string::npos);
+}
+
+TEST(Cli, BadSceneExitsTwoNamingTheKeyAndWritesOnlyAnErrorJunit) {
   test::TempDir dir;
   const auto scene = dir.path() / "bad.yaml";
   std::ofstream(scene) << "name: x\nsensor_model: "
                        << test::SourcePath("sensor-models/shad-micron.yaml")
                        << "\nsweeps: 1\nsweep: 2\nmaterials: [{name: a, reflectivity: 2}]\n"
                        << "meshes: [{name: m, type: plane, size_m: [1, 1, 0], material: a}]\n"
-                       << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+                       << "trajectory: {type: static, position_m: [0, 0, 0]}\n"
+                       << "criteria: {metrics: {coverage: {min: 0.5}, coverage: {min: 0.6}}}\n";
   std::string output;
   const auto out = dir.path() / "out";
   EXPECT_EQ(RunCli("run " + scene.string() + " --out " + out.string(), &output), 2);
   EXPECT_NE(output.find("bad.yaml:4:1: key 'sweep': unknown key"), std::string::npos) << output;
   EXPECT_NE(output.find("'materials[0].reflectivity'"), std::string::npos) << output;
-  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_NE(output.find("'criteria.metrics.coverage': duplicate key"), std::string::npos) << output;
+  // The CI system still learns why: junit.xml holds one <error>, and nothing else is written.
+  std::vector<std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(out))
+    files.push_back(entry.path().filename().string());
+  EXPECT_EQ(files, std::vector<std::string>{"junit.xml"});
+  const std::string junit = ReadFile(out / "junit.xml");
+  EXPECT_NE(junit.find("<error type=\"input_error\" message=\""), std::string::npos) << junit;
+  EXPECT_NE(junit.find(XmlEscape(scene.string()) + ":4:1: key &apos;sweep&apos;: unknown key"),
+            std::string::npos)
+      << junit;
+  EXPECT_NE(XmlLint(out / "junit.xml"), 1);
 }
 
 TEST(Cli, MissingSceneAndBadOptionsExitTwo) {

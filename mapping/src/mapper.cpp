@@ -31,11 +31,16 @@ BatchStats Mapper::Integrate(std::span<const Beam> beams) {
   return Integrate(beams, obstacles);
 }
 
-BatchStats Mapper::IntegrateSweeps(std::span<const Beam> beams) {
+BatchStats Mapper::IntegrateSweeps(
+    std::span<const Beam> beams,
+    const std::function<void(std::size_t done, std::size_t total)>& on_sweep) {
   const auto per_sweep = static_cast<std::size_t>(sensor_.BeamsPerSweep());
+  const std::size_t sweeps = (beams.size() + per_sweep - 1) / per_sweep;
   BatchStats totals;
-  for (std::size_t first = 0; first < beams.size(); first += per_sweep) {
+  for (std::size_t sweep = 0; sweep < sweeps; ++sweep) {
+    const std::size_t first = sweep * per_sweep;
     totals += Integrate(beams.subspan(first, std::min(per_sweep, beams.size() - first)));
+    if (on_sweep) on_sweep(sweep + 1, sweeps);
   }
   return totals;
 }
@@ -48,9 +53,21 @@ BatchStats Mapper::Integrate(std::span<const Beam> beams,
   return IntegrateBatch<KeyOpenSet>(*tree_, beams, obstacles, directions_, free_range_m_, threads_);
 }
 
+void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out) {
+  // AbstractOccupancyOcTree::writeBinaryConst's header, then the node data.
+  out << "# Octomap OcTree binary file\n# (feel free to add / change comments, but leave the first "
+         "line as it is!)\n#\n"
+      << "id " << tree.getTreeType() << "\n"
+      << "size " << tree.size() << "\n"
+      << "res " << tree.getResolution() << "\n"
+      << "data\n";
+  tree.writeBinaryData(out);
+}
+
 void Mapper::WriteBinary(const std::string& path) const {
   WriteFileAtomically(path, [&](std::ostream& out) {
-    if (!tree_->writeBinaryConst(out)) throw std::runtime_error(path + ": OctoMap could not write");
+    WriteOctomapBinary(*tree_, out);
+    if (!out) throw std::runtime_error(path + ": OctoMap could not write");
   });
 }
 

@@ -174,6 +174,13 @@ bool YamlReader::Has(const std::string& key) const {
   return false;
 }
 
+std::vector<std::string> YamlReader::Keys() const {
+  std::vector<std::string> keys;
+  if (!node_.IsMap()) return keys;
+  for (const auto& item : node_) keys.push_back(item.first.Scalar());
+  return keys;
+}
+
 void YamlReader::Fail(const std::string& key, const std::string& expected) {
   YAML::Node at = node_;
   for (const auto& item : node_) {

@@ -1,21 +1,30 @@
-// sonarbench: the command-line front end. Exit status: 0 success, 2 bad input, 3 internal error.
+// sonarbench: the command-line front end. Exit status: 0 success, 1 a scenario's criteria failed,
+// 2 bad input, 3 internal error.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cstdint>
+#include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <string>
 
+#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mat_log.hpp"
 #include "sonarbench/sim/fidelity.hpp"
 #include "sonarbench/sim/map_log.hpp"
 #include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/scenario.hpp"
+#include "sonarbench/sim/scenario_report.hpp"
 #include "sonarbench/sim/scene.hpp"
 #include "sonarbench/sim/simulation.hpp"
 
 namespace {
 
+constexpr int kExitCriteriaFailed = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitInternalError = 3;
 
@@ -24,11 +33,60 @@ struct RunArgs {
   std::string out = "out";
   std::optional<std::uint64_t> seed;
   int threads = 0;
+  bool no_progress = false;
 };
 
-void PrintSummary(const sonarbench::sim::ScenarioResult& r, const std::string& out) {
+// One self-overwriting progress line on stderr (stage, sweeps done, rate, time left), shown only
+// on an interactive terminal outside CI, at most five times a second.
+class ProgressLine {
+ public:
+  explicit ProgressLine(bool enabled) : enabled_(enabled) {}
+  ProgressLine(const ProgressLine&) = delete;
+  ProgressLine& operator=(const ProgressLine&) = delete;
+  ~ProgressLine() { Clear(); }
+
+  static bool WantedFor(bool disabled_by_user) {
+    return !disabled_by_user && isatty(STDERR_FILENO) == 1 && std::getenv("CI") == nullptr;
+  }
+
+  void Update(std::string_view stage, std::size_t done, std::size_t total) {
+    if (!enabled_) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (stage != stage_) {
+      stage_ = stage;
+      stage_start_ = now;
+    } else if (done < total && now - last_print_ < std::chrono::milliseconds(200)) {
+      return;
+    }
+    last_print_ = now;
+    const double elapsed = std::chrono::duration<double>(now - stage_start_).count();
+    const double rate = elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0;
+    char line[160];
+    std::snprintf(line, sizeof line, "\r%-9s sweep %zu/%zu  %.1f sweeps/s  %.0f s left   ",
+                  std::string(stage).c_str(), done, total, rate,
+                  rate > 0 ? static_cast<double>(total - done) / rate : 0.0);
+    std::cerr << line << std::flush;
+    shown_ = true;
+  }
+
+  void Clear() {
+    if (shown_) std::cerr << "\r" << std::string(60, ' ') << "\r" << std::flush;
+    shown_ = false;
+  }
+
+ private:
+  bool enabled_;
+  bool shown_ = false;
+  std::string stage_;
+  std::chrono::steady_clock::time_point stage_start_;
+  std::chrono::steady_clock::time_point last_print_;
+};
+
+void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::ScenarioResult& r,
+                  const std::string& out) {
   const auto& m = r.metrics;
   const auto& t = r.timings;
+  const auto& v = r.verdict;
   std::cout << "beams " << r.beams << ", seed " << r.seed << ", threads " << r.threads << "\n"
             << "occupied precision " << m.occupied_precision << " (" << m.true_positive_cells << "/"
             << m.occupied_cells << "), recall " << m.occupied_recall << " ("
@@ -36,7 +94,14 @@ void PrintSummary(const sonarbench::sim::ScenarioResult& r, const std::string& o
             << m.coverage << " (" << m.known_observable_cells << "/" << m.observable_cells << ")\n"
             << "timing [s]: scene " << t.build_scene_s << ", simulate " << t.simulate_s << ", map "
             << t.map_s << ", ground truth " << t.ground_truth_s << ", score " << t.score_s << "\n"
-            << "wrote " << out << "/report.json\n";
+            << "wrote " << out << "/report.json, junit.xml, report.html, map.bt and images\n";
+  std::size_t met = 0;
+  for (const auto& c : v.results) met += c.status != sonarbench::sim::CriterionStatus::kFail;
+  for (const auto& w : v.warnings) std::cout << "warning: " << w << "\n";
+  std::cout << (v.passed ? "PASS " : "FAIL ") << scene.name << ": " << met << "/"
+            << v.results.size() << " criteria met"
+            << (v.expect_fail ? " (the scene expects a failure)" : "") << "\n";
+  for (const auto& reason : v.reasons) std::cout << "  " << reason << "\n";
 }
 
 struct MapArgs {
@@ -122,10 +187,28 @@ int Run(const RunArgs& args) {
   sonarbench::sim::RunOptions options;
   options.seed = args.seed;
   options.threads = args.threads;
+  ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
+  options.progress = [&](std::string_view stage, std::size_t done, std::size_t total) {
+    progress.Update(stage, done, total);
+  };
   const auto result = sonarbench::sim::RunScenario(scene, options);
+  progress.Clear();
   sonarbench::sim::WriteScenarioOutputs(args.out, scene, result);
-  PrintSummary(result, args.out);
-  return 0;
+  PrintSummary(scene, result, args.out);
+  return result.verdict.passed ? 0 : kExitCriteriaFailed;
+}
+
+// A run that broke still leaves a junit.xml saying so, for the CI system that collects it.
+void WriteErrorJunit(const RunArgs& args, std::string_view type, const std::string& message) {
+  try {
+    std::filesystem::create_directories(args.out);
+    const std::string xml = sonarbench::sim::ErrorJunitXml(
+        std::filesystem::path(args.scene).stem().string(), type, message);
+    sonarbench::WriteFileAtomically((std::filesystem::path(args.out) / "junit.xml").string(),
+                                    [&](std::ostream& out) { out << xml; });
+  } catch (const std::exception& e) {
+    std::cerr << "sonarbench: could not write junit.xml: " << e.what() << "\n";
+  }
 }
 
 }  // namespace
@@ -140,8 +223,10 @@ int main(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand(
       "run",
       "Run a scenario end to end: simulate every sweep of SCENE, map them, score the map against "
-      "the scene's ground truth, and write report.json, map.bt (open it in octovis), polar.png "
-      "(the first sweep, beams x bins), fan.png and map_top.png into --out.");
+      "the scene's ground truth and its criteria, and write report.json, junit.xml, report.html, "
+      "map.bt (open it in octovis), polar.png (the first sweep, beams x bins), fan.png, "
+      "map_top.png and map_side.png into --out. Exit status 0 when the criteria pass, 1 when "
+      "they fail, 2 on bad input, 3 on an internal error.");
   run_cmd->add_option("scene", run.scene, "Scene YAML file (see scenes/)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -150,6 +235,9 @@ int main(int argc, char** argv) {
   run_cmd->add_option("-s,--seed", run.seed,
                       "Seed of every random draw; overrides the scene's 'seed'");
   AddThreadsOption(run_cmd, run.threads);
+  run_cmd->add_flag("--no-progress", run.no_progress,
+                    "Never show the progress line (it shows only on a terminal, and never when "
+                    "the CI environment variable is set)");
 
   MapArgs map;
   CLI::App* map_cmd = app.add_subcommand(
@@ -213,9 +301,11 @@ int main(int argc, char** argv) {
     if (*fidelity_cmd) return Fidelity(fidelity);
   } catch (const sonarbench::InputError& e) {
     std::cerr << "sonarbench: error: " << e.what() << "\n";
+    if (*run_cmd) WriteErrorJunit(run, "input_error", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << "sonarbench: internal error: " << e.what() << "\n";
+    if (*run_cmd) WriteErrorJunit(run, "internal_error", e.what());
     return kExitInternalError;
   }
   return kExitInternalError;

@@ -10,9 +10,14 @@
 #include "sonarbench/mapping/atomic_file.hpp"
 
 namespace sonarbench::sim {
-void WritePng(const std::string& path, const cv::Mat& image) {
+std::vector<unsigned char> EncodePng(const cv::Mat& image) {
   std::vector<uchar> bytes;
-  if (!cv::imencode(".png", image, bytes)) throw std::runtime_error(path + ": PNG encoding failed");
+  if (!cv::imencode(".png", image, bytes)) throw std::runtime_error("PNG encoding failed");
+  return bytes;
+}
+
+void WritePng(const std::string& path, const cv::Mat& image) {
+  const std::vector<uchar> bytes = EncodePng(image);
   WriteFileAtomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(bytes.data()),
               static_cast<std::streamsize>(bytes.size()));
@@ -100,25 +105,36 @@ void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep
   WritePng(path, RenderFanImage(sweep, pixel_m));
 }
 
-void WriteTopDownImage(const std::string& path, const MapCells& map, const mapping::KeySet& truth,
-                       const mapping::KeySet& observable) {
-  int lo_x = 1 << 16, lo_y = 1 << 16, hi_x = 0, hi_y = 0;
+cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
+                      const mapping::KeySet& observable, const MapView& view) {
+  // Image axes: u (key index) to the right, v up; the third axis is projected (top) or sliced.
+  const int u = 0;
+  const int v = view.kind == MapView::Kind::kTop ? 1 : 2;
+  const int w = view.kind == MapView::Kind::kTop ? 2 : 1;
+  auto in_view = [&](const octomap::OcTreeKey& k) {
+    return view.kind == MapView::Kind::kTop ||
+           std::abs(static_cast<int>(k[w]) - static_cast<int>(view.slab_key)) <=
+               view.slab_half_cells;
+  };
+  int lo_u = 1 << 16, lo_v = 1 << 16, hi_u = 0, hi_v = 0;
   auto extend = [&](const mapping::KeySet& cells) {
     for (const auto& k : cells) {
-      lo_x = std::min<int>(lo_x, k[0]);
-      hi_x = std::max<int>(hi_x, k[0]);
-      lo_y = std::min<int>(lo_y, k[1]);
-      hi_y = std::max<int>(hi_y, k[1]);
+      if (!in_view(k)) continue;
+      lo_u = std::min<int>(lo_u, k[u]);
+      hi_u = std::max<int>(hi_u, k[u]);
+      lo_v = std::min<int>(lo_v, k[v]);
+      hi_v = std::max<int>(hi_v, k[v]);
     }
   };
   extend(map.occupied);
   extend(map.free);
   extend(truth);
-  if (hi_x < lo_x) lo_x = hi_x = lo_y = hi_y = 0;
-  // Per column: 1 free, 2 missed truth, 3 false positive, 4 true positive (higher wins).
-  cv::Mat label(hi_y - lo_y + 1, hi_x - lo_x + 1, CV_8UC1, cv::Scalar(0));
+  if (hi_u < lo_u) lo_u = hi_u = lo_v = hi_v = 0;
+  // Per pixel: 1 free, 2 missed truth, 3 false positive, 4 true positive (higher wins).
+  cv::Mat label(hi_v - lo_v + 1, hi_u - lo_u + 1, CV_8UC1, cv::Scalar(0));
   auto mark = [&](const octomap::OcTreeKey& k, uchar value) {
-    uchar& cell = label.at<uchar>(hi_y - k[1], k[0] - lo_x);
+    if (!in_view(k)) return;
+    uchar& cell = label.at<uchar>(hi_v - k[v], k[u] - lo_u);
     cell = std::max(cell, value);
   };
   for (const auto& k : map.free) mark(k, 1);
@@ -137,7 +153,12 @@ void WriteTopDownImage(const std::string& path, const MapCells& map, const mappi
   }
   const double scale = std::max(1.0, 400.0 / std::max(label.rows, label.cols));
   cv::resize(colour, colour, cv::Size(), scale, scale, cv::INTER_NEAREST);
-  WritePng(path, colour);
+  return colour;
+}
+
+void WriteTopDownImage(const std::string& path, const MapCells& map, const mapping::KeySet& truth,
+                       const mapping::KeySet& observable) {
+  WritePng(path, RenderMapView(map, truth, observable, MapView{}));
 }
 
 }  // namespace sonarbench::sim

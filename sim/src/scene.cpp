@@ -144,6 +144,7 @@ Scene LoadScene(const std::string& path) {
   if (auto mapping = root.OptionalChild("mapping")) {
     scene.mapping = mapping::ReadMapperConfig(*mapping);
   }
+  if (auto criteria = root.OptionalChild("criteria")) scene.criteria = ReadCriteria(*criteria);
   root.RejectUnknownKeys();
   root.ThrowIfErrors();
 

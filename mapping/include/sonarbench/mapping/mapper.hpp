@@ -2,7 +2,9 @@
 
 #include <octomap/OcTree.h>
 
+#include <functional>
 #include <memory>
+#include <ostream>
 #include <span>
 #include <string>
 
@@ -13,6 +15,10 @@
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
 namespace sonarbench::mapping {
+
+/// Writes `tree` in OctoMap's binary `.bt` format: the bytes OcTree::writeBinaryConst writes,
+/// without the " done." that Debian's liboctomap prints on stderr for each file.
+void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out);
 
 /// The production mapper: detection, beam-volume ray casting and OctoMap log-odds updates.
 /// Threading: Integrate() casts the rays of a batch on `config.threads` threads, each into its
@@ -27,8 +33,11 @@ class Mapper {
   /// update: each cell is updated at most once per batch, occupied winning over free.
   BatchStats Integrate(std::span<const Beam> beams);
   /// Integrates a run of beams sweep by sweep: batches of BeamsPerSweep() consecutive beams (the
-  /// last may be partial), each as one Integrate(). Returns the summed counts.
-  BatchStats IntegrateSweeps(std::span<const Beam> beams);
+  /// last may be partial), each as one Integrate(). Returns the summed counts. `on_sweep`, when
+  /// set, is called after each sweep with the sweeps done and the total.
+  BatchStats IntegrateSweeps(
+      std::span<const Beam> beams,
+      const std::function<void(std::size_t done, std::size_t total)>& on_sweep = {});
   /// The same, with obstacle ranges already detected (one list per beam).
   BatchStats Integrate(std::span<const Beam> beams, std::span<const std::vector<double>> obstacles);
 

@@ -43,6 +43,8 @@ class YamlReader {
   [[nodiscard]] std::vector<YamlReader> Sequence(const std::string& key);
 
   [[nodiscard]] bool Has(const std::string& key) const;
+  /// The keys of this mapping, in file order (for mappings keyed by name, such as criteria).
+  [[nodiscard]] std::vector<std::string> Keys() const;
   /// Records an error at `key` (or at this node when `key` is empty).
   void Fail(const std::string& key, const std::string& expected);
 

@@ -1,14 +1,18 @@
 #pragma once
 
+#include <cstdint>
 #include <opencv2/core.hpp>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/sim/score.hpp"
 
 namespace sonarbench::sim {
 
+/// `image` as PNG file bytes.
+[[nodiscard]] std::vector<unsigned char> EncodePng(const cv::Mat& image);
 /// Writes `image` as a PNG file, atomically.
 void WritePng(const std::string& path, const cv::Mat& image);
 
@@ -24,10 +28,24 @@ void WritePolarImage(const std::string& path, std::span<const mapping::Beam> swe
 /// RenderFanImage, written as a PNG file atomically.
 void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep, double pixel_m);
 
-/// Writes a top-down view of the map against the truth, one pixel per cell column (x right,
-/// y up): green where a column holds a true-positive cell, red where it holds only false
-/// positives, blue where it holds observable truth the map missed, grey where only free cells.
-/// With an empty `truth` (a real log), occupied columns are white.
+/// Which cells a map image shows: every column seen from above (x right, y up), or a slab of
+/// cells around one y key seen from the side (x right, z up).
+struct MapView {
+  enum class Kind { kTop, kSide };
+  Kind kind = Kind::kTop;
+  /// kSide: the slab holds the cells whose y key is within slab_half_cells of slab_key.
+  std::uint16_t slab_key = 0;
+  int slab_half_cells = 1;
+};
+
+/// Renders the map against the truth, one pixel per cell (scaled up to about 400 pixels): green
+/// where a pixel's cells hold a true positive, red where only false positives, blue where
+/// observable truth the map missed, grey where only free cells. With an empty `truth` (a real
+/// log), occupied cells are white.
+[[nodiscard]] cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
+                                    const mapping::KeySet& observable, const MapView& view);
+
+/// The top-down RenderMapView, written as a PNG file atomically.
 void WriteTopDownImage(const std::string& path, const MapCells& map, const mapping::KeySet& truth,
                        const mapping::KeySet& observable);
 

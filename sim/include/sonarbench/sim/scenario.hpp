@@ -1,9 +1,11 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "sonarbench/mapping/mapper.hpp"
@@ -17,6 +19,8 @@ struct RunOptions {
   std::optional<std::uint64_t> seed;
   /// Threads for simulation and mapping; 0 = all. Outputs do not depend on it.
   int threads = 0;
+  /// Called after each sweep of a long stage ("simulate", "map") with sweeps done and total.
+  std::function<void(std::string_view stage, std::size_t done, std::size_t total)> progress;
 };
 
 /// Wall-clock time of each stage of a run [s].
@@ -41,14 +45,13 @@ struct ScenarioResult {
   std::vector<mapping::Beam> first_sweep;
   mapping::KeySet truth;
   mapping::KeySet observable;
+  /// The sonar's position at the first beam [m], where the side slice of the map is cut.
+  Eigen::Vector3d sonar_start_m = Eigen::Vector3d::Zero();
+  /// The metrics against the scene's criteria.
+  Verdict verdict;
 };
 
 /// Simulates the scene, maps every sweep, builds the ground truth and scores the map.
 [[nodiscard]] ScenarioResult RunScenario(const Scene& scene, const RunOptions& options);
-
-/// Writes `report.json`, `map.bt`, `polar.png`, `fan.png` and `map_top.png` into `out_dir`
-/// (created if needed); each file is written atomically, the report last.
-void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
-                          const ScenarioResult& result);
 
 }  // namespace sonarbench::sim

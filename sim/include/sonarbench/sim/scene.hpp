@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sonarbench/mapping/mapper_config.hpp"
+#include "sonarbench/sim/criteria.hpp"
 #include "sonarbench/sim/sensor_model.hpp"
 
 namespace sonarbench::sim {
@@ -75,6 +76,8 @@ struct Scene {
   /// Seed of every random draw in the run (overridable on the command line).
   std::uint64_t seed = 1;
   mapping::MapperConfig mapping;
+  /// Pass/fail bounds on the map's metrics (none: the scenario passes when it runs).
+  Criteria criteria;
 };
 
 /// Loads a scene YAML file and the sensor model it names (relative to the scene file).

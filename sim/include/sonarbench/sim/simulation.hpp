@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -24,9 +25,10 @@ struct ScheduledBeam {
 
 /// Synthesises every beam of the scene's run, in time order, on `threads` threads (0 = all).
 /// Beam b draws only from DeriveSeed(seed, b): the output does not depend on the thread count.
-[[nodiscard]] std::vector<SynthesizedBeam> SimulateScene(const Scene& scene,
-                                                         const RayTracer& tracer,
-                                                         std::uint64_t seed, int threads);
+/// `on_sweep`, when set, is called after each sweep with the sweeps done and the total.
+[[nodiscard]] std::vector<SynthesizedBeam> SimulateScene(
+    const Scene& scene, const RayTracer& tracer, std::uint64_t seed, int threads,
+    const std::function<void(std::size_t done, std::size_t total)>& on_sweep = {});
 
 /// The beams alone, as the mapper takes them.
 [[nodiscard]] std::vector<mapping::Beam> BeamsOf(std::span<const SynthesizedBeam> synthesized);

@@ -1,0 +1,77 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sonarbench/mapping/yaml_reader.hpp"
+
+namespace sonarbench::sim {
+
+struct MapMetrics;  // score.hpp (which includes the scene, and so this header)
+
+/// One pass/fail bound on a map metric, from a scene's `criteria.metrics.<name>` entry.
+///
+/// The metric passes when it lies within [min, max] (either may be absent). Outside that, it is
+/// still *acceptable* when it lies within [acceptable_min, acceptable_max]: reported as a warning,
+/// not a failure, so a criterion can carry a target and a tolerated band. An optional criterion
+/// is evaluated and reported but never decides the verdict.
+struct Criterion {
+  std::string metric;
+  std::optional<double> min;
+  std::optional<double> max;
+  std::optional<double> acceptable_min;
+  std::optional<double> acceptable_max;
+  bool optional = false;
+};
+
+/// A scene's criteria. With `expect_fail`, the scenario passes only when at least one required
+/// criterion fails: a suite can hold scenarios that check the criteria themselves.
+struct Criteria {
+  bool expect_fail = false;
+  std::vector<Criterion> metrics;
+};
+
+/// The metric names a criterion may name, each with a one-line definition.
+struct MetricInfo {
+  const char* name;
+  const char* definition;
+  double (*value)(const MapMetrics&);
+};
+[[nodiscard]] const std::vector<MetricInfo>& KnownMetrics();
+
+/// Reads the `criteria` mapping of a scene (`expect: pass|fail`, `metrics: {name: bounds}`).
+/// Errors are collected in `node` like every other key of the scene.
+[[nodiscard]] Criteria ReadCriteria(YamlReader& node);
+
+enum class CriterionStatus { kPass, kAcceptable, kFail };
+[[nodiscard]] const char* StatusName(CriterionStatus status);
+
+struct CriterionResult {
+  Criterion criterion;
+  double actual = 0.0;
+  /// Distance from the success bound, positive inside: actual - min or max - actual (the smaller
+  /// when both are set). Negative means the metric missed its bound by that much.
+  double margin = 0.0;
+  CriterionStatus status = CriterionStatus::kPass;
+  /// "0.42 >= 0.45"-style text of the bound, for reports.
+  std::string expected;
+};
+
+/// The outcome of a scenario against its criteria.
+struct Verdict {
+  bool passed = true;
+  bool expect_fail = false;
+  std::vector<CriterionResult> results;
+  /// Why the scenario failed (empty when it passed), one line per reason.
+  std::vector<std::string> reasons;
+  /// Optional criteria that failed and criteria that were only acceptable, one line each.
+  std::vector<std::string> warnings;
+};
+
+[[nodiscard]] Verdict Evaluate(const Criteria& criteria, const MapMetrics& metrics);
+
+/// "metric = actual, expected ..., margin ..." for terminal output and reports.
+[[nodiscard]] std::string Describe(const CriterionResult& result);
+
+}  // namespace sonarbench::sim
