@@ -53,11 +53,14 @@ class ProgressLine {
     if (!enabled_) return;
     const auto now = std::chrono::steady_clock::now();
     if (stage != stage_) {
+      // A stage starts when the previous one reported its last sweep (or when the run began).
       stage_ = stage;
-      stage_start_ = now;
+      stage_start_ = last_event_;
     } else if (done < total && now - last_print_ < std::chrono::milliseconds(200)) {
+      last_event_ = now;
       return;
     }
+    last_event_ = now;
     last_print_ = now;
     const double elapsed = std::chrono::duration<double>(now - stage_start_).count();
     const double rate = elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0;
@@ -79,6 +82,7 @@ class ProgressLine {
   bool shown_ = false;
   std::string stage_;
   std::chrono::steady_clock::time_point stage_start_;
+  std::chrono::steady_clock::time_point last_event_ = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point last_print_;
 };
 
