@@ -12,7 +12,7 @@ namespace {
 
 Criteria Parse(const std::string& yaml) {
   YamlReader reader = YamlReader::FromString(yaml, "scene.yaml");
-  Criteria criteria = ReadCriteria(reader);
+  Criteria criteria = ReadCriteria(reader, {"tank", "crate"});
   reader.ThrowIfErrors();
   return criteria;
 }
@@ -116,6 +116,18 @@ TEST(Criteria, OptionalFailuresWarnAndExpectFailInverts) {
   const Criteria only_optional =
       Parse("expect: fail\nmetrics: {occupied_recall: {min: 0.5, optional: true}}");
   EXPECT_FALSE(Evaluate(only_optional, Metrics(0.1, 0)).passed);
+}
+
+TEST(Criteria, MeshRecallNamesAMeshOfTheScene) {
+  const Criteria c = Parse("metrics: {mesh_recall.crate: {min: 0.5}}");
+  MapMetrics m;
+  m.per_mesh.push_back({"tank", 10, 10, 1.0});
+  m.per_mesh.push_back({"crate", 10, 4, 0.4});
+  const Verdict v = Evaluate(c, m);
+  EXPECT_FALSE(v.passed);
+  EXPECT_DOUBLE_EQ(v.results[0].actual, 0.4);
+  EXPECT_NE(ParseError("metrics: {mesh_recall.boat: {min: 0.5}}").find("(tank, crate)"),
+            std::string::npos);
 }
 
 TEST(Criteria, EveryKnownMetricReadsItsField) {

@@ -49,6 +49,21 @@ TEST(VoxelizeMeshes, PlaneCellsCanBeCounted) {
   }
 }
 
+// The same plane lying exactly on the cell face z = 0: cells are half-open like OctoMap's keys
+// (coordToKey(0) is the cell [0, 0.05)), so it belongs to that layer alone, 400 cells, and not
+// to the layer below nor to none (float cell centres once lost it from both).
+TEST(VoxelizeMeshes, SurfaceOnACellFaceBelongsToTheUpperCellOnly) {
+  TriangleMesh plane = SmallPlane();
+  for (auto& v : plane.vertices) v.z() = 0.0f;
+  const octomap::OcTree key_space(0.05);
+  const mapping::KeySet cells = VoxelizeMeshes(std::vector<TriangleMesh>{plane}, key_space);
+  EXPECT_EQ(cells.size(), 400u);
+  for (const auto& key : cells) {
+    EXPECT_EQ(key, key_space.coordToKey(key_space.keyToCoord(key)));
+    EXPECT_EQ(key[2], key_space.coordToKey(0.0, 0.0, 0.0)[2]);
+  }
+}
+
 // A box 0.3 m on a side, centred in a cell block, has 6 faces of 6 × 6 cells; the shell of a
 // 6 × 6 × 6 block is 6³ - 4³ = 152 cells.
 TEST(VoxelizeMeshes, BoxShellCellsCanBeCounted) {

@@ -348,6 +348,35 @@ TEST(Cli, BadSceneExitsTwoNamingTheKeyAndWritesOnlyAnErrorJunit) {
   EXPECT_NE(XmlLint(out / "junit.xml"), 1);
 }
 
+TEST(Cli, BadMeshFilesExitTwoNamingSceneMeshAndFile) {
+  test::TempDir dir;
+  std::ofstream(dir.path() / "nan.obj") << "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n";
+  auto scene_with = [&](const std::string& file) {
+    const auto scene = dir.path() / "scene.yaml";
+    std::ofstream(scene) << "name: x\nsensor_model: "
+                         << test::SourcePath("sensor-models/shad-micron.yaml")
+                         << "\nsweeps: 1\nmaterials: [{name: a, reflectivity: 0.5}]\n"
+                         << "meshes: [{name: rock, type: file, file: " << file
+                         << ", material: a}]\n"
+                         << "trajectory: {type: static, position_m: [0, 0, 1]}\n";
+    return scene.string();
+  };
+  std::string output;
+  EXPECT_EQ(
+      RunCli("run " + scene_with("nan.obj") + " --out " + (dir.path() / "o").string(), &output), 2);
+  EXPECT_NE(output.find("mesh 'rock' (" + (dir.path() / "nan.obj").string() +
+                        "): vertex 2 is not finite"),
+            std::string::npos)
+      << output;
+  EXPECT_EQ(
+      RunCli("run " + scene_with("missing.stl") + " --out " + (dir.path() / "o").string(), &output),
+      2);
+  EXPECT_NE(output.find("scene.yaml: mesh 'rock': " + (dir.path() / "missing.stl").string() +
+                        ": no such mesh file"),
+            std::string::npos)
+      << output;
+}
+
 TEST(Cli, MissingSceneAndBadOptionsExitTwo) {
   std::string output;
   EXPECT_EQ(RunCli("run /nonexistent.yaml", &output), 2);

@@ -101,6 +101,16 @@ void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::Sc
             << "wrote " << out << "/report.json, junit.xml, report.html, map.bt and images\n";
   std::size_t met = 0;
   for (const auto& c : v.results) met += c.status != sonarbench::sim::CriterionStatus::kFail;
+  for (const auto& mesh : r.meshes) {
+    if (mesh.check.zero_area_triangles > 0) {
+      std::cout << "warning: mesh '" << mesh.name << "': " << mesh.check.zero_area_triangles
+                << " zero-area triangles dropped\n";
+    }
+    if (mesh.check.non_manifold_edges > 0) {
+      std::cout << "warning: mesh '" << mesh.name << "': " << mesh.check.non_manifold_edges
+                << " non-manifold edges (three or more triangles share them)\n";
+    }
+  }
   for (const auto& w : v.warnings) std::cout << "warning: " << w << "\n";
   std::cout << (v.passed ? "PASS " : "FAIL ") << scene.name << ": " << met << "/"
             << v.results.size() << " criteria met"

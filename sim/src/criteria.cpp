@@ -91,7 +91,20 @@ const char* StatusName(CriterionStatus status) {
   return "?";
 }
 
-Criteria ReadCriteria(YamlReader& node) {
+double MetricValue(const MapMetrics& metrics, const std::string& name) {
+  for (const MetricInfo& m : KnownMetrics()) {
+    if (name == m.name) return m.value(metrics);
+  }
+  if (name.starts_with(kMeshRecallPrefix)) {
+    const std::string mesh = name.substr(std::string(kMeshRecallPrefix).size());
+    for (const auto& r : metrics.per_mesh) {
+      if (r.name == mesh) return r.recall;
+    }
+  }
+  return NAN;
+}
+
+Criteria ReadCriteria(YamlReader& node, const std::vector<std::string>& mesh_names) {
   Criteria criteria;
   std::string expect = "pass";
   node.Optional("expect", expect, OneOf({"pass", "fail"}));
@@ -102,11 +115,21 @@ Criteria ReadCriteria(YamlReader& node) {
     Criterion c;
     c.metric = name;
     const auto& known = KnownMetrics();
-    if (std::none_of(known.begin(), known.end(),
-                     [&](const MetricInfo& m) { return name == m.name; })) {
+    const bool is_known = std::any_of(known.begin(), known.end(),
+                                      [&](const MetricInfo& m) { return name == m.name; });
+    const bool is_mesh_recall =
+        name.starts_with(kMeshRecallPrefix) &&
+        std::find(mesh_names.begin(), mesh_names.end(),
+                  name.substr(std::string(kMeshRecallPrefix).size())) != mesh_names.end();
+    if (!is_known && !is_mesh_recall) {
       std::string names;
       for (const MetricInfo& m : known) names += (names.empty() ? "" : ", ") + std::string(m.name);
-      metrics.Fail(name, "a known metric (" + names + ")");
+      std::string meshes;
+      for (const auto& m : mesh_names) meshes += (meshes.empty() ? "" : ", ") + m;
+      metrics.Fail(name, "a known metric (" + names +
+                             ") or mesh_recall.MESH for a mesh of the "
+                             "scene (" +
+                             meshes + ")");
       continue;
     }
     auto read_bound = [&](const char* key, std::optional<double>& out) {
@@ -144,9 +167,7 @@ Verdict Evaluate(const Criteria& criteria, const MapMetrics& metrics) {
     CriterionResult r;
     r.criterion = c;
     r.expected = ExpectedText(c);
-    for (const MetricInfo& m : KnownMetrics()) {
-      if (c.metric == m.name) r.actual = m.value(metrics);
-    }
+    r.actual = MetricValue(metrics, c.metric);
     double margin = INFINITY;
     if (c.min) margin = std::min(margin, r.actual - *c.min);
     if (c.max) margin = std::min(margin, *c.max - r.actual);

@@ -22,11 +22,15 @@ bool Separates(const Vector3d& axis, const Vector3d& v0, const Vector3d& v1, con
   return std::min({p0, p1, p2}) > r || std::max({p0, p1, p2}) < -r;
 }
 
-// Adds to `cells` every cell whose box the triangle a, b, c crosses or touches.
+// Adds to `cells` every cell whose half-open box the triangle a, b, c crosses or touches.
 void AddTriangleCells(const Vector3d& a, const Vector3d& b, const Vector3d& c,
                       const octomap::OcTree& key_space, mapping::KeySet& cells) {
   const double resolution = key_space.getResolution();
-  const Vector3d half(0.5 * resolution, 0.5 * resolution, 0.5 * resolution);
+  // Cells are half-open, [lo, hi) on each axis, as OctoMap's coordToKey assigns points: a
+  // surface lying exactly on a face between two cells (a floor at z = 0) belongs to the upper
+  // cell only. The box tested is [lo, hi - ε] with ε far below any mesh's float precision.
+  const double epsilon = 1e-9 * resolution;
+  const Vector3d half = Vector3d::Constant(0.5 * (resolution - epsilon));
   const Vector3d lo = a.cwiseMin(b).cwiseMin(c);
   const Vector3d hi = a.cwiseMax(b).cwiseMax(c);
   octomap::OcTreeKey key_lo;
@@ -42,8 +46,12 @@ void AddTriangleCells(const Vector3d& a, const Vector3d& b, const Vector3d& c,
         const octomap::OcTreeKey key(static_cast<octomap::key_type>(x),
                                      static_cast<octomap::key_type>(y),
                                      static_cast<octomap::key_type>(z));
-        const octomap::point3d centre = key_space.keyToCoord(key);
-        if (TriangleBoxOverlap(Vector3d(centre.x(), centre.y(), centre.z()), half, a, b, c)) {
+        // Centres in double: OctoMap's float point3d rounds 0.05 up, and a surface lying exactly
+        // on a cell face would then touch neither cell.
+        const Vector3d centre = Vector3d(key_space.keyToCoord(key[0]), key_space.keyToCoord(key[1]),
+                                         key_space.keyToCoord(key[2])) -
+                                Vector3d::Constant(0.5 * epsilon);
+        if (TriangleBoxOverlap(centre, half, a, b, c)) {
           cells.insert(key);
         }
       }

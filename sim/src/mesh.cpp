@@ -1,8 +1,10 @@
 #include "sonarbench/sim/mesh.hpp"
 
 #include <cmath>
+#include <map>
 #include <numbers>
 
+#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/random.hpp"
 
 namespace sonarbench::sim {
@@ -74,14 +76,76 @@ TriangleMesh BuildMesh(const MeshSpec& spec, std::uint64_t seed) {
       }
       break;
     }
+    case MeshSpec::Type::kFile:
+      for (const Eigen::Vector3d& v : spec.file_vertices) {
+        mesh.vertices.push_back(
+            p(spec.scale[0] * v.x(), spec.scale[1] * v.y(), spec.scale[2] * v.z()).cast<float>());
+      }
+      mesh.triangles = spec.file_triangles;
+      break;
   }
   return mesh;
+}
+
+MeshCheck CheckMesh(TriangleMesh& mesh, const std::string& where) {
+  MeshCheck check;
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Eigen::Vector3f& v = mesh.vertices[i];
+    if (!v.allFinite()) {
+      throw InputError(where + ": vertex " + std::to_string(i) + " is not finite (" +
+                       std::to_string(v.x()) + ", " + std::to_string(v.y()) + ", " +
+                       std::to_string(v.z()) + "); the truth cannot be computed from it");
+    }
+  }
+  // Zero-area triangles have no surface: no echo, no truth cell. They are dropped and counted.
+  std::vector<std::array<std::uint32_t, 3>> kept;
+  kept.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>();
+    const Eigen::Vector3d b = mesh.vertices[t[1]].cast<double>();
+    const Eigen::Vector3d c = mesh.vertices[t[2]].cast<double>();
+    if (0.5 * (b - a).cross(c - a).norm() < kMinTriangleAreaM2) {
+      ++check.zero_area_triangles;
+    } else {
+      kept.push_back(t);
+    }
+  }
+  mesh.triangles = std::move(kept);
+  if (mesh.triangles.empty()) throw InputError(where + ": no triangle with a non-zero area");
+  // Edges between vertices welded by position: one triangle on an edge is a hole's border, more
+  // than two a non-manifold seam.
+  std::map<std::array<float, 3>, std::uint32_t> weld;
+  std::vector<std::uint32_t> id(mesh.vertices.size());
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    const Eigen::Vector3f& v = mesh.vertices[i];
+    id[i] = weld.emplace(std::array<float, 3>{v.x(), v.y(), v.z()},
+                         static_cast<std::uint32_t>(weld.size()))
+                .first->second;
+  }
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+  for (const auto& t : mesh.triangles) {
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = id[t[e]];
+      const std::uint32_t b = id[t[(e + 1) % 3]];
+      ++edges[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  for (const auto& [edge, count] : edges) {
+    if (count == 1) ++check.boundary_edges;
+    if (count > 2) ++check.non_manifold_edges;
+  }
+  return check;
 }
 
 std::vector<TriangleMesh> BuildSceneMeshes(const Scene& scene) {
   std::vector<TriangleMesh> meshes;
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
-    meshes.push_back(BuildMesh(scene.meshes[i], DeriveSeed(scene.seed, 0x6d657368ULL + i)));
+    const MeshSpec& spec = scene.meshes[i];
+    meshes.push_back(BuildMesh(spec, DeriveSeed(scene.seed, 0x6d657368ULL + i)));
+    meshes.back().name = spec.name;
+    meshes.back().check =
+        CheckMesh(meshes.back(), scene.file + ": mesh '" + spec.name + "'" +
+                                     (spec.file.empty() ? std::string() : " (" + spec.file + ")"));
   }
   return meshes;
 }

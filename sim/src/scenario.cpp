@@ -34,6 +34,8 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
   Stopwatch clock;
 
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
+  for (const TriangleMesh& mesh : meshes)
+    result.meshes.push_back({mesh.name, mesh.triangles.size(), mesh.check});
   const RayTracer tracer(meshes);
   result.timings.build_scene_s = clock.Lap();
 

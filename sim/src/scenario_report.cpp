@@ -102,6 +102,29 @@ nlohmann::json CriteriaJson(const Verdict& v) {
   return {{"expect", v.expect_fail ? "fail" : "pass"}, {"results", results}};
 }
 
+nlohmann::json PerMeshJson(const MapMetrics& m) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& r : m.per_mesh) {
+    out.push_back({{"name", r.name},
+                   {"recall", r.recall},
+                   {"observable_cells", r.observable_cells},
+                   {"observed_occupied_cells", r.observed_occupied_cells}});
+  }
+  return out;
+}
+
+nlohmann::json MeshesJson(const std::vector<ScenarioResult::MeshSummary>& meshes) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& m : meshes) {
+    out.push_back({{"name", m.name},
+                   {"triangles", m.triangles},
+                   {"zero_area_triangles_dropped", m.check.zero_area_triangles},
+                   {"boundary_edges", m.check.boundary_edges},
+                   {"non_manifold_edges", m.check.non_manifold_edges}});
+  }
+  return out;
+}
+
 double TotalSeconds(const StageTimings& t) {
   return t.build_scene_s + t.simulate_s + t.map_s + t.ground_truth_s + t.score_s;
 }
@@ -197,6 +220,11 @@ std::string ScenarioHtml(const Scene& scene, const ScenarioResult& result,
     html << "<tr><td>" << info.name << "</td><td class=\"n\">" << Number(info.value(m))
          << "</td><td>" << HtmlEscape(info.definition) << "</td></tr>\n";
   }
+  for (const auto& r : m.per_mesh) {
+    html << "<tr><td>" << kMeshRecallPrefix << HtmlEscape(r.name) << "</td><td class=\"n\">"
+         << Number(r.recall) << "</td><td>" << r.observed_occupied_cells << " of "
+         << r.observable_cells << " observable cells of this mesh mapped occupied</td></tr>\n";
+  }
   html << "</table>\n<p>Counts: " << m.truth_cells << " surface cells, " << m.observable_cells
        << " observable, " << m.occupied_cells << " occupied (" << m.true_positive_cells
        << " on a surface), " << m.free_cells
@@ -242,6 +270,7 @@ nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& resu
        {"criteria", CriteriaJson(result.verdict)},
        {"seed", result.seed},
        {"threads", result.threads},
+       {"meshes", MeshesJson(result.meshes)},
        {"parameters",
         {{"sweeps", scene.sweeps},
          {"beams", result.beams},
@@ -255,6 +284,7 @@ nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& resu
          {"coverage", m.coverage},
          {"coverage_absolute", m.coverage_absolute},
          {"free_accuracy", m.free_accuracy},
+         {"per_mesh", PerMeshJson(m)},
          {"surface_distance",
           {{"map_to_mesh", DistanceJson(m.map_to_mesh)},
            {"mesh_to_map", DistanceJson(m.mesh_to_map)}}},

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/mesh_file.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -23,17 +24,28 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
   MeshSpec m;
   std::string type;
   node.Required("name", m.name);
-  node.Required("type", type, OneOf({"tank", "box", "plane", "height_field"}));
-  m.type = type == "tank"    ? MeshSpec::Type::kTank
-           : type == "plane" ? MeshSpec::Type::kPlane
-           : type == "box"   ? MeshSpec::Type::kBox
-                             : MeshSpec::Type::kHeightField;
-  node.Required("size_m", m.size_m,
-                YamlReader::Check<std::array<double, 3>>(
-                    [](const std::array<double, 3>& s) -> std::optional<std::string> {
-                      if (s[0] > 0 && s[1] > 0 && s[2] >= 0) return std::nullopt;
-                      return "sizes x > 0, y > 0, z >= 0";
-                    }));
+  node.Required("type", type, OneOf({"tank", "box", "plane", "height_field", "file"}));
+  m.type = type == "tank"           ? MeshSpec::Type::kTank
+           : type == "plane"        ? MeshSpec::Type::kPlane
+           : type == "box"          ? MeshSpec::Type::kBox
+           : type == "height_field" ? MeshSpec::Type::kHeightField
+                                    : MeshSpec::Type::kFile;
+  if (m.type == MeshSpec::Type::kFile) {
+    node.Required("file", m.file);
+    node.Optional("scale", m.scale,
+                  YamlReader::Check<std::array<double, 3>>(
+                      [](const std::array<double, 3>& s) -> std::optional<std::string> {
+                        if (s[0] > 0 && s[1] > 0 && s[2] > 0) return std::nullopt;
+                        return "three positive scale factors [x, y, z]";
+                      }));
+  } else {
+    node.Required("size_m", m.size_m,
+                  YamlReader::Check<std::array<double, 3>>(
+                      [](const std::array<double, 3>& s) -> std::optional<std::string> {
+                        if (s[0] > 0 && s[1] > 0 && s[2] >= 0) return std::nullopt;
+                        return "sizes x > 0, y > 0, z >= 0";
+                      }));
+  }
   m.T_world_mesh = ReadPose(node);
   if (m.type == MeshSpec::Type::kHeightField) {
     node.Required("cell_m", m.cell_m, Positive());
@@ -144,14 +156,32 @@ Scene LoadScene(const std::string& path) {
   if (auto mapping = root.OptionalChild("mapping")) {
     scene.mapping = mapping::ReadMapperConfig(*mapping);
   }
-  if (auto criteria = root.OptionalChild("criteria")) scene.criteria = ReadCriteria(*criteria);
+  if (auto criteria = root.OptionalChild("criteria")) {
+    std::vector<std::string> mesh_names;
+    for (const MeshSpec& mesh : scene.meshes) mesh_names.push_back(mesh.name);
+    scene.criteria = ReadCriteria(*criteria, mesh_names);
+  }
   root.RejectUnknownKeys();
   root.ThrowIfErrors();
 
   // The sensor model is its own file, read (and its errors reported) only once the scene is sound.
-  std::filesystem::path sensor_path(scene.sensor_model_file);
-  if (sensor_path.is_relative())
-    sensor_path = std::filesystem::path(root.Directory()) / sensor_path;
+  auto resolve = [&](const std::string& file) {
+    std::filesystem::path resolved(file);
+    if (resolved.is_relative()) resolved = std::filesystem::path(root.Directory()) / resolved;
+    return resolved.lexically_normal().string();
+  };
+  for (MeshSpec& mesh : scene.meshes) {
+    if (mesh.type != MeshSpec::Type::kFile) continue;
+    mesh.file = resolve(mesh.file);
+    try {
+      MeshFileData data = LoadMeshFile(mesh.file);
+      mesh.file_vertices = std::move(data.vertices);
+      mesh.file_triangles = std::move(data.triangles);
+    } catch (const InputError& e) {
+      throw InputError(path + ": mesh '" + mesh.name + "': " + e.what());
+    }
+  }
+  std::filesystem::path sensor_path = resolve(scene.sensor_model_file);
   scene.sensor_model_file = sensor_path.lexically_normal().string();
   scene.sensor = LoadSensorModel(scene.sensor_model_file);
   if (T_vehicle_sonar) scene.sensor.geometry.T_vehicle_sonar = *T_vehicle_sonar;

@@ -143,6 +143,18 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
   for (const auto& key : cells.free) m.free_on_surface_cells += truth.contains(key) ? 1 : 0;
   m.free_accuracy = cells.free.empty() ? 0.0 : 1.0 - Ratio(m.free_on_surface_cells, m.free_cells);
 
+  for (const TriangleMesh& mesh : meshes) {
+    MapMetrics::MeshRecall r;
+    r.name = mesh.name;
+    for (const auto& key : VoxelizeMeshes(std::span(&mesh, 1), map)) {
+      if (!observable.contains(key)) continue;
+      ++r.observable_cells;
+      r.observed_occupied_cells += cells.occupied.contains(key) ? 1 : 0;
+    }
+    r.recall = Ratio(r.observed_occupied_cells, r.observable_cells);
+    m.per_mesh.push_back(r);
+  }
+
   const double res = map.getResolution();
   if (!meshes.empty()) {
     const RayTracer tracer(meshes);

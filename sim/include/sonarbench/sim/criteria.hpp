@@ -40,9 +40,16 @@ struct MetricInfo {
 };
 [[nodiscard]] const std::vector<MetricInfo>& KnownMetrics();
 
-/// Reads the `criteria` mapping of a scene (`expect: pass|fail`, `metrics: {name: bounds}`).
-/// Errors are collected in `node` like every other key of the scene.
-[[nodiscard]] Criteria ReadCriteria(YamlReader& node);
+/// Besides the known metrics, a criterion may name `mesh_recall.NAME`: the recall of one mesh's
+/// own observable cells (MapMetrics::per_mesh), NAME one of the scene's meshes.
+inline constexpr const char* kMeshRecallPrefix = "mesh_recall.";
+
+/// Reads the `criteria` mapping of a scene (`expect: pass|fail`, `metrics: {name: bounds}`);
+/// `mesh_names` are the scene's meshes. Errors are collected in `node` like every other key.
+[[nodiscard]] Criteria ReadCriteria(YamlReader& node, const std::vector<std::string>& mesh_names);
+
+/// The value of a criterion's metric, NaN when the metrics do not hold it.
+[[nodiscard]] double MetricValue(const MapMetrics& metrics, const std::string& name);
 
 enum class CriterionStatus { kPass, kAcceptable, kFail };
 [[nodiscard]] const char* StatusName(CriterionStatus status);

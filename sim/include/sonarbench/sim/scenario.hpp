@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sonarbench/mapping/mapper.hpp"
+#include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/scene.hpp"
 #include "sonarbench/sim/score.hpp"
 
@@ -47,6 +48,13 @@ struct ScenarioResult {
   mapping::KeySet observable;
   /// The sonar's position at the first beam [m], where the side slice of the map is cut.
   Eigen::Vector3d sonar_start_m = Eigen::Vector3d::Zero();
+  /// Each mesh's name, triangle count and preflight findings, in scene order.
+  struct MeshSummary {
+    std::string name;
+    std::size_t triangles = 0;
+    MeshCheck check;
+  };
+  std::vector<MeshSummary> meshes;
   /// The metrics against the scene's criteria.
   Verdict verdict;
 };

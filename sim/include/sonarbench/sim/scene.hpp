@@ -24,9 +24,9 @@ struct Material {
   double specular = 0.0;
 };
 
-/// A procedural mesh, as the scene file describes it.
+/// A mesh, as the scene file describes it: procedural, or loaded from a mesh file.
 struct MeshSpec {
-  enum class Type { kTank, kBox, kPlane, kHeightField };
+  enum class Type { kTank, kBox, kPlane, kHeightField, kFile };
   std::string name;
   Type type = Type::kBox;
   /// kTank: inner size x, y, wall height; kBox: size; kPlane: size x, y (z ignored);
@@ -41,6 +41,12 @@ struct MeshSpec {
   double amplitude_m = 0.0;
   double wavelength_m = 5.0;
   double roughness_m = 0.0;
+  /// kFile: the mesh file (resolved against the scene file's directory), the scale applied to
+  /// its coordinates along its own x, y, z before the pose, and its triangles as loaded.
+  std::string file;
+  std::array<double, 3> scale{1, 1, 1};
+  std::vector<Eigen::Vector3d> file_vertices;
+  std::vector<std::array<std::uint32_t, 3>> file_triangles;
   std::size_t material = 0;
 };
 

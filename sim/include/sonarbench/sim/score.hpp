@@ -4,6 +4,8 @@
 
 #include <cstddef>
 #include <span>
+#include <string>
+#include <vector>
 
 #include "sonarbench/mapping/beam_volume.hpp"
 #include "sonarbench/sim/mesh.hpp"
@@ -48,6 +50,16 @@ struct MapMetrics {
   /// distance), and from each observable surface cell's centre to the nearest occupied cell's.
   DistanceStats map_to_mesh;
   DistanceStats mesh_to_map;
+  /// Recall per mesh (scene order; only when meshes are given): of the observable cells that
+  /// mesh's own surface crosses, the share mapped occupied. An object on a floor is judged by
+  /// its own cells, not lost among the floor's.
+  struct MeshRecall {
+    std::string name;
+    std::size_t observable_cells = 0;
+    std::size_t observed_occupied_cells = 0;
+    double recall = 0.0;
+  };
+  std::vector<MeshRecall> per_mesh;
 };
 
 /// Scores `map` against the surface cells `truth` and the subset `observable` a perfect sensor
