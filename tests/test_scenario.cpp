@@ -377,6 +377,27 @@ TEST(Cli, BadMeshFilesExitTwoNamingSceneMeshAndFile) {
       << output;
 }
 
+TEST(Cli, SimulateWritesADatasetThatMapReads) {
+  test::TempDir dir;
+  const auto scene = TankSceneWithCriteria(dir.path(), "");
+  const auto ds = dir.path() / "ds";
+  std::string output;
+  EXPECT_EQ(RunCli("simulate " + scene.string() + " --out " + ds.string(), &output), 0) << output;
+  EXPECT_TRUE(std::filesystem::exists(ds / "manifest.json"));
+  EXPECT_EQ(RunCli("simulate " + scene.string() + " --out " + ds.string(), &output), 0);
+  EXPECT_NE(output.find("nothing to do"), std::string::npos) << output;
+  EXPECT_EQ(RunCli("simulate " + scene.string() + " --out " + ds.string() + " --seed 5", &output),
+            2);
+  EXPECT_NE(output.find("pass --force"), std::string::npos) << output;
+  EXPECT_EQ(
+      RunCli("simulate " + scene.string() + " --out " + ds.string() + " --shard 3/2", &output), 2);
+  const auto map = dir.path() / "map";
+  EXPECT_EQ(RunCli("map " + ds.string() + " --out " + map.string(), &output), 0) << output;
+  EXPECT_TRUE(std::filesystem::exists(map / "map.bt"));
+  EXPECT_EQ(RunCli("map " + dir.path().string() + " --out " + map.string(), &output), 2);
+  EXPECT_NE(output.find("no manifest.json"), std::string::npos) << output;
+}
+
 TEST(Cli, MissingSceneAndBadOptionsExitTwo) {
   std::string output;
   EXPECT_EQ(RunCli("run /nonexistent.yaml", &output), 2);

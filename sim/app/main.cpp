@@ -14,6 +14,7 @@
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mat_log.hpp"
+#include "sonarbench/sim/dataset_writer.hpp"
 #include "sonarbench/sim/fidelity.hpp"
 #include "sonarbench/sim/map_log.hpp"
 #include "sonarbench/sim/mesh.hpp"
@@ -187,6 +188,76 @@ int Fidelity(const FidelityArgs& args) {
   return 0;
 }
 
+struct SimulateArgs {
+  std::string scene;
+  std::string out;
+  std::optional<std::uint64_t> seed;
+  int threads = 0;
+  bool force = false;
+  std::string shard;
+  bool no_progress = false;
+};
+
+int Simulate(const SimulateArgs& args) {
+  namespace sim = sonarbench::sim;
+  const sim::Scene scene = sim::LoadScene(args.scene);
+  sim::DatasetOptions options;
+  options.seed = args.seed;
+  options.threads = args.threads;
+  options.force = args.force;
+  if (!args.shard.empty()) {
+    options.shard = sim::ParseShard(args.shard);
+  } else if (const auto slurm = sim::ShardFromSlurm()) {
+    options.shard = *slurm;
+  }
+  ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
+  options.progress = [&](std::size_t done, std::size_t total) {
+    progress.Update("simulate", done, total);
+  };
+  const sim::DatasetSummary summary = sim::SimulateDataset(scene, args.out, options);
+  progress.Clear();
+  if (summary.already_complete) {
+    std::cout << args.out
+              << ": already a complete dataset of this configuration; nothing to do "
+                 "(--force rewrites it)\n";
+    return 0;
+  }
+  std::cout << "shard " << options.shard.index + 1 << "/" << options.shard.count << ": wrote "
+            << summary.sweeps_written << " sweeps, skipped " << summary.sweeps_skipped
+            << " already complete, of " << summary.sweeps_total << "\n";
+  if (summary.complete) {
+    std::cout << "wrote " << args.out << "/manifest.json (config "
+              << summary.config_sha256.substr(0, 12) << ")\n";
+  } else {
+    std::cout << "other shards' sweeps are still missing: the last shard to finish, or a rerun "
+                 "without --shard, writes the poses, truth/occupancy.bt and manifest.json\n";
+  }
+  return 0;
+}
+
+struct ImportArgs {
+  std::string log;
+  std::string out;
+  std::string sensor;
+  bool force = false;
+};
+
+int Import(const ImportArgs& args) {
+  namespace sim = sonarbench::sim;
+  sonarbench::mapping::SensorGeometry sensor;
+  if (!args.sensor.empty()) sensor = sim::LoadSensorModel(args.sensor).geometry;
+  const sonarbench::mapping::MatLog log = sonarbench::mapping::ReadMatLog(args.log);
+  const sim::DatasetSummary summary =
+      sim::ImportLogDataset(args.log, log, sensor, args.out, args.force);
+  if (summary.already_complete) {
+    std::cout << args.out << ": already holds this log's dataset; nothing to do\n";
+    return 0;
+  }
+  std::cout << log.beams.size() << " beams (" << log.truncated_beams << " truncated) in "
+            << summary.sweeps_total << " sweeps\nwrote " << args.out << "/manifest.json\n";
+  return 0;
+}
+
 // The --threads option every subcommand has.
 void AddThreadsOption(CLI::App* command, int& threads) {
   command
@@ -256,12 +327,16 @@ int main(int argc, char** argv) {
   MapArgs map;
   CLI::App* map_cmd = app.add_subcommand(
       "map",
-      "Map a recorded log with the production mapper: INPUT is a real MSIS log in MATLAB .mat "
-      "form (the CRAS lab's parsedData layout; the vehicle static at the origin). Writes map.bt "
+      "Map a recorded log with the production mapper: INPUT is a sonarbench dataset directory "
+      "(from `simulate` or `import`; its manifest's sensor is used) or a real MSIS log in MATLAB "
+      ".mat form (the CRAS lab's parsedData layout; the vehicle static at the origin). Writes "
+      "map.bt "
       "and map.ot (octovis), map_top.png (occupied cells from above), polar.png and fan.png (the "
       "first sweep) and report.json into --out. The sensor is the SHAD Micron and the mapper "
       "uses its defaults unless --scene, --sensor or --mapping say otherwise.");
-  map_cmd->add_option("input", map.input, "The log (.mat)")->required()->check(CLI::ExistingPath);
+  map_cmd->add_option("input", map.input, "A dataset directory or a .mat log")
+      ->required()
+      ->check(CLI::ExistingPath);
   map_cmd->add_option("-o,--out", map.out, "Output directory (created if needed)")
       ->capture_default_str();
   auto* scene_opt =
@@ -302,6 +377,42 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
 
+  SimulateArgs simulate;
+  CLI::App* simulate_cmd = app.add_subcommand(
+      "simulate",
+      "Simulate SCENE into a dataset directory (format: docs/dataset-format.md): beams of every "
+      "sweep in binary, a polar PNG per sweep, per-beam ground truth, sonar and vehicle poses "
+      "(TUM), the truth occupancy (.bt) and manifest.json with the sha256 of every file. Writes "
+      "are atomic; a rerun resumes where a killed one stopped; an existing dataset is replaced "
+      "only with --force. `sonarbench map DIR` maps it.");
+  simulate_cmd->add_option("scene", simulate.scene, "Scene YAML file")
+      ->required()
+      ->check(CLI::ExistingFile);
+  simulate_cmd->add_option("-o,--out", simulate.out, "Dataset directory")->required();
+  simulate_cmd->add_option("-s,--seed", simulate.seed, "Overrides the scene's seed");
+  AddThreadsOption(simulate_cmd, simulate.threads);
+  simulate_cmd->add_flag("--force", simulate.force,
+                         "Replace an existing dataset (never deletes a directory that is not one)");
+  simulate_cmd->add_option(
+      "--shard", simulate.shard,
+      "K/N: write only sweeps s with s mod N = K-1 (cluster array jobs; default from "
+      "SLURM_ARRAY_TASK_ID/_MIN/_COUNT). Beams are seeded by hashing their index, so shards "
+      "give the same bytes as one run");
+  simulate_cmd->add_flag("--no-progress", simulate.no_progress, "Never show the progress line");
+
+  ImportArgs import;
+  CLI::App* import_cmd = app.add_subcommand(
+      "import",
+      "Write a real .mat log as a dataset directory (the format `simulate` writes, without "
+      "truth), so `sonarbench map DIR` and other tools read both the same way.");
+  import_cmd->add_option("log", import.log, "Real log (.mat)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  import_cmd->add_option("-o,--out", import.out, "Dataset directory")->required();
+  import_cmd->add_option("--sensor", import.sensor, "Sensor model YAML (default: the SHAD Micron)")
+      ->check(CLI::ExistingFile);
+  import_cmd->add_flag("--force", import.force, "Replace an existing dataset");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -313,6 +424,8 @@ int main(int argc, char** argv) {
     if (*run_cmd) return Run(run);
     if (*map_cmd) return Map(map);
     if (*fidelity_cmd) return Fidelity(fidelity);
+    if (*simulate_cmd) return Simulate(simulate);
+    if (*import_cmd) return Import(import);
   } catch (const sonarbench::InputError& e) {
     std::cerr << "sonarbench: error: " << e.what() << "\n";
     if (*run_cmd) WriteErrorJunit(run, "input_error", e.what());

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/dataset.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mat_log.hpp"
 #include "sonarbench/sim/images.hpp"
@@ -15,29 +16,33 @@ namespace sonarbench::sim {
 
 LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
                     const mapping::MapperConfig& config) {
-  namespace fs = std::filesystem;
-  if (fs::is_directory(input)) {
-    throw InputError(input +
-                     ": a directory; expected a .mat log (dataset directories are not "
-                     "readable yet)");
-  }
   LogMapResult result;
   result.input = input;
   auto start = std::chrono::steady_clock::now();
-  const mapping::MatLog log = mapping::ReadMatLog(input);
+  std::vector<mapping::Beam> beams;
+  mapping::SensorGeometry geometry = sensor;
+  if (std::filesystem::is_directory(input)) {
+    mapping::Dataset dataset = mapping::ReadDataset(input);
+    geometry = dataset.sensor;  // a dataset carries its sensor
+    beams = std::move(dataset.beams);
+    result.source = "dataset";
+  } else {
+    mapping::MatLog log = mapping::ReadMatLog(input);
+    beams = std::move(log.beams);
+    result.truncated_beams = log.truncated_beams;
+    result.source = "mat";
+  }
   auto now = std::chrono::steady_clock::now();
   result.import_s = std::chrono::duration<double>(now - start).count();
-  result.beams = log.beams.size();
-  result.truncated_beams = log.truncated_beams;
+  result.beams = beams.size();
 
   start = now;
-  result.mapper = std::make_unique<mapping::Mapper>(config, sensor);
-  result.totals = result.mapper->IntegrateSweeps(log.beams);
-  const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
-  result.sweeps = (log.beams.size() + per_sweep - 1) / per_sweep;
+  result.mapper = std::make_unique<mapping::Mapper>(config, geometry);
+  result.totals = result.mapper->IntegrateSweeps(beams);
+  const auto per_sweep = static_cast<std::size_t>(geometry.BeamsPerSweep());
+  result.sweeps = (beams.size() + per_sweep - 1) / per_sweep;
   result.first_sweep.assign(
-      log.beams.begin(),
-      log.beams.begin() + static_cast<long>(std::min(per_sweep, log.beams.size())));
+      beams.begin(), beams.begin() + static_cast<long>(std::min(per_sweep, beams.size())));
   result.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
@@ -56,6 +61,7 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) 
   const auto& c = result.mapper->config();
   nlohmann::json report = ReportHeader();
   report.update({{"input", result.input},
+                 {"input_kind", result.source},
                  {"beams", result.beams},
                  {"sweeps", result.sweeps},
                  {"truncated_beams", result.truncated_beams},

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 
 #include "sonarbench/sim/random.hpp"
@@ -26,28 +27,37 @@ ScheduledBeam ScheduleBeam(const Scene& scene, std::size_t index) {
   return out;
 }
 
-std::vector<SynthesizedBeam> SimulateScene(
-    const Scene& scene, const RayTracer& tracer, std::uint64_t seed, int threads,
-    const std::function<void(std::size_t done, std::size_t total)>& on_sweep) {
+std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const RayTracer& tracer,
+                                           std::uint64_t seed, int threads, std::size_t first,
+                                           std::size_t last) {
   std::vector<Material> materials_by_mesh;
   for (const MeshSpec& mesh : scene.meshes)
     materials_by_mesh.push_back(scene.materials[mesh.material]);
   const BeamSynthesizer synthesizer(scene.sensor, tracer, std::move(materials_by_mesh));
-  const std::size_t count = ScenarioBeamCount(scene);
-  std::vector<SynthesizedBeam> beams(count);
+  std::vector<SynthesizedBeam> beams(last - first);
   const int n_threads = threads > 0 ? threads : omp_get_max_threads();
+#pragma omp parallel for num_threads(n_threads) schedule(dynamic, 8)
+  for (std::int64_t b = 0; b < static_cast<std::int64_t>(beams.size()); ++b) {
+    const std::size_t index = first + static_cast<std::size_t>(b);
+    const ScheduledBeam s = ScheduleBeam(scene, index);
+    beams[static_cast<std::size_t>(b)] = synthesizer.Synthesize(
+        s.time_s, s.pose.head_angle_rad, s.pose.T_world_sonar, DeriveSeed(seed, index));
+  }
+  return beams;
+}
+
+std::vector<SynthesizedBeam> SimulateScene(
+    const Scene& scene, const RayTracer& tracer, std::uint64_t seed, int threads,
+    const std::function<void(std::size_t done, std::size_t total)>& on_sweep) {
+  const std::size_t count = ScenarioBeamCount(scene);
   const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
   const auto sweeps = static_cast<std::size_t>(scene.sweeps);
+  std::vector<SynthesizedBeam> beams;
+  beams.reserve(count);
   for (std::size_t sweep = 0; sweep < sweeps; ++sweep) {
-    const auto first = static_cast<std::int64_t>(sweep * per_sweep);
-    const auto last = static_cast<std::int64_t>(std::min(count, (sweep + 1) * per_sweep));
-#pragma omp parallel for num_threads(n_threads) schedule(dynamic, 8)
-    for (std::int64_t b = first; b < last; ++b) {
-      const auto index = static_cast<std::size_t>(b);
-      const ScheduledBeam s = ScheduleBeam(scene, index);
-      beams[index] = synthesizer.Synthesize(s.time_s, s.pose.head_angle_rad, s.pose.T_world_sonar,
-                                            DeriveSeed(seed, index));
-    }
+    auto part = SimulateBeams(scene, tracer, seed, threads, sweep * per_sweep,
+                              std::min(count, (sweep + 1) * per_sweep));
+    std::move(part.begin(), part.end(), std::back_inserter(beams));
     if (on_sweep) on_sweep(sweep + 1, sweeps);
   }
   return beams;

@@ -11,6 +11,8 @@ namespace sonarbench::sim {
 /// A recorded log run through the production mapper.
 struct LogMapResult {
   std::string input;
+  /// "mat" (a real .mat log) or "dataset" (a sonarbench dataset directory).
+  std::string source;
   std::size_t beams = 0;
   std::size_t sweeps = 0;
   std::size_t truncated_beams = 0;
@@ -21,8 +23,9 @@ struct LogMapResult {
   std::vector<mapping::Beam> first_sweep;
 };
 
-/// Imports a real `.mat` log and maps it sweep by sweep (BeamsPerSweep() consecutive beams each;
-/// the last sweep may be partial). Throws InputError for input that is not a readable log.
+/// Reads a real `.mat` log or a dataset directory (mapping::ReadDataset; its own sensor geometry
+/// replaces `sensor`) and maps it sweep by sweep (BeamsPerSweep() consecutive beams each; the
+/// last sweep may be partial). Throws InputError for input that is not a readable log.
 [[nodiscard]] LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
                                   const mapping::MapperConfig& config);
 

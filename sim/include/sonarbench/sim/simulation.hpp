@@ -30,6 +30,13 @@ struct ScheduledBeam {
     const Scene& scene, const RayTracer& tracer, std::uint64_t seed, int threads,
     const std::function<void(std::size_t done, std::size_t total)>& on_sweep = {});
 
+/// Synthesises beams [first, last) of the scene's run, on `threads` threads (0 = all); beam b
+/// draws only from DeriveSeed(seed, b), so any split of a run gives the same beams.
+[[nodiscard]] std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene,
+                                                         const RayTracer& tracer,
+                                                         std::uint64_t seed, int threads,
+                                                         std::size_t first, std::size_t last);
+
 /// The beams alone, as the mapper takes them.
 [[nodiscard]] std::vector<mapping::Beam> BeamsOf(std::span<const SynthesizedBeam> synthesized);
 

@@ -1,0 +1,371 @@
+#include "sonarbench/sim/dataset_writer.hpp"
+
+#include <octomap/OcTree.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/mapping/mapper.hpp"
+#include "sonarbench/sim/ground_truth.hpp"
+#include "sonarbench/sim/images.hpp"
+#include "sonarbench/sim/mesh.hpp"
+#include "sonarbench/sim/ray_tracer.hpp"
+#include "sonarbench/sim/report.hpp"
+#include "sonarbench/sim/simulation.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// Present while a dataset is being written; holds the configuration's hash so a rerun knows
+// whether the sweeps on disk are its own.
+constexpr const char* kPartialMarker = ".sonarbench-partial.json";
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void WriteText(const fs::path& path, const std::string& text) {
+  WriteFileAtomically(path.string(), [&](std::ostream& out) { out << text; });
+}
+
+std::string Number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", value);
+  return text;
+}
+
+// The config hash stored in a manifest or partial marker; "" when the file is absent, "?" when
+// it is unreadable.
+std::optional<std::string> StoredConfig(const fs::path& file) {
+  if (!fs::is_regular_file(file)) return std::nullopt;
+  try {
+    return json::parse(ReadText(file)).at("config_sha256").get<std::string>();
+  } catch (const std::exception&) {
+    return std::string("?");
+  }
+}
+
+// Readies `dir` for the dataset of `config`. Returns true when a complete dataset of that very
+// configuration is already there (nothing to do).
+bool PrepareDirectory(const std::string& dir, const std::string& config, bool force) {
+  const fs::path root(dir);
+  if (fs::exists(root) && !fs::is_directory(root))
+    throw InputError(dir + ": exists and is not a directory");
+  const auto complete = StoredConfig(root / "manifest.json");
+  const auto partial = StoredConfig(root / kPartialMarker);
+  const bool is_dataset = complete || partial;
+  const bool empty = !fs::exists(root) || fs::is_empty(root);
+  if (!empty && !is_dataset) {
+    throw InputError(dir +
+                     ": holds files that are not a sonarbench dataset; choose an empty or "
+                     "new directory (--force never deletes what is not a dataset)");
+  }
+  if (force) {
+    if (!empty) fs::remove_all(root);
+  } else if (complete) {
+    if (*complete == config) return true;
+    throw InputError(dir + ": holds a dataset of another configuration (config_sha256 " +
+                     *complete + "); pass --force to replace it");
+  } else if (partial && *partial != config) {
+    throw InputError(dir +
+                     ": holds a partial dataset of another configuration; pass --force to "
+                     "replace it");
+  }
+  for (const char* sub : {"beams", "images", "truth", "poses"}) fs::create_directories(root / sub);
+  // Temporary files of a killed run are never whole: remove them.
+  for (const auto& entry : fs::recursive_directory_iterator(root)) {
+    if (entry.is_regular_file() &&
+        entry.path().filename().string().find(".tmp.") != std::string::npos) {
+      fs::remove(entry.path());
+    }
+  }
+  if (!fs::exists(root / kPartialMarker)) {
+    WriteText(root / kPartialMarker,
+              json{{"format", mapping::kDatasetFormat}, {"config_sha256", config}}.dump(2) + "\n");
+  }
+  return false;
+}
+
+// Writes manifest.json over every file in `dir` (sha256 and size), then drops the marker.
+void Finalize(const std::string& dir, json manifest) {
+  const fs::path root(dir);
+  std::vector<std::string> files;
+  for (const auto& entry : fs::recursive_directory_iterator(root)) {
+    if (!entry.is_regular_file()) continue;
+    const std::string relative = fs::relative(entry.path(), root).generic_string();
+    if (relative == "manifest.json" || relative == kPartialMarker ||
+        relative.find(".tmp.") != std::string::npos) {
+      continue;
+    }
+    files.push_back(relative);
+  }
+  std::sort(files.begin(), files.end());
+  json list = json::array();
+  for (const auto& relative : files) {
+    list.push_back({{"path", relative},
+                    {"bytes", fs::file_size(root / relative)},
+                    {"sha256", mapping::Sha256OfFile((root / relative).string())}});
+  }
+  manifest["files"] = list;
+  WriteText(root / "manifest.json", manifest.dump(2) + "\n");
+  std::error_code ignored;
+  fs::remove(root / kPartialMarker, ignored);
+}
+
+json ManifestBase(const mapping::SensorGeometry& sensor, std::size_t sweeps, std::size_t beams,
+                  const std::string& config) {
+  json m = {{"format", mapping::kDatasetFormat},
+            {"schema_version", mapping::kDatasetSchemaVersion},
+            {"tool", ReportHeader()["tool"]},
+            {"config_sha256", config},
+            {"units",
+             {{"time", "s, since the start of the run"},
+              {"length", "m"},
+              {"head_angle", "rad in beam files; keys ending in _deg are degrees"},
+              {"intensity", "8-bit, 0-255, one byte per range bin"}}},
+            {"frames",
+             {{"world", "right-handed, z up"},
+              {"sonar",
+               "x along head angle 0, z the head's rotation axis; a ray at head angle θ and "
+               "elevation ε points along (cos θ cos ε, sin θ cos ε, sin ε)"},
+              {"poses",
+               "poses/sonar.tum holds T_world_sonar at each beam's time (head angle 0); "
+               "poses/vehicle.tum T_world_vehicle"}}},
+            {"quaternion_order", "x y z w (TUM: time tx ty tz qx qy qz qw), Hamilton"},
+            {"beam_file",
+             "little-endian: 'SBBEAMS1', u32 beam count, per beam f64 time_s, f64 "
+             "head_angle_rad, f64 bin_size_m, u32 bin count, u8 intensities"},
+            {"sensor", mapping::SensorGeometryJson(sensor)},
+            {"sweeps", sweeps},
+            {"beams_per_sweep", sensor.BeamsPerSweep()},
+            {"beams", beams}};
+  return m;
+}
+
+void WriteBeams(const fs::path& path, std::span<const mapping::Beam> beams) {
+  WriteFileAtomically(path.string(),
+                      [&](std::ostream& out) { mapping::WriteBeamFile(out, beams); });
+}
+
+bool SweepComplete(const fs::path& root, std::size_t sweep, bool with_truth) {
+  return fs::is_regular_file(root / mapping::SweepFile("beams", sweep, "bin")) &&
+         fs::is_regular_file(root / mapping::SweepFile("images", sweep, "png")) &&
+         (!with_truth || fs::is_regular_file(root / mapping::SweepFile("truth", sweep, "csv")));
+}
+
+std::string ConfigHash(const Scene& scene, std::uint64_t seed) {
+  json inputs = {{"tool", ReportHeader()["tool"]},
+                 {"schema_version", mapping::kDatasetSchemaVersion},
+                 {"seed", seed},
+                 {"scene_sha256", mapping::Sha256OfFile(scene.file)},
+                 {"sensor_model_sha256", mapping::Sha256OfFile(scene.sensor_model_file)}};
+  json meshes = json::array();
+  for (const MeshSpec& mesh : scene.meshes) {
+    meshes.push_back(mesh.file.empty() ? json(nullptr) : json(mapping::Sha256OfFile(mesh.file)));
+  }
+  inputs["mesh_files_sha256"] = meshes;
+  return mapping::Sha256(inputs.dump());
+}
+
+std::string TruthCsv(std::span<const SynthesizedBeam> beams, std::size_t first_index,
+                     const Scene& scene) {
+  std::string csv =
+      "beam,time_s,head_angle_rad,first_hit_range_m,first_hit_mesh,axis_hit_range_m\n";
+  for (std::size_t i = 0; i < beams.size(); ++i) {
+    const SynthesizedBeam& b = beams[i];
+    csv += std::to_string(first_index + i) + "," + Number(b.beam.time_s) + "," +
+           Number(b.beam.head_angle_rad) + ",";
+    if (b.truth.first_hit_range_m) {
+      csv += Number(*b.truth.first_hit_range_m) + "," + scene.meshes[b.truth.first_hit_mesh].name;
+    } else {
+      csv += ",";
+    }
+    csv += ",";
+    if (b.truth.axis_hit_range_m) csv += Number(*b.truth.axis_hit_range_m);
+    csv += "\n";
+  }
+  return csv;
+}
+
+void WriteTruthOccupancy(const fs::path& path, const std::vector<TriangleMesh>& meshes,
+                         double resolution) {
+  octomap::OcTree tree(resolution);
+  const mapping::KeySet cells = VoxelizeMeshes(meshes, tree);
+  std::vector<octomap::OcTreeKey> sorted(cells.begin(), cells.end());
+  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) {
+    return std::tie(a[0], a[1], a[2]) < std::tie(b[0], b[1], b[2]);
+  });
+  for (const auto& key : sorted) tree.updateNode(key, true, true);
+  tree.updateInnerOccupancy();
+  WriteFileAtomically(path.string(),
+                      [&](std::ostream& out) { mapping::WriteOctomapBinary(tree, out); });
+}
+
+}  // namespace
+
+Shard ParseShard(const std::string& text) {
+  int k = 0;
+  int n = 0;
+  char slash = 0;
+  std::istringstream in(text);
+  std::string rest;
+  if (!(in >> k >> slash >> n) || slash != '/' || (in >> rest) || n < 1 || k < 1 || k > n) {
+    throw InputError("--shard '" + text + "': expected K/N with 1 <= K <= N, e.g. 3/8");
+  }
+  return {k - 1, n};
+}
+
+std::optional<Shard> ShardFromSlurm() {
+  const char* id = std::getenv("SLURM_ARRAY_TASK_ID");
+  const char* count = std::getenv("SLURM_ARRAY_TASK_COUNT");
+  if (id == nullptr || count == nullptr) return std::nullopt;
+  const char* min = std::getenv("SLURM_ARRAY_TASK_MIN");
+  auto number = [](const char* name, const char* value) {
+    char* end = nullptr;
+    const long v = std::strtol(value, &end, 10);
+    if (end == value || *end != '\0' || v < 0) {
+      throw InputError(std::string("environment variable ") + name + "='" + value +
+                       "': expected a non-negative integer");
+    }
+    return static_cast<int>(v);
+  };
+  const int task = number("SLURM_ARRAY_TASK_ID", id);
+  const int tasks = number("SLURM_ARRAY_TASK_COUNT", count);
+  const int first = min != nullptr ? number("SLURM_ARRAY_TASK_MIN", min) : 0;
+  if (tasks < 1 || task < first || task - first >= tasks) {
+    throw InputError("SLURM_ARRAY_TASK_ID " + std::to_string(task) + " is outside the array (min " +
+                     std::to_string(first) + ", count " + std::to_string(tasks) +
+                     "): pass --shard K/N");
+  }
+  return Shard{task - first, tasks};
+}
+
+DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
+                               const DatasetOptions& options) {
+  const std::uint64_t seed = options.seed.value_or(scene.seed);
+  DatasetSummary summary;
+  summary.sweeps_total = static_cast<std::size_t>(scene.sweeps);
+  summary.config_sha256 = ConfigHash(scene, seed);
+  if (PrepareDirectory(dir, summary.config_sha256, options.force)) {
+    summary.complete = summary.already_complete = true;
+    return summary;
+  }
+  const fs::path root(dir);
+  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
+  const RayTracer tracer(meshes);
+  const std::size_t beam_count = ScenarioBeamCount(scene);
+  const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
+  const Shard& shard = options.shard;
+
+  std::size_t mine = 0;
+  for (std::size_t s = static_cast<std::size_t>(shard.index); s < summary.sweeps_total;
+       s += static_cast<std::size_t>(shard.count))
+    ++mine;
+  std::size_t handled = 0;
+  for (std::size_t s = static_cast<std::size_t>(shard.index); s < summary.sweeps_total;
+       s += static_cast<std::size_t>(shard.count)) {
+    if (SweepComplete(root, s, true)) {
+      ++summary.sweeps_skipped;
+    } else {
+      const std::size_t first = s * per_sweep;
+      const auto synthesized = SimulateBeams(scene, tracer, seed, options.threads, first,
+                                             std::min(beam_count, first + per_sweep));
+      const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
+      WriteBeams(root / mapping::SweepFile("beams", s, "bin"), beams);
+      WriteText(root / mapping::SweepFile("truth", s, "csv"), TruthCsv(synthesized, first, scene));
+      WritePolarImage((root / mapping::SweepFile("images", s, "png")).string(), beams);
+      ++summary.sweeps_written;
+    }
+    if (options.progress) options.progress(++handled, mine);
+  }
+
+  for (std::size_t s = 0; s < summary.sweeps_total; ++s) {
+    if (!SweepComplete(root, s, true)) return summary;  // other shards' sweeps are still due
+  }
+  std::string sonar;
+  std::string vehicle;
+  for (std::size_t b = 0; b < beam_count; ++b) {
+    const ScheduledBeam scheduled = ScheduleBeam(scene, b);
+    sonar += mapping::TumLine(scheduled.time_s, scheduled.pose.T_world_sonar);
+    vehicle +=
+        mapping::TumLine(scheduled.time_s, scene.trajectory.T_world_vehicle(scheduled.time_s));
+  }
+  WriteText(root / "poses/sonar.tum", sonar);
+  WriteText(root / "poses/vehicle.tum", vehicle);
+  WriteTruthOccupancy(root / "truth/occupancy.bt", meshes, scene.mapping.resolution_m);
+
+  json manifest =
+      ManifestBase(scene.sensor.geometry, summary.sweeps_total, beam_count, summary.config_sha256);
+  manifest["source"] = "simulate";
+  manifest["scene"] = {{"name", scene.name}, {"file", scene.file}};
+  manifest["seed"] = seed;
+  manifest["truth"] = {
+      {"per_beam",
+       "truth/sweep_NNNN.csv: beam, time_s, head_angle_rad, first_hit_range_m "
+       "(nearest surface any ray of the beam hit), first_hit_mesh, "
+       "axis_hit_range_m; empty when nothing within range"},
+      {"occupancy", "truth/occupancy.bt: every cell a mesh surface crosses, at resolution_m"},
+      {"resolution_m", scene.mapping.resolution_m}};
+  json mesh_names = json::array();
+  for (const MeshSpec& mesh : scene.meshes) mesh_names.push_back(mesh.name);
+  manifest["meshes"] = mesh_names;
+  Finalize(dir, manifest);
+  summary.complete = true;
+  return summary;
+}
+
+DatasetSummary ImportLogDataset(const std::string& log_path, const mapping::MatLog& log,
+                                const mapping::SensorGeometry& sensor, const std::string& dir,
+                                bool force) {
+  DatasetSummary summary;
+  const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
+  summary.sweeps_total = (log.beams.size() + per_sweep - 1) / per_sweep;
+  const json inputs = {{"tool", ReportHeader()["tool"]},
+                       {"log_sha256", mapping::Sha256OfFile(log_path)},
+                       {"sensor", mapping::SensorGeometryJson(sensor)}};
+  summary.config_sha256 = mapping::Sha256(inputs.dump());
+  if (PrepareDirectory(dir, summary.config_sha256, force)) {
+    summary.complete = summary.already_complete = true;
+    return summary;
+  }
+  const fs::path root(dir);
+  const std::span<const mapping::Beam> all(log.beams);
+  std::string poses;
+  for (std::size_t s = 0; s < summary.sweeps_total; ++s) {
+    const auto sweep = all.subspan(s * per_sweep, std::min(per_sweep, all.size() - s * per_sweep));
+    if (SweepComplete(root, s, false)) {
+      ++summary.sweeps_skipped;
+    } else {
+      WriteBeams(root / mapping::SweepFile("beams", s, "bin"), sweep);
+      WritePolarImage((root / mapping::SweepFile("images", s, "png")).string(), sweep);
+      ++summary.sweeps_written;
+    }
+  }
+  for (const mapping::Beam& beam : log.beams)
+    poses += mapping::TumLine(beam.time_s, beam.T_world_sonar);
+  WriteText(root / "poses/sonar.tum", poses);
+  json manifest =
+      ManifestBase(sensor, summary.sweeps_total, log.beams.size(), summary.config_sha256);
+  manifest["source"] = "import";
+  manifest["log"] = {{"file", log_path}, {"truncated_beams", log.truncated_beams}};
+  manifest["seed"] = nullptr;
+  manifest["truth"] = nullptr;
+  Finalize(dir, manifest);
+  summary.complete = true;
+  return summary;
+}
+
+}  // namespace sonarbench::sim

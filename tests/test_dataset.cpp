@@ -1,0 +1,256 @@
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "sonarbench/mapping/dataset.hpp"
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/dataset_writer.hpp"
+#include "sonarbench/sim/mesh.hpp"
+#include "sonarbench/sim/ray_tracer.hpp"
+#include "sonarbench/sim/simulation.hpp"
+#include "test_util.hpp"
+
+namespace sonarbench {
+namespace {
+
+namespace fs = std::filesystem;
+using mapping::Beam;
+
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string Bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Every file under `dir` (relative path → bytes).
+std::map<std::string, std::string> Tree(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.is_regular_file()) files[fs::relative(e.path(), dir).string()] = Bytes(e.path());
+  }
+  return files;
+}
+
+TEST(BeamFile, RoundTripsAndRejectsDamage) {
+  std::vector<Beam> beams(2);
+  beams[0].time_s = 1.25;
+  beams[0].head_angle_rad = 0.5;
+  beams[0].bin_size_m = 0.0125;
+  beams[0].intensities = {0, 7, 255};
+  beams[1].time_s = 1.5;
+  beams[1].bin_size_m = 0.0125;  // no bins: a beam cut short
+  std::stringstream file;
+  mapping::WriteBeamFile(file, beams);
+  const std::string bytes = file.str();
+  EXPECT_EQ(bytes.size(), 8u + 4u + 2 * (3 * 8u + 4u) + 3u);
+  std::istringstream in(bytes);
+  const auto back = mapping::ReadBeamFile(in, "f.bin");
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[0].time_s, 1.25);
+  EXPECT_EQ(back[0].head_angle_rad, 0.5);
+  EXPECT_EQ(back[0].intensities, beams[0].intensities);
+  EXPECT_TRUE(back[1].intensities.empty());
+
+  std::istringstream truncated(bytes.substr(0, bytes.size() - 1));
+  EXPECT_NE(ErrorOf([&] {
+              (void)mapping::ReadBeamFile(truncated, "f.bin");
+            }).find("f.bin: truncated in the header of beam 1"),
+            std::string::npos);
+  std::istringstream trailing(bytes + "x");
+  EXPECT_NE(ErrorOf([&] { (void)mapping::ReadBeamFile(trailing, "f.bin"); }).find("bytes after"),
+            std::string::npos);
+  std::istringstream wrong("PNG....");
+  EXPECT_NE(ErrorOf([&] { (void)mapping::ReadBeamFile(wrong, "f.bin"); }).find("SBBEAMS1"),
+            std::string::npos);
+}
+
+TEST(Tum, RoundTripsAPoseAndNamesTheBadLine) {
+  test::TempDir dir;
+  Eigen::Isometry3d pose = mapping::PoseFromXyzRpy({1, -2, 0.5}, {0.1, -0.2, 2.5});
+  const auto path = dir.path() / "p.tum";
+  std::ofstream(path) << "# comment\n" << mapping::TumLine(3.5, pose);
+  const auto back = mapping::ReadTum(path.string());
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_EQ(back[0].time_s, 3.5);
+  EXPECT_TRUE(back[0].pose.isApprox(pose, 1e-8));
+  std::ofstream(path) << mapping::TumLine(0, pose) << "1 2 3\n";
+  EXPECT_NE(ErrorOf([&] { (void)mapping::ReadTum(path.string()); }).find("p.tum:2: expected 8"),
+            std::string::npos);
+  std::ofstream(path) << "0 0 0 0 0 0 0 2\n";
+  EXPECT_NE(ErrorOf([&] { (void)mapping::ReadTum(path.string()); }).find("norm"),
+            std::string::npos);
+}
+
+TEST(Sha256, MatchesFips180Vectors) {
+  EXPECT_EQ(mapping::Sha256("abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(mapping::Sha256(""),
+            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+}
+
+TEST(Shard, ParsesKOfNAndSlurmArrays) {
+  EXPECT_EQ(sim::ParseShard("3/8").index, 2);
+  EXPECT_EQ(sim::ParseShard("3/8").count, 8);
+  for (const char* bad : {"0/3", "4/3", "a/b", "1/0", "2", "1/2/3"}) {
+    EXPECT_NE(ErrorOf([&] { (void)sim::ParseShard(bad); }).find("expected K/N"), std::string::npos)
+        << bad;
+  }
+  ::unsetenv("SLURM_ARRAY_TASK_ID");
+  EXPECT_FALSE(sim::ShardFromSlurm().has_value());
+  ::setenv("SLURM_ARRAY_TASK_ID", "5", 1);
+  ::setenv("SLURM_ARRAY_TASK_MIN", "4", 1);
+  ::setenv("SLURM_ARRAY_TASK_COUNT", "3", 1);
+  const auto shard = sim::ShardFromSlurm();
+  ASSERT_TRUE(shard.has_value());
+  EXPECT_EQ(shard->index, 1);
+  EXPECT_EQ(shard->count, 3);
+  ::setenv("SLURM_ARRAY_TASK_ID", "x", 1);
+  EXPECT_NE(ErrorOf([] { (void)sim::ShardFromSlurm(); }).find("SLURM_ARRAY_TASK_ID='x'"),
+            std::string::npos);
+  for (const char* v : {"SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_MIN", "SLURM_ARRAY_TASK_COUNT"})
+    ::unsetenv(v);
+}
+
+class TankDataset : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scene_ = new sim::Scene(sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml")));
+    scene_->sweeps = 3;
+  }
+  static void TearDownTestSuite() {
+    delete scene_;
+    scene_ = nullptr;
+  }
+  static sim::Scene* scene_;
+};
+sim::Scene* TankDataset::scene_ = nullptr;
+
+TEST_F(TankDataset, ReadsBackTheSimulatedBeamsAndPoses) {
+  test::TempDir dir;
+  const auto out = dir.path() / "ds";
+  const auto summary = sim::SimulateDataset(*scene_, out.string(), {});
+  EXPECT_TRUE(summary.complete);
+  EXPECT_EQ(summary.sweeps_written, 3u);
+
+  const mapping::Dataset dataset = mapping::ReadDataset(out.string());
+  EXPECT_EQ(dataset.manifest["schema_version"], mapping::kDatasetSchemaVersion);
+  EXPECT_EQ(dataset.manifest["seed"], scene_->seed);
+  EXPECT_EQ(dataset.sweeps, 3u);
+  EXPECT_EQ(dataset.sensor.num_bins, scene_->sensor.geometry.num_bins);
+  // Every file but the manifest is listed with its hash: beams, images and truth per sweep, two
+  // pose files and the truth occupancy.
+  EXPECT_EQ(dataset.manifest["files"].size(), 3u * 3u + 2u + 1u);
+  EXPECT_FALSE(fs::exists(out / ".sonarbench-partial.json"));
+
+  const auto meshes = sim::BuildSceneMeshes(*scene_);
+  const sim::RayTracer tracer(meshes);
+  const auto expected = sim::BeamsOf(sim::SimulateScene(*scene_, tracer, scene_->seed, 1));
+  ASSERT_EQ(dataset.beams.size(), expected.size());
+  for (std::size_t b = 0; b < expected.size(); b += 37) {
+    EXPECT_EQ(dataset.beams[b].intensities, expected[b].intensities) << b;
+    EXPECT_EQ(dataset.beams[b].head_angle_rad, expected[b].head_angle_rad);
+    EXPECT_TRUE(dataset.beams[b].T_world_sonar.isApprox(expected[b].T_world_sonar, 1e-8));
+  }
+  // The per-beam truth: beam 200 (sweep 1's first) looks along -x, as the scene starts at 180°.
+  // Its axis meets the -x wall at 4.36/2 + 0.10 m; its nearest hit is the floor plane (0.0005 m)
+  // seen by the fan's lowest rays: at 17.5° down, or up to one ray stratum (35°/160) higher.
+  std::ifstream truth(out / "truth/sweep_0001.csv");
+  std::string header;
+  std::getline(truth, header);
+  EXPECT_EQ(header, "beam,time_s,head_angle_rad,first_hit_range_m,first_hit_mesh,axis_hit_range_m");
+  std::string line;
+  std::getline(truth, line);
+  std::stringstream fields(line);
+  std::vector<std::string> f;
+  for (std::string field; std::getline(fields, field, ',');) f.push_back(field);
+  ASSERT_EQ(f.size(), 6u) << line;
+  EXPECT_EQ(f[0], "200");
+  EXPECT_NEAR(std::stod(f[2]), M_PI, 1e-6);
+  EXPECT_EQ(f[4], "floor");
+  const double height = 0.45 - 0.0005;
+  const double edge = 17.5 * M_PI / 180;
+  EXPECT_GE(std::stod(f[3]), height / std::sin(edge) - 1e-6);
+  EXPECT_LE(std::stod(f[3]), height / std::sin(edge - 35.0 / 160 * M_PI / 180));
+  EXPECT_NEAR(std::stod(f[5]), 4.36 / 2 + 0.10, 1e-5);
+}
+
+TEST_F(TankDataset, ShardsAndResumedRunsGiveTheSameBytesAsOneRun) {
+  test::TempDir dir;
+  const auto whole = dir.path() / "whole";
+  const auto split = dir.path() / "split";
+  (void)sim::SimulateDataset(*scene_, whole.string(), {});
+
+  sim::DatasetOptions first;
+  first.shard = {0, 2};  // sweeps 0 and 2
+  const auto partial = sim::SimulateDataset(*scene_, split.string(), first);
+  EXPECT_FALSE(partial.complete);
+  EXPECT_EQ(partial.sweeps_written, 2u);
+  EXPECT_NE(ErrorOf([&] { (void)mapping::ReadDataset(split.string()); }).find("no manifest.json"),
+            std::string::npos);
+  // A run killed while writing leaves at most a temporary file: the rerun removes it.
+  std::ofstream(split / "beams/sweep_0001.bin.tmp.999") << "half";
+
+  const auto resumed = sim::SimulateDataset(*scene_, split.string(), {});
+  EXPECT_TRUE(resumed.complete);
+  EXPECT_EQ(resumed.sweeps_skipped, 2u);
+  EXPECT_EQ(resumed.sweeps_written, 1u);
+  EXPECT_EQ(Tree(whole), Tree(split));
+
+  const auto again = sim::SimulateDataset(*scene_, split.string(), {});
+  EXPECT_TRUE(again.already_complete);
+}
+
+TEST_F(TankDataset, NeverOverwritesWithoutForceAndNeverDeletesStrangers) {
+  test::TempDir dir;
+  const auto out = dir.path() / "ds";
+  (void)sim::SimulateDataset(*scene_, out.string(), {});
+  sim::DatasetOptions other_seed;
+  other_seed.seed = 99;
+  EXPECT_NE(ErrorOf([&] {
+              (void)sim::SimulateDataset(*scene_, out.string(), other_seed);
+            }).find("another configuration"),
+            std::string::npos);
+  other_seed.force = true;
+  EXPECT_TRUE(sim::SimulateDataset(*scene_, out.string(), other_seed).complete);
+  EXPECT_EQ(mapping::ReadDataset(out.string()).manifest["seed"], 99);
+
+  const auto stranger = dir.path() / "home";
+  fs::create_directories(stranger);
+  std::ofstream(stranger / "thesis.tex") << "precious";
+  EXPECT_NE(ErrorOf([&] {
+              (void)sim::SimulateDataset(*scene_, stranger.string(), other_seed);
+            }).find("not a sonarbench dataset"),
+            std::string::npos);
+  EXPECT_EQ(Bytes(stranger / "thesis.tex"), "precious");
+}
+
+TEST_F(TankDataset, ADamagedFileIsNamed) {
+  test::TempDir dir;
+  const auto out = dir.path() / "ds";
+  (void)sim::SimulateDataset(*scene_, out.string(), {});
+  {
+    std::fstream f(out / "beams/sweep_0002.bin", std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(100);
+    f.put('\x01');
+  }
+  EXPECT_NE(ErrorOf([&] {
+              (void)mapping::ReadDataset(out.string());
+            }).find("sweep_0002.bin: its sha256 differs"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace sonarbench
