@@ -15,6 +15,7 @@
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mat_log.hpp"
 #include "sonarbench/sim/dataset_writer.hpp"
+#include "sonarbench/sim/divisions_study.hpp"
 #include "sonarbench/sim/fidelity.hpp"
 #include "sonarbench/sim/map_log.hpp"
 #include "sonarbench/sim/mesh.hpp"
@@ -235,6 +236,51 @@ int Simulate(const SimulateArgs& args) {
   return 0;
 }
 
+struct SweepArgs {
+  std::string scene;
+  std::string out;
+  std::optional<std::uint64_t> seed;
+  std::optional<int> sweeps;
+  int coverage_beams = 20;
+  int threads = 0;
+  bool force = false;
+  std::string shard;
+  bool no_progress = false;
+};
+
+int Sweep(const SweepArgs& args) {
+  namespace sim = sonarbench::sim;
+  const sim::Scene scene = sim::LoadScene(args.scene);
+  sim::StudyOptions options;
+  options.seed = args.seed;
+  options.sweeps = args.sweeps;
+  options.coverage_beams = args.coverage_beams;
+  options.threads = args.threads;
+  options.force = args.force;
+  if (!args.shard.empty()) {
+    options.shard = sim::ParseShard(args.shard);
+  } else if (const auto slurm = sim::ShardFromSlurm()) {
+    options.shard = *slurm;
+  }
+  ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
+  options.progress = [&](std::size_t done, std::size_t total) {
+    progress.Update("study", done, total);
+  };
+  const sim::StudySummary summary = sim::RunDivisionsStudy(scene, args.out, options);
+  progress.Clear();
+  std::cout << "shard " << options.shard.index + 1 << "/" << options.shard.count << ": ran "
+            << summary.items_written << " items, skipped " << summary.items_skipped
+            << " already done, of " << summary.items_total << "\n";
+  if (summary.complete) {
+    std::cout << "wrote " << args.out
+              << "/divisions.csv, coverage_vs_divisions.png, time_vs_divisions.png, study.json\n";
+  } else {
+    std::cout << "other shards' items are still missing: the last shard to finish, or a rerun "
+                 "without --shard, writes divisions.csv and the plots\n";
+  }
+  return 0;
+}
+
 struct ImportArgs {
   std::string log;
   std::string out;
@@ -400,6 +446,33 @@ int main(int argc, char** argv) {
       "give the same bytes as one run");
   simulate_cmd->add_flag("--no-progress", simulate.no_progress, "Never show the progress line");
 
+  SweepArgs sweep;
+  CLI::App* sweep_cmd = app.add_subcommand(
+      "sweep",
+      "The coverage-vs-divisions study (the seed paper's figures 9 and 10): simulate SCENE once, "
+      "then for each setting of horizontal x vertical ray divisions (H 1..64 at V 64, V 1..128 at "
+      "H 32, and a grid) map it and measure the coverage of the exact beam volume, the map's "
+      "precision, recall and coverage, and the mapping time. Writes items/item_NNN.json per "
+      "setting, then divisions.csv, coverage_vs_divisions.png, time_vs_divisions.png and "
+      "study.json into --out. Resumable; --shard splits the settings across array jobs.");
+  sweep_cmd->add_option("scene", sweep.scene, "Scene YAML file")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sweep_cmd->add_option("-o,--out", sweep.out, "Study directory")->required();
+  sweep_cmd->add_option("-s,--seed", sweep.seed, "Overrides the scene's seed");
+  sweep_cmd->add_option("--sweeps", sweep.sweeps, "Overrides the scene's sweeps (fewer: quicker)")
+      ->check(CLI::Range(1, 100000));
+  sweep_cmd
+      ->add_option("--coverage-beams", sweep.coverage_beams,
+                   "Beams of the first sweep whose exact volume is measured")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  AddThreadsOption(sweep_cmd, sweep.threads);
+  sweep_cmd->add_flag("--force", sweep.force, "Discard the items of an earlier study in --out");
+  sweep_cmd->add_option("--shard", sweep.shard,
+                        "K/N: run only settings i with i mod N = K-1 (default from SLURM_ARRAY_*)");
+  sweep_cmd->add_flag("--no-progress", sweep.no_progress, "Never show the progress line");
+
   ImportArgs import;
   CLI::App* import_cmd = app.add_subcommand(
       "import",
@@ -426,6 +499,7 @@ int main(int argc, char** argv) {
     if (*fidelity_cmd) return Fidelity(fidelity);
     if (*simulate_cmd) return Simulate(simulate);
     if (*import_cmd) return Import(import);
+    if (*sweep_cmd) return Sweep(sweep);
   } catch (const sonarbench::InputError& e) {
     std::cerr << "sonarbench: error: " << e.what() << "\n";
     if (*run_cmd) WriteErrorJunit(run, "input_error", e.what());

@@ -166,20 +166,6 @@ bool SweepComplete(const fs::path& root, std::size_t sweep, bool with_truth) {
          (!with_truth || fs::is_regular_file(root / mapping::SweepFile("truth", sweep, "csv")));
 }
 
-std::string ConfigHash(const Scene& scene, std::uint64_t seed) {
-  json inputs = {{"tool", ReportHeader()["tool"]},
-                 {"schema_version", mapping::kDatasetSchemaVersion},
-                 {"seed", seed},
-                 {"scene_sha256", mapping::Sha256OfFile(scene.file)},
-                 {"sensor_model_sha256", mapping::Sha256OfFile(scene.sensor_model_file)}};
-  json meshes = json::array();
-  for (const MeshSpec& mesh : scene.meshes) {
-    meshes.push_back(mesh.file.empty() ? json(nullptr) : json(mapping::Sha256OfFile(mesh.file)));
-  }
-  inputs["mesh_files_sha256"] = meshes;
-  return mapping::Sha256(inputs.dump());
-}
-
 std::string TruthCsv(std::span<const SynthesizedBeam> beams, std::size_t first_index,
                      const Scene& scene) {
   std::string csv =
@@ -215,6 +201,20 @@ void WriteTruthOccupancy(const fs::path& path, const std::vector<TriangleMesh>& 
 }
 
 }  // namespace
+
+std::string SceneConfigHash(const Scene& scene, std::uint64_t seed) {
+  json inputs = {{"tool", ReportHeader()["tool"]},
+                 {"schema_version", mapping::kDatasetSchemaVersion},
+                 {"seed", seed},
+                 {"scene_sha256", mapping::Sha256OfFile(scene.file)},
+                 {"sensor_model_sha256", mapping::Sha256OfFile(scene.sensor_model_file)}};
+  json meshes = json::array();
+  for (const MeshSpec& mesh : scene.meshes) {
+    meshes.push_back(mesh.file.empty() ? json(nullptr) : json(mapping::Sha256OfFile(mesh.file)));
+  }
+  inputs["mesh_files_sha256"] = meshes;
+  return mapping::Sha256(inputs.dump());
+}
 
 Shard ParseShard(const std::string& text) {
   int k = 0;
@@ -258,7 +258,7 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   const std::uint64_t seed = options.seed.value_or(scene.seed);
   DatasetSummary summary;
   summary.sweeps_total = static_cast<std::size_t>(scene.sweeps);
-  summary.config_sha256 = ConfigHash(scene, seed);
+  summary.config_sha256 = SceneConfigHash(scene, seed);
   if (PrepareDirectory(dir, summary.config_sha256, options.force)) {
     summary.complete = summary.already_complete = true;
     return summary;

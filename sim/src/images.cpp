@@ -156,6 +156,68 @@ cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
   return colour;
 }
 
+cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
+                       const std::string& y_label, const std::vector<PlotSeries>& series,
+                       bool log2_x, double y_min, std::optional<double> y_max) {
+  constexpr int kWidth = 720, kHeight = 460, kLeft = 80, kRight = 20, kTop = 40, kBottom = 60;
+  cv::Mat img(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
+  std::vector<double> xs;
+  double top = y_max.value_or(y_min);
+  for (const auto& s : series) {
+    xs.insert(xs.end(), s.x.begin(), s.x.end());
+    if (!y_max) {
+      for (double v : s.y) top = std::max(top, v);
+    }
+  }
+  std::sort(xs.begin(), xs.end());
+  xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
+  if (xs.empty()) return img;
+  if (top <= y_min) top = y_min + 1.0;
+  auto fx = [&](double x) { return log2_x ? std::log2(std::max(x, 1e-9)) : x; };
+  const double x0 = fx(xs.front());
+  const double x1 = xs.size() > 1 ? fx(xs.back()) : x0 + 1.0;
+  auto px = [&](double x) {
+    return cv::Point(kLeft + static_cast<int>((fx(x) - x0) / (x1 - x0) * (kWidth - kLeft - kRight)),
+                     0);
+  };
+  auto py = [&](double y) {
+    return kHeight - kBottom -
+           static_cast<int>((y - y_min) / (top - y_min) * (kHeight - kTop - kBottom));
+  };
+  const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  for (double x : xs) {
+    const int u = px(x).x;
+    cv::line(img, {u, kTop}, {u, kHeight - kBottom}, grey, 1);
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", x);
+    cv::putText(img, text, {u - 8, kHeight - kBottom + 18}, font, 0.42, black, 1, cv::LINE_AA);
+  }
+  for (int i = 0; i <= 4; ++i) {
+    const double y = y_min + (top - y_min) * i / 4.0;
+    cv::line(img, {kLeft, py(y)}, {kWidth - kRight, py(y)}, grey, 1);
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", y);
+    cv::putText(img, text, {8, py(y) + 4}, font, 0.42, black, 1, cv::LINE_AA);
+  }
+  cv::rectangle(img, {kLeft, kTop}, {kWidth - kRight, kHeight - kBottom}, black, 1);
+  cv::putText(img, title, {kLeft, 26}, font, 0.55, black, 1, cv::LINE_AA);
+  cv::putText(img, x_label, {kLeft + 180, kHeight - 18}, font, 0.5, black, 1, cv::LINE_AA);
+  cv::putText(img, y_label, {8, kTop - 8}, font, 0.45, black, 1, cv::LINE_AA);
+  int legend_y = kTop + 20;
+  for (const auto& s : series) {
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      const cv::Point p(px(s.x[i]).x, py(s.y[i]));
+      cv::circle(img, p, 3, s.colour, cv::FILLED, cv::LINE_AA);
+      if (i > 0) cv::line(img, {px(s.x[i - 1]).x, py(s.y[i - 1])}, p, s.colour, 2, cv::LINE_AA);
+    }
+    cv::line(img, {kWidth - 250, legend_y - 4}, {kWidth - 225, legend_y - 4}, s.colour, 2);
+    cv::putText(img, s.name, {kWidth - 220, legend_y}, font, 0.42, black, 1, cv::LINE_AA);
+    legend_y += 18;
+  }
+  return img;
+}
+
 void WriteTopDownImage(const std::string& path, const MapCells& map, const mapping::KeySet& truth,
                        const mapping::KeySet& observable) {
   WritePng(path, RenderMapView(map, truth, observable, MapView{}));

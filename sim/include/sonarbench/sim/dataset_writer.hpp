@@ -25,6 +25,10 @@ struct Shard {
 /// one. Throws InputError when the variables are malformed.
 [[nodiscard]] std::optional<Shard> ShardFromSlurm();
 
+/// SHA-256 of what determines a scene's outputs: the tool and schema versions, the seed, and the
+/// SHA-256 of the scene file, the sensor model file and every mesh file.
+[[nodiscard]] std::string SceneConfigHash(const Scene& scene, std::uint64_t seed);
+
 struct DatasetOptions {
   std::optional<std::uint64_t> seed;
   int threads = 0;

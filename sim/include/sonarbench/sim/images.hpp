@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -44,6 +45,21 @@ struct MapView {
 /// log), occupied cells are white.
 [[nodiscard]] cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
                                     const mapping::KeySet& observable, const MapView& view);
+
+/// One line of a plot: its legend name, colour (BGR) and points.
+struct PlotSeries {
+  std::string name;
+  cv::Scalar colour;
+  std::vector<double> x;
+  std::vector<double> y;
+};
+/// Renders a line plot with axes, ticks at the x values of the series (log2 scale when
+/// `log2_x`), five y ticks from `y_min` to the data's maximum (or `y_max` when it is set), a
+/// title, axis labels and a legend.
+[[nodiscard]] cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
+                                     const std::string& y_label,
+                                     const std::vector<PlotSeries>& series, bool log2_x,
+                                     double y_min, std::optional<double> y_max = std::nullopt);
 
 /// The top-down RenderMapView, written as a PNG file atomically.
 void WriteTopDownImage(const std::string& path, const MapCells& map, const mapping::KeySet& truth,
