@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/ground_truth.hpp"
+#include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/score.hpp"
 
 namespace sonarbench::sim {
@@ -179,6 +181,65 @@ TEST(ScoreMap, FreeCellsOnTheSurfaceLowerFreeAccuracy) {
   EXPECT_DOUBLE_EQ(m.free_accuracy, 1.0 - 5.0 / 20.0);
   EXPECT_DOUBLE_EQ(m.coverage_absolute, 0.5);
   EXPECT_EQ(m.mesh_to_map.count, 0u);  // no occupied cell: no distance, and no NaN
+}
+
+}  // namespace
+}  // namespace sonarbench::sim
+
+namespace sonarbench::sim {
+namespace {
+
+// The 0.29 m box of BoxShellCellsCanBeCounted, filled: its shell (152 cells) and the 4³ = 64
+// cells inside it, the whole 6 × 6 × 6 block.
+TEST(VoxelizeMeshes, AFilledBoxIsItsWholeBlock) {
+  MeshSpec spec;
+  spec.type = MeshSpec::Type::kBox;
+  spec.size_m = {0.29, 0.29, 0.29};
+  spec.T_world_mesh.translation() = Eigen::Vector3d(0.15, 0.15, 0.15);
+  TriangleMesh box = BuildMesh(spec, 0);
+  box.fill = true;
+  const octomap::OcTree key_space(0.05);
+  EXPECT_EQ(VoxelizeMeshes(std::vector<TriangleMesh>{box}, key_space).size(), 216u);
+}
+
+// For a box turned 30° about z: the filled cells cover the box (every cell meeting it either
+// crosses the surface or lies wholly inside), so at least volume / cell volume of them; and
+// beyond the shell only cells wholly inside are added, so at most that plus the shell.
+TEST(VoxelizeMeshes, AFilledTurnedBoxHoldsItsVolume) {
+  MeshSpec spec;
+  spec.type = MeshSpec::Type::kBox;
+  spec.size_m = {1.0, 0.6, 0.4};
+  spec.T_world_mesh = mapping::PoseFromXyzRpy({0.013, -0.021, 0.007}, {0, 0, 0.5236});
+  TriangleMesh box = BuildMesh(spec, 0);
+  const octomap::OcTree key_space(0.05);
+  const auto shell = VoxelizeMeshes(std::vector<TriangleMesh>{box}, key_space);
+  box.fill = true;
+  const auto solid = VoxelizeMeshes(std::vector<TriangleMesh>{box}, key_space);
+  const double volume_cells = 1.0 * 0.6 * 0.4 / (0.05 * 0.05 * 0.05);  // 1920
+  EXPECT_GE(static_cast<double>(solid.size()), volume_cells);
+  EXPECT_LE(static_cast<double>(solid.size()), volume_cells + static_cast<double>(shell.size()));
+  for (const auto& key : shell) EXPECT_TRUE(solid.contains(key));
+}
+
+TEST(BuildSceneMeshes, FillingAnOpenMeshIsRefused) {
+  Scene scene;
+  scene.file = "s.yaml";
+  scene.materials.push_back({});
+  MeshSpec tank;
+  tank.name = "tank";
+  tank.type = MeshSpec::Type::kTank;
+  tank.size_m = {4, 4, 1.5};
+  tank.fill = true;
+  scene.meshes.push_back(tank);
+  try {
+    (void)BuildSceneMeshes(scene);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("s.yaml: mesh 'tank': 'fill' needs a closed mesh, but it "
+                                         "has 4 open"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -89,6 +89,64 @@ bool TriangleBoxOverlap(const Vector3d& box_centre, const Vector3d& box_half_siz
   return true;
 }
 
+namespace {
+
+// Adds every cell whose centre lies inside the closed mesh.
+void AddInteriorCells(const TriangleMesh& mesh, const octomap::OcTree& key_space,
+                      mapping::KeySet& cells) {
+  if (mesh.triangles.empty()) return;
+  Vector3d lo = Vector3d::Constant(1e300);
+  Vector3d hi = Vector3d::Constant(-1e300);
+  for (const auto& v : mesh.vertices) {
+    lo = lo.cwiseMin(v.cast<double>());
+    hi = hi.cwiseMax(v.cast<double>());
+  }
+  const octomap::OcTreeKey k_lo = key_space.coordToKey(lo.x(), lo.y(), lo.z());
+  const octomap::OcTreeKey k_hi = key_space.coordToKey(hi.x(), hi.y(), hi.z());
+  const double res = key_space.getResolution();
+  // A row of cell centres along x crosses the closed surface an even number of times; the cells
+  // between the 1st and 2nd, 3rd and 4th, ... crossing are inside. The row is nudged off the
+  // centres by far more than float rounding and far less than a cell, so that it never runs
+  // exactly through an edge or a vertex (which would count one crossing twice).
+  const double dy = 1.234567e-4 * res;
+  const double dz = 2.345678e-4 * res;
+  std::vector<double> crossings;
+  for (int y = k_lo[1]; y <= k_hi[1]; ++y) {
+    for (int z = k_lo[2]; z <= k_hi[2]; ++z) {
+      const double py = key_space.keyToCoord(static_cast<octomap::key_type>(y)) + dy;
+      const double pz = key_space.keyToCoord(static_cast<octomap::key_type>(z)) + dz;
+      crossings.clear();
+      for (const auto& t : mesh.triangles) {
+        const Vector3d a = mesh.vertices[t[0]].cast<double>();
+        const Vector3d b = mesh.vertices[t[1]].cast<double>();
+        const Vector3d c = mesh.vertices[t[2]].cast<double>();
+        // Barycentric coordinates of (py, pz) in the triangle's projection on the y-z plane.
+        const double d = (b.y() - a.y()) * (c.z() - a.z()) - (c.y() - a.y()) * (b.z() - a.z());
+        if (d == 0.0) continue;  // edge-on to the row
+        const double u = ((py - a.y()) * (c.z() - a.z()) - (c.y() - a.y()) * (pz - a.z())) / d;
+        const double v = ((b.y() - a.y()) * (pz - a.z()) - (py - a.y()) * (b.z() - a.z())) / d;
+        if (u < 0.0 || v < 0.0 || u + v > 1.0) continue;
+        crossings.push_back(a.x() + u * (b.x() - a.x()) + v * (c.x() - a.x()));
+      }
+      std::sort(crossings.begin(), crossings.end());
+      for (std::size_t i = 0; i + 1 < crossings.size(); i += 2) {
+        const octomap::OcTreeKey from = key_space.coordToKey(crossings[i], py, pz);
+        for (int x = from[0]; x <= k_hi[0]; ++x) {
+          const double cx = key_space.keyToCoord(static_cast<octomap::key_type>(x));
+          if (cx > crossings[i + 1]) break;
+          if (cx >= crossings[i]) {
+            cells.insert(octomap::OcTreeKey(static_cast<octomap::key_type>(x),
+                                            static_cast<octomap::key_type>(y),
+                                            static_cast<octomap::key_type>(z)));
+          }
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
 mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
                                const octomap::OcTree& key_space) {
   mapping::KeySet cells;
@@ -97,6 +155,7 @@ mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
       AddTriangleCells(mesh.vertices[t[0]].cast<double>(), mesh.vertices[t[1]].cast<double>(),
                        mesh.vertices[t[2]].cast<double>(), key_space, cells);
     }
+    if (mesh.fill) AddInteriorCells(mesh, key_space, cells);
   }
   return cells;
 }

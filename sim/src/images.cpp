@@ -204,7 +204,8 @@ cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
   cv::putText(img, title, {kLeft, 26}, font, 0.55, black, 1, cv::LINE_AA);
   cv::putText(img, x_label, {kLeft + 180, kHeight - 18}, font, 0.5, black, 1, cv::LINE_AA);
   cv::putText(img, y_label, {8, kTop - 8}, font, 0.45, black, 1, cv::LINE_AA);
-  int legend_y = kTop + 20;
+  // The legend sits in the lower right, where coverage-like curves that rise to 1 leave room.
+  int legend_y = kHeight - kBottom - 12 - 18 * (static_cast<int>(series.size()) - 1);
   for (const auto& s : series) {
     for (std::size_t i = 0; i < s.x.size(); ++i) {
       const cv::Point p(px(s.x[i]).x, py(s.y[i]));

@@ -143,9 +143,17 @@ std::vector<TriangleMesh> BuildSceneMeshes(const Scene& scene) {
     const MeshSpec& spec = scene.meshes[i];
     meshes.push_back(BuildMesh(spec, DeriveSeed(scene.seed, 0x6d657368ULL + i)));
     meshes.back().name = spec.name;
-    meshes.back().check =
-        CheckMesh(meshes.back(), scene.file + ": mesh '" + spec.name + "'" +
-                                     (spec.file.empty() ? std::string() : " (" + spec.file + ")"));
+    const std::string where = scene.file + ": mesh '" + spec.name + "'" +
+                              (spec.file.empty() ? std::string() : " (" + spec.file + ")");
+    TriangleMesh& mesh = meshes.back();
+    mesh.check = CheckMesh(mesh, where);
+    mesh.fill = spec.fill;
+    if (spec.fill && (mesh.check.boundary_edges > 0 || mesh.check.non_manifold_edges > 0)) {
+      throw InputError(where + ": 'fill' needs a closed mesh, but it has " +
+                       std::to_string(mesh.check.boundary_edges) + " open and " +
+                       std::to_string(mesh.check.non_manifold_edges) +
+                       " non-manifold edges: its inside is not defined");
+    }
   }
   return meshes;
 }

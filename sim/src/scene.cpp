@@ -53,6 +53,7 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
     node.Optional("wavelength_m", m.wavelength_m, Positive());
     node.Optional("roughness_m", m.roughness_m, NonNegative());
   }
+  node.Optional("fill", m.fill);
   std::string material;
   node.Required("material", material);
   bool found = false;

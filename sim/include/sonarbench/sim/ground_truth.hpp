@@ -18,7 +18,8 @@ namespace sonarbench::sim {
                                       const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                       const Eigen::Vector3d& c);
 
-/// Every cell of `key_space`'s grid whose box the surface of a mesh crosses.
+/// Every cell of `key_space`'s grid whose box the surface of a mesh crosses (cells half-open, as
+/// OctoMap assigns points), and, for a mesh with `fill`, every cell whose centre lies inside it.
 [[nodiscard]] mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
                                              const octomap::OcTree& key_space);
 

@@ -23,6 +23,8 @@ struct TriangleMesh {
   std::vector<Eigen::Vector3f> vertices;
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::size_t material = 0;
+  /// Its inside counts as occupied truth too (a closed mesh: checked by BuildSceneMeshes).
+  bool fill = false;
   MeshCheck check;
 };
 

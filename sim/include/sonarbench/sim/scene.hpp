@@ -48,6 +48,8 @@ struct MeshSpec {
   std::vector<Eigen::Vector3d> file_vertices;
   std::vector<std::array<std::uint32_t, 3>> file_triangles;
   std::size_t material = 0;
+  /// Count the cells inside the (closed) mesh as occupied truth, not only its surface.
+  bool fill = false;
 };
 
 /// A waypoint of the vehicle: time [s] and pose of the vehicle in the world.
