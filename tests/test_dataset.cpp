@@ -19,15 +19,6 @@ namespace {
 namespace fs = std::filesystem;
 using mapping::Beam;
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 std::string Bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream s;
@@ -65,16 +56,19 @@ TEST(BeamFile, RoundTripsAndRejectsDamage) {
   EXPECT_TRUE(back[1].intensities.empty());
 
   std::istringstream truncated(bytes.substr(0, bytes.size() - 1));
-  EXPECT_NE(ErrorOf([&] {
+  EXPECT_NE(test::InputErrorOf([&] {
               (void)mapping::ReadBeamFile(truncated, "f.bin");
             }).find("f.bin: truncated in the header of beam 1"),
             std::string::npos);
   std::istringstream trailing(bytes + "x");
-  EXPECT_NE(ErrorOf([&] { (void)mapping::ReadBeamFile(trailing, "f.bin"); }).find("bytes after"),
+  EXPECT_NE(test::InputErrorOf([&] {
+              (void)mapping::ReadBeamFile(trailing, "f.bin");
+            }).find("bytes after"),
             std::string::npos);
   std::istringstream wrong("PNG....");
-  EXPECT_NE(ErrorOf([&] { (void)mapping::ReadBeamFile(wrong, "f.bin"); }).find("SBBEAMS1"),
-            std::string::npos);
+  EXPECT_NE(
+      test::InputErrorOf([&] { (void)mapping::ReadBeamFile(wrong, "f.bin"); }).find("SBBEAMS1"),
+      std::string::npos);
 }
 
 TEST(Tum, RoundTripsAPoseAndNamesTheBadLine) {
@@ -87,10 +81,12 @@ TEST(Tum, RoundTripsAPoseAndNamesTheBadLine) {
   EXPECT_EQ(back[0].time_s, 3.5);
   EXPECT_TRUE(back[0].pose.isApprox(pose, 1e-8));
   std::ofstream(path) << mapping::TumLine(0, pose) << "1 2 3\n";
-  EXPECT_NE(ErrorOf([&] { (void)mapping::ReadTum(path.string()); }).find("p.tum:2: expected 8"),
+  EXPECT_NE(test::InputErrorOf([&] {
+              (void)mapping::ReadTum(path.string());
+            }).find("p.tum:2: expected 8"),
             std::string::npos);
   std::ofstream(path) << "0 0 0 0 0 0 0 2\n";
-  EXPECT_NE(ErrorOf([&] { (void)mapping::ReadTum(path.string()); }).find("norm"),
+  EXPECT_NE(test::InputErrorOf([&] { (void)mapping::ReadTum(path.string()); }).find("norm"),
             std::string::npos);
 }
 
@@ -105,7 +101,8 @@ TEST(Shard, ParsesKOfNAndSlurmArrays) {
   EXPECT_EQ(sim::ParseShard("3/8").index, 2);
   EXPECT_EQ(sim::ParseShard("3/8").count, 8);
   for (const char* bad : {"0/3", "4/3", "a/b", "1/0", "2", "1/2/3"}) {
-    EXPECT_NE(ErrorOf([&] { (void)sim::ParseShard(bad); }).find("expected K/N"), std::string::npos)
+    EXPECT_NE(test::InputErrorOf([&] { (void)sim::ParseShard(bad); }).find("expected K/N"),
+              std::string::npos)
         << bad;
   }
   ::unsetenv("SLURM_ARRAY_TASK_ID");
@@ -118,7 +115,7 @@ TEST(Shard, ParsesKOfNAndSlurmArrays) {
   EXPECT_EQ(shard->index, 1);
   EXPECT_EQ(shard->count, 3);
   ::setenv("SLURM_ARRAY_TASK_ID", "x", 1);
-  EXPECT_NE(ErrorOf([] { (void)sim::ShardFromSlurm(); }).find("SLURM_ARRAY_TASK_ID='x'"),
+  EXPECT_NE(test::InputErrorOf([] { (void)sim::ShardFromSlurm(); }).find("SLURM_ARRAY_TASK_ID='x'"),
             std::string::npos);
   for (const char* v : {"SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_MIN", "SLURM_ARRAY_TASK_COUNT"})
     ::unsetenv(v);
@@ -198,7 +195,9 @@ TEST_F(TankDataset, ShardsAndResumedRunsGiveTheSameBytesAsOneRun) {
   const auto partial = sim::SimulateDataset(*scene_, split.string(), first);
   EXPECT_FALSE(partial.complete);
   EXPECT_EQ(partial.sweeps_written, 2u);
-  EXPECT_NE(ErrorOf([&] { (void)mapping::ReadDataset(split.string()); }).find("no manifest.json"),
+  EXPECT_NE(test::InputErrorOf([&] {
+              (void)mapping::ReadDataset(split.string());
+            }).find("no manifest.json"),
             std::string::npos);
   // A run killed while writing leaves at most a temporary file: the rerun removes it.
   std::ofstream(split / "beams/sweep_0001.bin.tmp.999") << "half";
@@ -219,7 +218,7 @@ TEST_F(TankDataset, NeverOverwritesWithoutForceAndNeverDeletesStrangers) {
   (void)sim::SimulateDataset(*scene_, out.string(), {});
   sim::DatasetOptions other_seed;
   other_seed.seed = 99;
-  EXPECT_NE(ErrorOf([&] {
+  EXPECT_NE(test::InputErrorOf([&] {
               (void)sim::SimulateDataset(*scene_, out.string(), other_seed);
             }).find("another configuration"),
             std::string::npos);
@@ -230,7 +229,7 @@ TEST_F(TankDataset, NeverOverwritesWithoutForceAndNeverDeletesStrangers) {
   const auto stranger = dir.path() / "home";
   fs::create_directories(stranger);
   std::ofstream(stranger / "thesis.tex") << "precious";
-  EXPECT_NE(ErrorOf([&] {
+  EXPECT_NE(test::InputErrorOf([&] {
               (void)sim::SimulateDataset(*scene_, stranger.string(), other_seed);
             }).find("not a sonarbench dataset"),
             std::string::npos);
@@ -246,7 +245,7 @@ TEST_F(TankDataset, ADamagedFileIsNamed) {
     f.seekp(100);
     f.put('\x01');
   }
-  EXPECT_NE(ErrorOf([&] {
+  EXPECT_NE(test::InputErrorOf([&] {
               (void)mapping::ReadDataset(out.string());
             }).find("sweep_0002.bin: its sha256 differs"),
             std::string::npos);

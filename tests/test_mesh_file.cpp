@@ -34,15 +34,6 @@ TriangleMesh AsMesh(const MeshFileData& data, const std::array<double, 3>& scale
   return BuildMesh(spec, 0);
 }
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
 // The generator (scenes/meshes/make_meshes.py) writes exact dimensions; floats hold them to 1e-6.
 constexpr double kTol = 1e-5;
 
@@ -111,7 +102,7 @@ TEST(MeshPreflight, RefusesNonFiniteVerticesAndDropsZeroAreaTriangles) {
   test::TempDir dir;
   const auto nan_obj = dir.path() / "nan.obj";
   std::ofstream(nan_obj) << "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n";
-  const std::string nan_error = ErrorOf([&] {
+  const std::string nan_error = test::InputErrorOf([&] {
     TriangleMesh mesh = AsMesh(LoadMeshFile(nan_obj.string()));
     (void)CheckMesh(mesh, nan_obj.string());
   });
@@ -129,7 +120,7 @@ TEST(MeshPreflight, RefusesNonFiniteVerticesAndDropsZeroAreaTriangles) {
   TriangleMesh only_degenerate;
   only_degenerate.vertices = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
   only_degenerate.triangles = {{0, 1, 2}};
-  EXPECT_NE(ErrorOf([&] {
+  EXPECT_NE(test::InputErrorOf([&] {
               (void)CheckMesh(only_degenerate, "flat");
             }).find("flat: no triangle with a non-zero area"),
             std::string::npos);
@@ -137,13 +128,13 @@ TEST(MeshPreflight, RefusesNonFiniteVerticesAndDropsZeroAreaTriangles) {
 
 TEST(MeshFile, MissingOrUnreadableFilesNameTheFile) {
   test::TempDir dir;
-  EXPECT_NE(ErrorOf([] {
+  EXPECT_NE(test::InputErrorOf([] {
               (void)LoadMeshFile("/nonexistent/rock.obj");
             }).find("/nonexistent/rock.obj: no such mesh file"),
             std::string::npos);
   const auto garbage = dir.path() / "garbage.stl";
   std::ofstream(garbage) << "this is not a mesh\n";
-  const std::string error = ErrorOf([&] { (void)LoadMeshFile(garbage.string()); });
+  const std::string error = test::InputErrorOf([&] { (void)LoadMeshFile(garbage.string()); });
   EXPECT_NE(error.find(garbage.string() + ": "), std::string::npos) << error;
 }
 

@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <functional>
 #include <string>
+
+#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::test {
 
@@ -26,6 +29,16 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
+
+/// The message of the InputError `f` throws, or "" when it throws none.
+inline std::string InputErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
 
 inline std::string SourcePath(const std::string& relative) {
   return std::string(SONARBENCH_SOURCE_DIR) + "/" + relative;

@@ -7,7 +7,10 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
+
+#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench {
 
@@ -34,6 +37,14 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
     std::filesystem::remove(temp, ignored);
     throw;
   }
+}
+
+std::string ReadFileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot be read");
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
 }
 
 }  // namespace sonarbench

@@ -12,6 +12,7 @@
 #include <memory>
 #include <sstream>
 
+#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/yaml_reader.hpp"
 
@@ -60,14 +61,6 @@ class Sha256Context {
  private:
   std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> ctx_;
 };
-
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot be read");
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 }  // namespace
 
@@ -203,7 +196,7 @@ Dataset ReadDataset(const std::string& dir) {
   }
   Dataset dataset;
   try {
-    dataset.manifest = nlohmann::json::parse(ReadText(manifest_path));
+    dataset.manifest = nlohmann::json::parse(ReadFileBytes(manifest_path));
   } catch (const nlohmann::json::parse_error& e) {
     throw InputError(manifest_path + ": not valid JSON: " + e.what());
   }

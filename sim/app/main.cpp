@@ -189,6 +189,12 @@ int Fidelity(const FidelityArgs& args) {
   return 0;
 }
 
+// The --shard option's value, else a SLURM array job's shard, else the whole run.
+sonarbench::sim::Shard ResolveShard(const std::string& option) {
+  if (!option.empty()) return sonarbench::sim::ParseShard(option);
+  return sonarbench::sim::ShardFromSlurm().value_or(sonarbench::sim::Shard{});
+}
+
 struct SimulateArgs {
   std::string scene;
   std::string out;
@@ -206,11 +212,7 @@ int Simulate(const SimulateArgs& args) {
   options.seed = args.seed;
   options.threads = args.threads;
   options.force = args.force;
-  if (!args.shard.empty()) {
-    options.shard = sim::ParseShard(args.shard);
-  } else if (const auto slurm = sim::ShardFromSlurm()) {
-    options.shard = *slurm;
-  }
+  options.shard = ResolveShard(args.shard);
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   options.progress = [&](std::size_t done, std::size_t total) {
     progress.Update("simulate", done, total);
@@ -257,11 +259,7 @@ int Sweep(const SweepArgs& args) {
   options.coverage_beams = args.coverage_beams;
   options.threads = args.threads;
   options.force = args.force;
-  if (!args.shard.empty()) {
-    options.shard = sim::ParseShard(args.shard);
-  } else if (const auto slurm = sim::ShardFromSlurm()) {
-    options.shard = *slurm;
-  }
+  options.shard = ResolveShard(args.shard);
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   options.progress = [&](std::size_t done, std::size_t total) {
     progress.Update("study", done, total);

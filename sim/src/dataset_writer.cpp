@@ -30,13 +30,6 @@ using nlohmann::json;
 // whether the sweeps on disk are its own.
 constexpr const char* kPartialMarker = ".sonarbench-partial.json";
 
-std::string ReadText(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 void WriteText(const fs::path& path, const std::string& text) {
   WriteFileAtomically(path.string(), [&](std::ostream& out) { out << text; });
 }
@@ -52,7 +45,7 @@ std::string Number(double value) {
 std::optional<std::string> StoredConfig(const fs::path& file) {
   if (!fs::is_regular_file(file)) return std::nullopt;
   try {
-    return json::parse(ReadText(file)).at("config_sha256").get<std::string>();
+    return json::parse(ReadFileBytes(file.string())).at("config_sha256").get<std::string>();
   } catch (const std::exception&) {
     return std::string("?");
   }

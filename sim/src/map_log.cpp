@@ -41,8 +41,8 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
   result.totals = result.mapper->IntegrateSweeps(beams);
   const auto per_sweep = static_cast<std::size_t>(geometry.BeamsPerSweep());
   result.sweeps = (beams.size() + per_sweep - 1) / per_sweep;
-  result.first_sweep.assign(
-      beams.begin(), beams.begin() + static_cast<long>(std::min(per_sweep, beams.size())));
+  result.first_sweep.assign(beams.begin(),
+                            beams.begin() + static_cast<long>(std::min(per_sweep, beams.size())));
   result.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -11,4 +11,7 @@ namespace sonarbench {
 /// and leaves any previous `path` untouched; throws std::runtime_error naming the file.
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// The whole content of `path`; throws InputError naming it when it cannot be read.
+[[nodiscard]] std::string ReadFileBytes(const std::string& path);
+
 }  // namespace sonarbench
