@@ -147,9 +147,9 @@ TEST_F(TankDataset, ReadsBackTheSimulatedBeamsAndPoses) {
   EXPECT_EQ(dataset.manifest["seed"], scene_->seed);
   EXPECT_EQ(dataset.sweeps, 3u);
   EXPECT_EQ(dataset.sensor.num_bins, scene_->sensor.geometry.num_bins);
-  // Every file but the manifest is listed with its hash: beams, images and truth per sweep, two
+  // Every file but the manifest is listed with its hash: beams, images and truth per sweep, three
   // pose files and the truth occupancy.
-  EXPECT_EQ(dataset.manifest["files"].size(), 3u * 3u + 2u + 1u);
+  EXPECT_EQ(dataset.manifest["files"].size(), 3u * 3u + 3u + 1u);
   EXPECT_FALSE(fs::exists(out / ".sonarbench-partial.json"));
 
   const auto meshes = sim::BuildSceneMeshes(*scene_);

@@ -46,6 +46,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   out.beam.time_s = time_s;
   out.beam.head_angle_rad = head_angle_rad;
   out.beam.T_world_sonar = T_world_sonar;
+  out.truth.T_world_sonar = T_world_sonar;
   out.beam.bin_size_m = g.bin_size_m;
   out.echo_power.assign(bins, 0.0);
 

@@ -135,8 +135,9 @@ json ManifestBase(const mapping::SensorGeometry& sensor, std::size_t sweeps, std
                "x along head angle 0, z the head's rotation axis; a ray at head angle θ and "
                "elevation ε points along (cos θ cos ε, sin θ cos ε, sin ε)"},
               {"poses",
-               "poses/sonar.tum holds T_world_sonar at each beam's time (head angle 0); "
-               "poses/vehicle.tum T_world_vehicle"}}},
+               "poses/sonar.tum holds T_world_sonar at each beam's time (head angle 0) as the "
+               "navigation reports it (what a mapper uses); poses/sonar_true.tum the true one "
+               "the beams were rendered from; poses/vehicle.tum the true T_world_vehicle"}}},
             {"quaternion_order", "x y z w (TUM: time tx ty tz qx qy qz qw), Hamilton"},
             {"beam_file",
              "little-endian: 'SBBEAMS1', u32 beam count, per beam f64 time_s, f64 "
@@ -289,14 +290,18 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
     if (!SweepComplete(root, s, true)) return summary;  // other shards' sweeps are still due
   }
   std::string sonar;
+  std::string sonar_true;
   std::string vehicle;
   for (std::size_t b = 0; b < beam_count; ++b) {
     const ScheduledBeam scheduled = ScheduleBeam(scene, b);
-    sonar += mapping::TumLine(scheduled.time_s, scheduled.pose.T_world_sonar);
+    sonar +=
+        mapping::TumLine(scheduled.time_s, ReportedSonarPose(scene, b, scheduled.time_s, seed));
+    sonar_true += mapping::TumLine(scheduled.time_s, scheduled.pose.T_world_sonar);
     vehicle +=
         mapping::TumLine(scheduled.time_s, scene.trajectory.T_world_vehicle(scheduled.time_s));
   }
   WriteText(root / "poses/sonar.tum", sonar);
+  WriteText(root / "poses/sonar_true.tum", sonar_true);
   WriteText(root / "poses/vehicle.tum", vehicle);
   WriteTruthOccupancy(root / "truth/occupancy.bt", meshes, scene.mapping.resolution_m);
 
@@ -305,6 +310,11 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   manifest["source"] = "simulate";
   manifest["scene"] = {{"name", scene.name}, {"file", scene.file}};
   manifest["seed"] = seed;
+  manifest["navigation_error"] = {
+      {"drift_m_per_s", scene.navigation.drift_m_per_s},
+      {"heading_drift_deg_per_s", scene.navigation.heading_drift_rad_per_s / mapping::kDegToRad},
+      {"position_noise_m", scene.navigation.position_noise_m},
+      {"heading_noise_deg", scene.navigation.heading_noise_rad / mapping::kDegToRad}};
   manifest["truth"] = {
       {"per_beam",
        "truth/sweep_NNNN.csv: beam, time_s, head_angle_rad, first_hit_range_m "

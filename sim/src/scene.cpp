@@ -149,6 +149,17 @@ Scene LoadScene(const std::string& path) {
   }
   YamlReader trajectory = root.Child("trajectory");
   scene.trajectory = ReadTrajectory(trajectory);
+  if (auto nav = root.OptionalChild("navigation")) {
+    double heading_drift_deg = 0.0;
+    double heading_noise_deg = 0.0;
+    nav->Optional("drift_m_per_s", scene.navigation.drift_m_per_s);
+    nav->Optional("heading_drift_deg_per_s", heading_drift_deg, InRange(-90.0, 90.0));
+    nav->Optional("position_noise_m", scene.navigation.position_noise_m, InRange(0.0, 100.0));
+    nav->Optional("heading_noise_deg", heading_noise_deg, InRange(0.0, 90.0));
+    nav->RejectUnknownKeys();
+    scene.navigation.heading_drift_rad_per_s = heading_drift_deg * kDegToRad;
+    scene.navigation.heading_noise_rad = heading_noise_deg * kDegToRad;
+  }
   std::optional<Eigen::Isometry3d> T_vehicle_sonar;
   if (auto mounting = root.OptionalChild("sonar_mounting")) {
     T_vehicle_sonar = ReadPose(*mounting);

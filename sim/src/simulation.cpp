@@ -27,6 +27,24 @@ ScheduledBeam ScheduleBeam(const Scene& scene, std::size_t index) {
   return out;
 }
 
+Eigen::Isometry3d ReportedSonarPose(const Scene& scene, std::size_t index, double time_s,
+                                    std::uint64_t seed) {
+  const Eigen::Isometry3d T_world_vehicle = scene.trajectory.T_world_vehicle(time_s);
+  const NavigationError& nav = scene.navigation;
+  if (!nav.Any()) return T_world_vehicle * scene.sensor.geometry.T_vehicle_sonar;
+  // Its own stream of draws, apart from the beam's acoustic noise.
+  Rng rng(DeriveSeed(DeriveSeed(seed, 0x6e6176ULL), index));
+  Eigen::Vector3d offset(nav.drift_m_per_s[0], nav.drift_m_per_s[1], nav.drift_m_per_s[2]);
+  offset *= time_s;
+  for (int i = 0; i < 3; ++i) offset[i] += nav.position_noise_m * rng.Normal();
+  const double yaw = nav.heading_drift_rad_per_s * time_s + nav.heading_noise_rad * rng.Normal();
+  Eigen::Isometry3d reported = T_world_vehicle;
+  reported.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                      T_world_vehicle.linear();
+  reported.translation() += offset;
+  return reported * scene.sensor.geometry.T_vehicle_sonar;
+}
+
 std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const RayTracer& tracer,
                                            std::uint64_t seed, int threads, std::size_t first,
                                            std::size_t last) {
@@ -40,8 +58,10 @@ std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const RayTracer& 
   for (std::int64_t b = 0; b < static_cast<std::int64_t>(beams.size()); ++b) {
     const std::size_t index = first + static_cast<std::size_t>(b);
     const ScheduledBeam s = ScheduleBeam(scene, index);
-    beams[static_cast<std::size_t>(b)] = synthesizer.Synthesize(
-        s.time_s, s.pose.head_angle_rad, s.pose.T_world_sonar, DeriveSeed(seed, index));
+    SynthesizedBeam& out = beams[static_cast<std::size_t>(b)];
+    out = synthesizer.Synthesize(s.time_s, s.pose.head_angle_rad, s.pose.T_world_sonar,
+                                 DeriveSeed(seed, index));
+    out.beam.T_world_sonar = ReportedSonarPose(scene, index, s.time_s, seed);
   }
   return beams;
 }

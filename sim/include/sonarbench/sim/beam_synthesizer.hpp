@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -17,6 +18,8 @@ struct BeamTruth {
   std::uint32_t first_hit_mesh = 0;
   /// The first hit along the beam axis, if within range.
   std::optional<double> axis_hit_range_m;
+  /// The sonar's true pose, from which the beam was rendered.
+  Eigen::Isometry3d T_world_sonar = Eigen::Isometry3d::Identity();
 };
 
 /// A simulated beam with its ground truth, plus the echo power before noise and quantisation.

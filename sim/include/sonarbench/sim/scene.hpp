@@ -66,6 +66,22 @@ struct Trajectory {
   [[nodiscard]] Eigen::Isometry3d T_world_vehicle(double time_s) const;
 };
 
+/// Error of the navigation solution the mapper is given (the simulator renders from the true
+/// poses). The reported vehicle pose at time t is the true one with its position moved by
+/// drift_m_per_s · t plus zero-mean Gaussian noise of σ position_noise_m per axis, and its yaw
+/// turned by heading_drift_deg_per_s · t plus noise of σ heading_noise_deg. The noise of beam b
+/// draws only from DeriveSeed(seed, b) of its own stream, so it is the same for any thread count.
+struct NavigationError {
+  std::array<double, 3> drift_m_per_s{0, 0, 0};
+  double heading_drift_rad_per_s = 0.0;
+  double position_noise_m = 0.0;
+  double heading_noise_rad = 0.0;
+  [[nodiscard]] bool Any() const {
+    return drift_m_per_s != std::array<double, 3>{0, 0, 0} || heading_drift_rad_per_s != 0.0 ||
+           position_noise_m != 0.0 || heading_noise_rad != 0.0;
+  }
+};
+
 /// A scenario: what is in the water, how the vehicle moves, the sonar, and how to map.
 struct Scene {
   std::string name;
@@ -77,6 +93,8 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<MeshSpec> meshes;
   Trajectory trajectory;
+  /// The navigation error on the poses the mapper gets (none by default).
+  NavigationError navigation;
   /// Full head revolutions to simulate.
   int sweeps = 1;
   /// Head angle of the first beam [rad].

@@ -23,9 +23,17 @@ struct ScheduledBeam {
 };
 [[nodiscard]] ScheduledBeam ScheduleBeam(const Scene& scene, std::size_t index);
 
+/// The sonar pose the navigation reports for beam `index` at `time_s`: the true pose with the
+/// scene's NavigationError applied to the vehicle (its noise seeded from `seed` and the index).
+/// Without navigation error, the true pose.
+[[nodiscard]] Eigen::Isometry3d ReportedSonarPose(const Scene& scene, std::size_t index,
+                                                  double time_s, std::uint64_t seed);
+
 /// Synthesises every beam of the scene's run, in time order, on `threads` threads (0 = all).
 /// Beam b draws only from DeriveSeed(seed, b): the output does not depend on the thread count.
-/// `on_sweep`, when set, is called after each sweep with the sweeps done and the total.
+/// Each beam is rendered from the true pose and carries the reported one (ReportedSonarPose) in
+/// `beam.T_world_sonar`; the true one is in `truth.T_world_sonar`. `on_sweep`, when set, is
+/// called after each sweep with the sweeps done and the total.
 [[nodiscard]] std::vector<SynthesizedBeam> SimulateScene(
     const Scene& scene, const RayTracer& tracer, std::uint64_t seed, int threads,
     const std::function<void(std::size_t done, std::size_t total)>& on_sweep = {});
