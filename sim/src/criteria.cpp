@@ -9,29 +9,24 @@
 namespace sonarbench::sim {
 namespace {
 
-std::string Number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.4g", value);
-  return text;
-}
-
 double Count(std::size_t n) { return static_cast<double>(n); }
 
 std::string ExpectedText(const Criterion& c) {
   std::string text;
   if (c.min && c.max) {
-    text = "in [" + Number(*c.min) + ", " + Number(*c.max) + "]";
+    text = "in [" + FormatMetricValue(*c.min) + ", " + FormatMetricValue(*c.max) + "]";
   } else if (c.min) {
-    text = ">= " + Number(*c.min);
+    text = ">= " + FormatMetricValue(*c.min);
   } else {
-    text = "<= " + Number(*c.max);
+    text = "<= " + FormatMetricValue(*c.max);
   }
   if (c.acceptable_min || c.acceptable_max) {
     text += " (acceptable " +
             (c.acceptable_min && c.acceptable_max
-                 ? "in [" + Number(*c.acceptable_min) + ", " + Number(*c.acceptable_max) + "]"
-             : c.acceptable_min ? ">= " + Number(*c.acceptable_min)
-                                : "<= " + Number(*c.acceptable_max)) +
+                 ? "in [" + FormatMetricValue(*c.acceptable_min) + ", " +
+                       FormatMetricValue(*c.acceptable_max) + "]"
+             : c.acceptable_min ? ">= " + FormatMetricValue(*c.acceptable_min)
+                                : "<= " + FormatMetricValue(*c.acceptable_max)) +
             ")";
   }
   return text;
@@ -42,6 +37,12 @@ bool Within(double value, const std::optional<double>& lo, const std::optional<d
 }
 
 }  // namespace
+
+std::string FormatMetricValue(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", value);
+  return text;
+}
 
 const std::vector<MetricInfo>& KnownMetrics() {
   static const std::vector<MetricInfo> metrics = {
@@ -149,9 +150,11 @@ Criteria ReadCriteria(YamlReader& node, const std::vector<std::string>& mesh_nam
     if (c.acceptable_min && !c.min) entry.Fail("acceptable_min", "'min' beside it");
     if (c.acceptable_max && !c.max) entry.Fail("acceptable_max", "'max' beside it");
     if (c.acceptable_min && c.min && *c.acceptable_min > *c.min)
-      entry.Fail("acceptable_min", "a value <= min (" + Number(*c.min) + "), a wider band");
+      entry.Fail("acceptable_min",
+                 "a value <= min (" + FormatMetricValue(*c.min) + "), a wider band");
     if (c.acceptable_max && c.max && *c.acceptable_max < *c.max)
-      entry.Fail("acceptable_max", "a value >= max (" + Number(*c.max) + "), a wider band");
+      entry.Fail("acceptable_max",
+                 "a value >= max (" + FormatMetricValue(*c.max) + "), a wider band");
     criteria.metrics.push_back(c);
   }
   metrics.RejectUnknownKeys();
@@ -204,8 +207,8 @@ Verdict Evaluate(const Criteria& criteria, const MapMetrics& metrics) {
 }
 
 std::string Describe(const CriterionResult& r) {
-  return r.criterion.metric + " = " + Number(r.actual) + ", expected " + r.expected + ", margin " +
-         Number(r.margin) + " (" + StatusName(r.status) + ")";
+  return r.criterion.metric + " = " + FormatMetricValue(r.actual) + ", expected " + r.expected +
+         ", margin " + FormatMetricValue(r.margin) + " (" + StatusName(r.status) + ")";
 }
 
 }  // namespace sonarbench::sim

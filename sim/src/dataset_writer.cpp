@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -262,15 +261,13 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   const RayTracer tracer(meshes);
   const std::size_t beam_count = ScenarioBeamCount(scene);
   const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
-  const Shard& shard = options.shard;
-
-  std::size_t mine = 0;
-  for (std::size_t s = static_cast<std::size_t>(shard.index); s < summary.sweeps_total;
-       s += static_cast<std::size_t>(shard.count))
-    ++mine;
+  const auto first_sweep = static_cast<std::size_t>(options.shard.index);
+  const auto stride = static_cast<std::size_t>(options.shard.count);
+  const std::size_t mine = first_sweep < summary.sweeps_total
+                               ? (summary.sweeps_total - first_sweep + stride - 1) / stride
+                               : 0;
   std::size_t handled = 0;
-  for (std::size_t s = static_cast<std::size_t>(shard.index); s < summary.sweeps_total;
-       s += static_cast<std::size_t>(shard.count)) {
+  for (std::size_t s = first_sweep; s < summary.sweeps_total; s += stride) {
     if (SweepComplete(root, s, true)) {
       ++summary.sweeps_skipped;
     } else {

@@ -94,7 +94,7 @@ json RunItem(const Scene& scene, const StudyInputs& in, const StudyItem& item, i
   const MapMetrics m = ScoreMap(mapper.tree(), in.truth, in.observable);
 
   std::size_t wedge = 0, undecided = 0, covered = 0, visited = 0, visits = 0, outside = 0;
-  double lower_num = 0, lower_den = 0, upper_num = 0, upper_den = 0;
+  double lower_num = 0, upper_num = 0;
   for (const auto& b : in.coverage_beams) {
     const BeamCoverage c =
         MeasureBeamCoverage(b.beam, scene.sensor.geometry, b.range_m, item.rays_horizontal,
@@ -106,17 +106,15 @@ json RunItem(const Scene& scene, const StudyInputs& in, const StudyItem& item, i
     visits += c.visits;
     outside += c.visited_outside;
     lower_num += c.coverage_lower * static_cast<double>(c.wedge_cells);
-    lower_den += static_cast<double>(c.wedge_cells);
     upper_num += c.coverage_upper * static_cast<double>(c.wedge_cells);
-    upper_den += static_cast<double>(c.wedge_cells);
   }
   auto ratio = [](double n, double d) { return d == 0 ? 0.0 : n / d; };
   return {{"group", item.group},
           {"rays_horizontal", item.rays_horizontal},
           {"rays_vertical", item.rays_vertical},
           {"beam_coverage", ratio(static_cast<double>(covered), static_cast<double>(wedge))},
-          {"beam_coverage_lower", ratio(lower_num, lower_den)},
-          {"beam_coverage_upper", ratio(upper_num, upper_den)},
+          {"beam_coverage_lower", ratio(lower_num, static_cast<double>(wedge))},
+          {"beam_coverage_upper", ratio(upper_num, static_cast<double>(wedge))},
           {"wedge_cells", wedge},
           {"undecided_cells", undecided},
           {"covered_cells", covered},

@@ -135,12 +135,6 @@ std::string Seconds(double s) {
   return text;
 }
 
-std::string Number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.4g", value);
-  return text;
-}
-
 /// The images of a run, encoded once: written as files and embedded in the HTML report.
 struct Image {
   const char* file;
@@ -208,21 +202,22 @@ std::string ScenarioHtml(const Scene& scene, const ScenarioResult& result,
             "<th>status</th><th>optional</th></tr>\n";
     for (const CriterionResult& r : v.results) {
       html << "<tr class=\"" << StatusName(r.status) << "\"><td>" << HtmlEscape(r.criterion.metric)
-           << "</td><td class=\"n\">" << Number(r.actual) << "</td><td>" << HtmlEscape(r.expected)
-           << "</td><td class=\"n\">" << Number(r.margin) << "</td><td>" << StatusName(r.status)
-           << "</td><td>" << (r.criterion.optional ? "yes" : "no") << "</td></tr>\n";
+           << "</td><td class=\"n\">" << FormatMetricValue(r.actual) << "</td><td>"
+           << HtmlEscape(r.expected) << "</td><td class=\"n\">" << FormatMetricValue(r.margin)
+           << "</td><td>" << StatusName(r.status) << "</td><td>"
+           << (r.criterion.optional ? "yes" : "no") << "</td></tr>\n";
     }
     html << "</table>\n";
   }
 
   html << "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>value</th><th>definition</th></tr>\n";
   for (const MetricInfo& info : KnownMetrics()) {
-    html << "<tr><td>" << info.name << "</td><td class=\"n\">" << Number(info.value(m))
+    html << "<tr><td>" << info.name << "</td><td class=\"n\">" << FormatMetricValue(info.value(m))
          << "</td><td>" << HtmlEscape(info.definition) << "</td></tr>\n";
   }
   for (const auto& r : m.per_mesh) {
     html << "<tr><td>" << kMeshRecallPrefix << HtmlEscape(r.name) << "</td><td class=\"n\">"
-         << Number(r.recall) << "</td><td>" << r.observed_occupied_cells << " of "
+         << FormatMetricValue(r.recall) << "</td><td>" << r.observed_occupied_cells << " of "
          << r.observable_cells << " observable cells of this mesh mapped occupied</td></tr>\n";
   }
   html << "</table>\n<p>Counts: " << m.truth_cells << " surface cells, " << m.observable_cells

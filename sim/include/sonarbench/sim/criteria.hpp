@@ -78,6 +78,9 @@ struct Verdict {
 
 [[nodiscard]] Verdict Evaluate(const Criteria& criteria, const MapMetrics& metrics);
 
+/// A metric value as reports print it: four significant digits ("%.4g").
+[[nodiscard]] std::string FormatMetricValue(double value);
+
 /// "metric = actual, expected ..., margin ..." for terminal output and reports.
 [[nodiscard]] std::string Describe(const CriterionResult& result);
 
