@@ -47,6 +47,7 @@ BatchStats Mapper::IntegrateSweeps(
 
 BatchStats Mapper::Integrate(std::span<const Beam> beams,
                              std::span<const std::vector<double>> obstacles) {
+  stale_ = true;
   if (config_.key_set == KeySetKind::kStd) {
     return IntegrateBatch<KeySet>(*tree_, beams, obstacles, directions_, free_range_m_, threads_);
   }
@@ -66,14 +67,14 @@ void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out) {
 
 void Mapper::WriteBinary(const std::string& path) const {
   WriteFileAtomically(path, [&](std::ostream& out) {
-    WriteOctomapBinary(*tree_, out);
+    WriteOctomapBinary(tree(), out);
     if (!out) throw std::runtime_error(path + ": OctoMap could not write");
   });
 }
 
 void Mapper::WriteFull(const std::string& path) const {
   WriteFileAtomically(path, [&](std::ostream& out) {
-    if (!tree_->write(out)) throw std::runtime_error(path + ": OctoMap could not write");
+    if (!tree().write(out)) throw std::runtime_error(path + ": OctoMap could not write");
   });
 }
 

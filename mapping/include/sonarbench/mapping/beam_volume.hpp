@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "sonarbench/mapping/beam.hpp"
+#include "sonarbench/mapping/beam_raster.hpp"
 #include "sonarbench/mapping/key_set.hpp"
-#include "sonarbench/mapping/ray_keys.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
 namespace sonarbench::mapping {
@@ -28,34 +28,31 @@ using KeySet = std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHas
                                                              int rays_vertical);
 
 /// The cells a batch of beams marks, in a set type `Set` with `insert(key)`, `erase(key)` and
-/// iteration (std::unordered_set, OpenKeySet, absl::flat_hash_set, ...).
+/// iteration (std::unordered_set, OpenKeySet, absl::flat_hash_set, ...), and the scratch space
+/// one thread needs to cast beams into them.
 template <typename Set>
 struct BasicBeamCells {
   Set free;
   Set occupied;
   /// Cell visits by all rays, repeats included (the paper's section 3.2 redundancy).
   std::size_t visits = 0;
-  /// The free keys inserted last, direct-mapped by hash: neighbouring rays of a beam cross the
-  /// same cells in the same order, so most repeats are caught here, in L1, before the set.
-  std::array<std::uint64_t, 2048> recent_free = MakeEmptyRecent();
+  /// Distinct free cells of each beam, summed over the beams.
+  std::size_t beam_free_cells = 0;
+  /// Walks a beam's rays and keeps each of its cells once (see BeamRaster).
+  BeamRaster raster;
+  std::vector<octomap::point3d> ends;
+  std::vector<std::uint64_t> beam_free;
+  /// Per obstacle, the previous ray's occupied cell (packed), or kNoKey.
+  std::vector<std::uint64_t> previous_occupied;
+  static constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
 
-  /// Inserts a free key (packed) unless the filter saw it (then the set already holds it).
+  /// Inserts a free key (packed).
   void InsertFree(std::uint64_t packed) {
-    std::uint64_t& slot = recent_free[(packed * 0x9e3779b97f4a7c15ULL) >> 53];
-    if (slot == packed) return;
-    slot = packed;
     if constexpr (requires(Set & s) { s.insert_packed(packed); }) {
       free.insert_packed(packed);
     } else {
       free.insert(UnpackKey(packed));
     }
-  }
-
- private:
-  static std::array<std::uint64_t, 2048> MakeEmptyRecent() {
-    std::array<std::uint64_t, 2048> a;
-    a.fill(~std::uint64_t{0});  // no packed key is all ones
-    return a;
   }
 };
 using BeamCells = BasicBeamCells<KeySet>;
@@ -64,7 +61,8 @@ using BeamCells = BasicBeamCells<KeySet>;
 /// Occupied cells are the cells of each ray's end point at an obstacle range, so the ends lie on
 /// the true spherical wedge (|end - origin| = range exactly; the seed's code put them up to 4.4%
 /// too far at the edges); free cells are those each ray crosses before the first obstacle, or
-/// out to `free_range_m` without one (0 = clear nothing). `directions` are from
+/// out to `free_range_m` without one (0 = clear nothing): OctoMap's computeRayKeys cells for
+/// each ray, each distinct cell of the beam inserted into the set once. `directions` are from
 /// BeamRayDirections. Occupied does not yet win over free here: see ResolveConflicts.
 template <typename Set>
 void CastBeam(const octomap::OcTree& tree, const Beam& beam,
@@ -81,24 +79,29 @@ void CastBeam(const octomap::OcTree& tree, const Beam& beam,
     return octomap::point3d(static_cast<float>(v.x()), static_cast<float>(v.y()),
                             static_cast<float>(v.z()));
   };
-  const octomap::point3d origin_point = to_point(origin);
+  cells.ends.clear();
+  // Neighbouring rays mostly end in the same cell: a repeat of the previous ray's cell at the
+  // same obstacle is not inserted again.
+  cells.previous_occupied.assign(obstacle_ranges_m.size(), BasicBeamCells<Set>::kNoKey);
   for (const Eigen::Vector3d& direction : directions) {
     const Eigen::Vector3d d_world = R_world_beam * direction;
     // The cells crossed before the end point's cell, which is left for the occupied update (or,
     // without an obstacle, for the next beam).
-    ForEachRayKey(tree, origin_point, to_point(origin + free_end_m * d_world),
-                  [&cells](std::uint64_t packed) {
-                    ++cells.visits;
-                    cells.InsertFree(packed);
-                  });
-    for (const double range : obstacle_ranges_m) {
+    cells.ends.push_back(to_point(origin + free_end_m * d_world));
+    for (std::size_t k = 0; k < obstacle_ranges_m.size(); ++k) {
       octomap::OcTreeKey key;
-      if (tree.coordToKeyChecked(to_point(origin + range * d_world), key)) {
-        cells.occupied.insert(key);
+      if (tree.coordToKeyChecked(to_point(origin + obstacle_ranges_m[k] * d_world), key)) {
         ++cells.visits;
+        if (PackKey(key) == cells.previous_occupied[k]) continue;
+        cells.occupied.insert(key);
+        cells.previous_occupied[k] = PackKey(key);
       }
     }
   }
+  cells.beam_free.clear();
+  cells.visits += cells.raster.Trace(tree, to_point(origin), cells.ends, cells.beam_free);
+  cells.beam_free_cells += cells.beam_free.size();
+  for (const std::uint64_t packed : cells.beam_free) cells.InsertFree(packed);
 }
 
 /// Occupied wins over free within one update: removes from `cells.free` every occupied key.

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -35,30 +36,52 @@ struct BatchStats {
   std::size_t ray_casts = 0;
   /// Cell visits by all rays, repeats included.
   std::size_t cell_visits = 0;
+  /// Distinct free cells of each beam, summed over the beams: what goes into the key sets.
+  std::size_t beam_free_cells = 0;
   /// Distinct cells updated free / occupied.
   std::size_t free_cells = 0;
   std::size_t occupied_cells = 0;
+  /// Wall time [s] of the stages: ray casting, merging the threads' sets (occupied winning), and
+  /// sorting and applying the updates.
+  double cast_s = 0.0;
+  double merge_s = 0.0;
+  double update_s = 0.0;
 
   BatchStats& operator+=(const BatchStats& o) {
     beams += o.beams;
     beams_with_obstacle += o.beams_with_obstacle;
     ray_casts += o.ray_casts;
     cell_visits += o.cell_visits;
+    beam_free_cells += o.beam_free_cells;
     free_cells += o.free_cells;
     occupied_cells += o.occupied_cells;
+    cast_s += o.cast_s;
+    merge_s += o.merge_s;
+    update_s += o.update_s;
     return *this;
   }
 };
 
+/// Brings a tree that IntegrateBatch updated up to date for reading and writing: OctoMap's node
+/// count, and the inner nodes' occupancy (the maximum of their children's). Updates leave both
+/// stale (lazy evaluation, no pruning): neither changes how a later update goes, so this is
+/// needed once after the last batch, not after each.
+inline void FinishUpdates(MapTree& tree) {
+  tree.RecountNodes();
+  tree.updateInnerOccupancy();
+}
+
 /// Casts the rays of a batch of beams on `threads` threads, each into its own key sets of type
 /// `Set`, merges the sets (no lock per key), lets occupied win over free, and applies one
 /// log-odds update per cell. The result does not depend on `threads` or on `Set`: a set's content
-/// does not depend on insertion order, and each cell gets exactly one update.
+/// does not depend on insertion order, and each cell gets exactly one update. Call FinishUpdates
+/// before reading the tree.
 template <typename Set>
 BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
                           std::span<const std::vector<double>> obstacles,
                           std::span<const Eigen::Vector3d> directions, double free_range_m,
                           int threads) {
+  const double start = omp_get_wtime();
   std::vector<BasicBeamCells<Set>> per_thread(static_cast<std::size_t>(threads));
   const auto count = static_cast<std::int64_t>(beams.size());
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 4)
@@ -67,6 +90,7 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
     CastBeam(tree, beams[i], directions, obstacles[i], free_range_m,
              per_thread[static_cast<std::size_t>(omp_get_thread_num())]);
   }
+  const double cast_done = omp_get_wtime();
   BasicBeamCells<Set> merged = std::move(per_thread.front());
   for (std::size_t t = 1; t < per_thread.size(); ++t) {
     if constexpr (requires(Set & s, const Set& o) { s.merge(o); }) {
@@ -77,47 +101,56 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
       merged.occupied.insert(per_thread[t].occupied.begin(), per_thread[t].occupied.end());
     }
     merged.visits += per_thread[t].visits;
+    merged.beam_free_cells += per_thread[t].beam_free_cells;
   }
   ResolveConflicts(merged);
-  // Updates in Morton (octree) order: consecutive updates descend the same branches, which stay
-  // in cache. The order does not change the result: each cell is updated once.
-  std::vector<std::pair<std::uint64_t, octomap::OcTreeKey>> updates;
-  updates.reserve(merged.free.size() + merged.occupied.size());
-  for (const auto& key : merged.free) updates.emplace_back(MortonCode(key) << 1, key);
-  for (const auto& key : merged.occupied) updates.emplace_back((MortonCode(key) << 1) | 1, key);
-  std::sort(updates.begin(), updates.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
-  // The Morton code's top three bits name the root's child (octant) a key lies in, so the sorted
-  // updates fall into up to eight runs of disjoint subtrees, updated in parallel. The first key
-  // of each run is updated serially, which creates the root and that child: afterwards no update
-  // touches a node another thread may create. OctoMap's node count is then recounted.
-  std::vector<std::size_t> starts;
-  for (std::size_t i = 0; i < updates.size(); ++i) {
-    if (i == 0 || (updates[i].first >> 46) != (updates[i - 1].first >> 46)) starts.push_back(i);
+  const double merge_done = omp_get_wtime();
+  // The updates fall into the root's eight octants (the top bit of each key coordinate), whose
+  // subtrees are disjoint: each octant's updates are sorted in octree (Morton) order and applied
+  // by one thread, walking only the part of each key's path that differs from the previous
+  // key's. The first update of each octant is applied first, serially: it creates the root and
+  // that octant's node, so no two threads create the same node. Neither the order nor the threads
+  // change the result: each cell is updated once. OctoMap's node count and the inner nodes are left
+  // for FinishUpdates.
+  std::array<std::vector<std::pair<std::uint64_t, octomap::OcTreeKey>>, 8> octants;
+  auto add = [&octants](const octomap::OcTreeKey& key, std::uint64_t occupied) {
+    const std::uint64_t code = MortonCode(key);
+    octants[code >> 45].emplace_back((code << 1) | occupied, key);
+  };
+  for (const auto& key : merged.free) add(key, 0);
+  for (const auto& key : merged.occupied) add(key, 1);
+  const float log_odds[2] = {tree.getProbMissLog(), tree.getProbHitLog()};
+  auto key_of = [](const auto& updates) {
+    return [&updates](std::size_t i) { return updates[i].second; };
+  };
+  auto log_odds_of = [&log_odds](const auto& updates) {
+    return [&updates, &log_odds](std::size_t i) { return log_odds[updates[i].first & 1]; };
+  };
+  for (auto& updates : octants) {
+    if (updates.empty()) continue;
+    tree.UpdateLeavesInOrder(1, key_of(updates), log_odds_of(updates));
+    updates.front() = updates.back();
+    updates.pop_back();
   }
-  starts.push_back(updates.size());
-  for (std::size_t r = 0; r + 1 < starts.size(); ++r) {
-    const auto& [code, key] = updates[starts[r]];
-    tree.updateNode(key, (code & 1) != 0, /*lazy_eval=*/true);
-  }
-  const auto runs = static_cast<std::int64_t>(starts.size()) - 1;
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
-  for (std::int64_t r = 0; r < runs; ++r) {
-    for (std::size_t i = starts[static_cast<std::size_t>(r)] + 1;
-         i < starts[static_cast<std::size_t>(r) + 1]; ++i) {
-      tree.updateNode(updates[i].second, (updates[i].first & 1) != 0, /*lazy_eval=*/true);
-    }
+  for (int o = 0; o < 8; ++o) {
+    auto& updates = octants[static_cast<std::size_t>(o)];
+    std::sort(updates.begin(), updates.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    tree.UpdateLeavesInOrder(updates.size(), key_of(updates), log_odds_of(updates));
   }
-  tree.RecountNodes();
-  tree.updateInnerOccupancy();
 
   BatchStats stats;
   stats.beams = beams.size();
   for (const auto& o : obstacles) stats.beams_with_obstacle += o.empty() ? 0 : 1;
   stats.ray_casts = beams.size() * directions.size();
   stats.cell_visits = merged.visits;
+  stats.beam_free_cells = merged.beam_free_cells;
   stats.free_cells = merged.free.size();
   stats.occupied_cells = merged.occupied.size();
+  stats.cast_s = cast_done - start;
+  stats.merge_s = merge_done - cast_done;
+  stats.update_s = omp_get_wtime() - merge_done;
   return stats;
 }
 

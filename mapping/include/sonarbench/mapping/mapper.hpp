@@ -41,7 +41,14 @@ class Mapper {
   /// The same, with obstacle ranges already detected (one list per beam).
   BatchStats Integrate(std::span<const Beam> beams, std::span<const std::vector<double>> obstacles);
 
-  [[nodiscard]] const octomap::OcTree& tree() const { return *tree_; }
+  /// The map, brought up to date (FinishUpdates) if a batch was integrated since the last call.
+  [[nodiscard]] const octomap::OcTree& tree() const {
+    if (stale_) {
+      FinishUpdates(*tree_);
+      stale_ = false;
+    }
+    return *tree_;
+  }
   [[nodiscard]] const MapperConfig& config() const { return config_; }
 
   /// Writes the map as an OctoMap binary `.bt` file (maximum-likelihood occupancy), atomically.
@@ -56,6 +63,8 @@ class Mapper {
   int threads_ = 1;
   std::vector<Eigen::Vector3d> directions_;
   std::unique_ptr<MapTree> tree_;
+  /// Whether the tree's node count and inner nodes lag its leaves (see FinishUpdates).
+  mutable bool stale_ = false;
 };
 
 }  // namespace sonarbench::mapping

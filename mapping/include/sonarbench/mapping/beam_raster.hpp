@@ -1,0 +1,63 @@
+#pragma once
+
+#include <octomap/OcTree.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "sonarbench/mapping/key_set.hpp"
+#include "sonarbench/mapping/ray_keys.hpp"
+
+namespace sonarbench::mapping {
+
+/// Collects the distinct cells that many rays from one origin cross: the free cells of one beam.
+///
+/// The rays are OctoMap's DDA (ForEachRayKey's cells, exactly). Each visited cell sets a mark in
+/// a byte array over the box of the beam's cells; a cell is reported when its mark was clear.
+/// The seed paper's section 3.2 notes that H×V rays visit the same cells many times (here ≈46
+/// visits per distinct cell of a beam): the marks absorb those repeats, and only a beam's
+/// distinct cells go on to the key set. On processors with AVX-512 the walks run eight at a
+/// time, one per vector lane, with masks instead of branches (the same arithmetic, so the same
+/// cells); elsewhere one after another. A beam whose box would exceed kMaxBoxCells (long range
+/// at fine resolution) is walked into a hash set instead; the cells are the same.
+///
+/// One BeamRaster per thread: it keeps its buffers between beams.
+class BeamRaster {
+ public:
+  /// kFastest uses the vector kernel where the processor has it; kPortable never does (tests
+  /// compare the two).
+  enum class Kernel { kFastest, kPortable };
+  explicit BeamRaster(Kernel kernel = Kernel::kFastest) : kernel_(kernel) {}
+
+  /// Whether this processor runs the AVX-512 kernel.
+  [[nodiscard]] static bool HasVectorKernel();
+
+  /// The largest box [cells] the marks cover (16 MiB, one byte per cell).
+  static constexpr std::uint64_t kMaxBoxCells = std::uint64_t{1} << 24;
+
+  /// Appends to `free_keys` (packed, see PackKey) each distinct cell that a segment from
+  /// `origin` to one of `ends` crosses before its end point's cell, once, in a fixed order.
+  /// Segments with a point outside the tree's key range are skipped, as ForEachRayKey does.
+  /// Returns the number of cell visits, repeats included.
+  std::size_t Trace(const octomap::OcTree& tree, const octomap::point3d& origin,
+                    std::span<const octomap::point3d> ends, std::vector<std::uint64_t>& free_keys);
+
+  /// Whether the last Trace() walked its rays one at a time (its box was too large).
+  [[nodiscard]] bool used_fallback() const { return used_fallback_; }
+
+ private:
+  std::size_t TraceOneByOne(const octomap::OcTree& tree, const octomap::point3d& origin,
+                            std::span<const octomap::point3d> ends,
+                            std::vector<std::uint64_t>& free_keys);
+
+  std::vector<RayWalk> walks_;
+  std::vector<std::uint8_t> marks_;     // one per cell of the box; all zero between calls
+  std::vector<std::uint64_t> touched_;  // cell indices whose bit was set, in order
+  OpenKeySet<> seen_;                   // the fallback's set
+  Kernel kernel_;
+  bool used_fallback_ = false;
+};
+
+}  // namespace sonarbench::mapping
