@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "sonarbench/mapping/beam_volume.hpp"
+#include "sonarbench/mapping/integrate.hpp"
 
 namespace sonarbench::mapping {
 namespace {
@@ -95,15 +96,24 @@ TEST(CastBeam, WithoutObstacleClearsToTheFreeRangeAndMarksNothingOccupied) {
   EXPECT_GE(on_axis, 19);
 }
 
-TEST(ResolveConflicts, OccupiedWinsOverFree) {
-  BeamCells cells;
-  const octomap::OcTreeKey a(1, 2, 3);
-  const octomap::OcTreeKey b(4, 5, 6);
-  cells.free = {a, b};
-  cells.occupied = {b};
-  ResolveConflicts(cells);
-  EXPECT_EQ(cells.free, KeySet{a});
-  EXPECT_EQ(cells.occupied, KeySet{b});
+// Two beams along +x in one batch: the far one's rays cross the near one's obstacle cells as
+// free. Occupied wins: those cells get one hit, whatever the thread count.
+TEST(IntegrateBatch, OccupiedWinsOverFreeWithinABatch) {
+  const SensorGeometry sensor;
+  const auto directions = BeamRayDirections(sensor, 1, 1);
+  const std::vector<Beam> beams(2);
+  const std::vector<std::vector<double>> obstacles{{1.02}, {2.02}};
+  for (const int threads : {1, 2}) {
+    MapTree tree(kResolution);
+    IntegrateBatch<KeySet>(tree, beams, obstacles, directions, 0.0, threads);
+    FinishUpdates(tree);
+    const octomap::OcTreeNode* near = tree.search(1.02, 0.0, 0.0);
+    ASSERT_NE(near, nullptr);
+    EXPECT_FLOAT_EQ(near->getLogOdds(), tree.getProbHitLog()) << threads << " threads";
+    const octomap::OcTreeNode* between = tree.search(1.5, 0.0, 0.0);
+    ASSERT_NE(between, nullptr);
+    EXPECT_FLOAT_EQ(between->getLogOdds(), tree.getProbMissLog()) << threads << " threads";
+  }
 }
 
 }  // namespace

@@ -64,8 +64,16 @@ Box MakeBox(std::span<const RayWalk> walks) {
   return box;
 }
 
+// One bit per cell of the box.
+bool IsMarked(const std::uint64_t* marks, std::uint64_t index) {
+  return ((marks[index >> 6] >> (index & 63)) & 1u) != 0;
+}
+void Mark(std::uint64_t* marks, std::uint64_t index) {
+  marks[index >> 6] |= std::uint64_t{1} << (index & 63);
+}
+
 // The portable kernel: one walk after another, each visit checked against the marks.
-std::size_t WalkPortable(std::span<const RayWalk> walks, const Box& box, std::uint8_t* marks,
+std::size_t WalkPortable(std::span<const RayWalk> walks, const Box& box, std::uint64_t* marks,
                          std::vector<std::uint64_t>& touched) {
   const std::uint64_t unit[3] = {std::uint64_t{1} << box.shift_x, std::uint64_t{1} << box.shift_y,
                                  1};
@@ -74,8 +82,8 @@ std::size_t WalkPortable(std::span<const RayWalk> walks, const Box& box, std::ui
     WalkRay(walk, box.Index(walk.origin_key), box.Index(walk.end_key), unit,
             [&](std::uint64_t index) {
               ++visits;
-              if (marks[index] == 0) {
-                marks[index] = 1;
+              if (!IsMarked(marks, index)) {
+                Mark(marks, index);
                 touched.push_back(index);
               }
             });
@@ -90,13 +98,15 @@ std::size_t WalkPortable(std::span<const RayWalk> walks, const Box& box, std::ui
 // for all eight with masks instead of branches (the same IEEE additions and comparisons, so the
 // same cells).
 __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWalk> walks,
-                                                          const Box& box, std::uint8_t* marks,
+                                                          const Box& box, std::uint64_t* marks,
                                                           std::vector<std::uint64_t>& touched) {
   // kGroups independent groups of eight walks step in turn: one group's step waits on its
   // previous step's comparisons (≈20 cycles), the others' fill that wait.
   constexpr std::size_t kGroups = 4;
   constexpr std::size_t kBatch = kGroups * kLanes;
   const std::int64_t unit[3] = {std::int64_t{1} << box.shift_x, std::int64_t{1} << box.shift_y, 1};
+  const __m512i low6 = _mm512_set1_epi64(63);
+  const __m512i one = _mm512_set1_epi64(1);
   std::size_t visits = 0;
   alignas(64) double lane_t[3][kBatch];
   alignas(64) double lane_delta[3][kBatch];
@@ -121,8 +131,8 @@ __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWal
     }
     // Every walk starts by visiting the origin's cell.
     const auto origin = static_cast<std::uint64_t>(lane_cell[0]);
-    if (marks[origin] == 0) {
-      marks[origin] = 1;
+    if (!IsMarked(marks, origin)) {
+      Mark(marks, origin);
       touched.push_back(origin);
     }
     visits += count;
@@ -163,19 +173,21 @@ __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWal
                                _mm512_cmp_pd_mask(tz[g], length, _CMP_GT_OQ));
         active[g] = active[g] & static_cast<__mmask8>(~done);
         any |= active[g];
-        // Most visits repeat a cell (≈46 per distinct cell of a beam): the lanes' marks are
-        // gathered at once (eight bytes from each cell's mark; the array has eight to spare at
-        // its end), and only lanes on an unmarked cell go on, one by one, to set it.
-        const __m512i seen = _mm512_mask_i64gather_epi64(_mm512_setzero_si512(), active[g], cell[g],
-                                                         static_cast<const void*>(marks), 1);
-        const __mmask8 fresh = active[g] & static_cast<__mmask8>(~_mm512_test_epi64_mask(
-                                               seen, _mm512_set1_epi64(0xff)));
+        // Most visits repeat a cell (≈70 per distinct cell of a beam): the words holding the
+        // lanes' marks are gathered at once, and only lanes on an unmarked cell go on, one by
+        // one, to set it.
+        const __m512i words = _mm512_mask_i64gather_epi64(_mm512_setzero_si512(), active[g],
+                                                          _mm512_maskz_srli_epi64(0xff, cell[g], 6),
+                                                          static_cast<const void*>(marks), 8);
+        const __m512i bits = _mm512_maskz_srlv_epi64(0xff, words, _mm512_and_si512(cell[g], low6));
+        const __mmask8 fresh =
+            active[g] & static_cast<__mmask8>(~_mm512_test_epi64_mask(bits, one));
         if (fresh != 0) {
           _mm512_store_si512(index, cell[g]);
           for (unsigned l = 0; l < kLanes; ++l) {
             // Two lanes may share a fresh cell: the mark is checked again.
-            if (((fresh >> l) & 1u) != 0 && marks[index[l]] == 0) {
-              marks[index[l]] = 1;
+            if (((fresh >> l) & 1u) != 0 && !IsMarked(marks, index[l])) {
+              Mark(marks, index[l]);
               touched.push_back(index[l]);
             }
           }
@@ -222,8 +234,8 @@ std::size_t BeamRaster::Trace(const octomap::OcTree& tree, const octomap::point3
     near_edge |= box.low[i] < 0 || static_cast<std::uint64_t>(box.low[i]) + extent[i] > 0x10000;
   }
   if (box.cells > kMaxBoxCells || near_edge) return TraceOneByOne(tree, origin, ends, free_keys);
-  if (marks_.size() < box.cells + 8) marks_.resize(box.cells + 8, 0);
-  std::uint8_t* const marks = marks_.data();
+  if (marks_.size() < box.cells / 64 + 1) marks_.resize(box.cells / 64 + 1, 0);
+  std::uint64_t* const marks = marks_.data();
   touched_.clear();
   std::size_t visits = 0;
 #ifdef SONARBENCH_HAVE_AVX512_KERNEL
@@ -238,9 +250,8 @@ std::size_t BeamRaster::Trace(const octomap::OcTree& tree, const octomap::point3
   free_keys.reserve(free_keys.size() + touched_.size());
   for (const std::uint64_t index : touched_) {
     free_keys.push_back(box.PackedKey(index));
-    marks[index] = 0;
+    marks[index >> 6] = 0;
   }
-  marks[0] = 0;
   return visits;
 }
 

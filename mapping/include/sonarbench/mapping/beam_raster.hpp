@@ -15,9 +15,9 @@ namespace sonarbench::mapping {
 /// Collects the distinct cells that many rays from one origin cross: the free cells of one beam.
 ///
 /// The rays are OctoMap's DDA (ForEachRayKey's cells, exactly). Each visited cell sets a mark in
-/// a byte array over the box of the beam's cells; a cell is reported when its mark was clear.
-/// The seed paper's section 3.2 notes that H×V rays visit the same cells many times (here ≈46
-/// visits per distinct cell of a beam): the marks absorb those repeats, and only a beam's
+/// a bitmap over the box of the beam's cells; a cell is reported when its mark was clear.
+/// The seed paper's section 3.2 notes that H×V rays visit the same cells many times (≈70 visits per
+/// distinct cell of a beam in the real tank log): the marks absorb those repeats, and only a beam's
 /// distinct cells go on to the key set. On processors with AVX-512 the walks run eight at a
 /// time, one per vector lane, with masks instead of branches (the same arithmetic, so the same
 /// cells); elsewhere one after another. A beam whose box would exceed kMaxBoxCells (long range
@@ -34,8 +34,8 @@ class BeamRaster {
   /// Whether this processor runs the AVX-512 kernel.
   [[nodiscard]] static bool HasVectorKernel();
 
-  /// The largest box [cells] the marks cover (16 MiB, one byte per cell).
-  static constexpr std::uint64_t kMaxBoxCells = std::uint64_t{1} << 24;
+  /// The largest box [cells] the marks cover (one bit per cell: 8 MiB).
+  static constexpr std::uint64_t kMaxBoxCells = std::uint64_t{1} << 26;
 
   /// Appends to `free_keys` (packed, see PackKey) each distinct cell that a segment from
   /// `origin` to one of `ends` crosses before its end point's cell, once, in a fixed order.
@@ -53,7 +53,7 @@ class BeamRaster {
                             std::vector<std::uint64_t>& free_keys);
 
   std::vector<RayWalk> walks_;
-  std::vector<std::uint8_t> marks_;     // one per cell of the box; all zero between calls
+  std::vector<std::uint64_t> marks_;    // one bit per cell of the box; all zero between calls
   std::vector<std::uint64_t> touched_;  // cell indices whose bit was set, in order
   OpenKeySet<> seen_;                   // the fallback's set
   Kernel kernel_;

@@ -63,7 +63,7 @@ using BeamCells = BasicBeamCells<KeySet>;
 /// too far at the edges); free cells are those each ray crosses before the first obstacle, or
 /// out to `free_range_m` without one (0 = clear nothing): OctoMap's computeRayKeys cells for
 /// each ray, each distinct cell of the beam inserted into the set once. `directions` are from
-/// BeamRayDirections. Occupied does not yet win over free here: see ResolveConflicts.
+/// BeamRayDirections. Occupied does not yet win over free here: IntegrateBatch resolves that.
 template <typename Set>
 void CastBeam(const octomap::OcTree& tree, const Beam& beam,
               std::span<const Eigen::Vector3d> directions,
@@ -102,12 +102,6 @@ void CastBeam(const octomap::OcTree& tree, const Beam& beam,
   cells.visits += cells.raster.Trace(tree, to_point(origin), cells.ends, cells.beam_free);
   cells.beam_free_cells += cells.beam_free.size();
   for (const std::uint64_t packed : cells.beam_free) cells.InsertFree(packed);
-}
-
-/// Occupied wins over free within one update: removes from `cells.free` every occupied key.
-template <typename Set>
-void ResolveConflicts(BasicBeamCells<Set>& cells) {
-  for (const auto& key : cells.occupied) cells.free.erase(key);
 }
 
 }  // namespace sonarbench::mapping

@@ -41,8 +41,8 @@ struct BatchStats {
   /// Distinct cells updated free / occupied.
   std::size_t free_cells = 0;
   std::size_t occupied_cells = 0;
-  /// Wall time [s] of the stages: ray casting, merging the threads' sets (occupied winning), and
-  /// sorting and applying the updates.
+  /// Wall time [s] of the stages: ray casting into the threads' sets, splitting the sets' cells
+  /// into octants, and per octant merging (occupied winning), sorting and applying the updates.
   double cast_s = 0.0;
   double merge_s = 0.0;
   double update_s = 0.0;
@@ -72,10 +72,10 @@ inline void FinishUpdates(MapTree& tree) {
 }
 
 /// Casts the rays of a batch of beams on `threads` threads, each into its own key sets of type
-/// `Set`, merges the sets (no lock per key), lets occupied win over free, and applies one
-/// log-odds update per cell. The result does not depend on `threads` or on `Set`: a set's content
-/// does not depend on insertion order, and each cell gets exactly one update. Call FinishUpdates
-/// before reading the tree.
+/// `Set`, merges the threads' cells (no lock per key), lets occupied win over free, and applies
+/// one log-odds update per cell. The result does not depend on `threads` or on `Set`: a set's
+/// content does not depend on insertion order, and each cell gets exactly one update. Call
+/// FinishUpdates before reading the tree.
 template <typename Set>
 BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
                           std::span<const std::vector<double>> obstacles,
@@ -91,63 +91,78 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
              per_thread[static_cast<std::size_t>(omp_get_thread_num())]);
   }
   const double cast_done = omp_get_wtime();
-  BasicBeamCells<Set> merged = std::move(per_thread.front());
-  for (std::size_t t = 1; t < per_thread.size(); ++t) {
-    if constexpr (requires(Set & s, const Set& o) { s.merge(o); }) {
-      merged.free.merge(per_thread[t].free);
-      merged.occupied.merge(per_thread[t].occupied);
-    } else {
-      merged.free.insert(per_thread[t].free.begin(), per_thread[t].free.end());
-      merged.occupied.insert(per_thread[t].occupied.begin(), per_thread[t].occupied.end());
-    }
-    merged.visits += per_thread[t].visits;
-    merged.beam_free_cells += per_thread[t].beam_free_cells;
+  // The threads' cells are merged without a lock per key: each thread splits its own into the
+  // root's eight octants (the top bit of each key coordinate), whose subtrees are disjoint; then
+  // one thread per octant sorts that octant's cells from all threads in octree (Morton) order,
+  // where a cell's copies meet, keeps one (occupied winning over free), and applies the updates,
+  // walking only the part of each key's path that differs from the previous key's. The root
+  // and each octant's path to one of its keys are created first, serially, so no two threads
+  // create the same node. Neither the order nor the threads change the result: each cell is
+  // updated once. OctoMap's node count and the inner nodes are left for FinishUpdates.
+  using Update = std::pair<std::uint64_t, octomap::OcTreeKey>;  // Morton code << 1 | occupied
+  std::vector<std::array<std::vector<Update>, 8>> split(per_thread.size());
+#pragma omp parallel for num_threads(threads) schedule(static, 1)
+  for (int t = 0; t < threads; ++t) {
+    auto& octants = split[static_cast<std::size_t>(t)];
+    const auto& cells = per_thread[static_cast<std::size_t>(t)];
+    auto add = [&octants](const octomap::OcTreeKey& key, std::uint64_t occupied) {
+      const std::uint64_t code = MortonCode(key);
+      octants[code >> 45].emplace_back((code << 1) | occupied, key);
+    };
+    for (const auto& key : cells.free) add(key, 0);
+    for (const auto& key : cells.occupied) add(key, 1);
   }
-  ResolveConflicts(merged);
   const double merge_done = omp_get_wtime();
-  // The updates fall into the root's eight octants (the top bit of each key coordinate), whose
-  // subtrees are disjoint: each octant's updates are sorted in octree (Morton) order and applied
-  // by one thread, walking only the part of each key's path that differs from the previous
-  // key's. The first update of each octant is applied first, serially: it creates the root and
-  // that octant's node, so no two threads create the same node. Neither the order nor the threads
-  // change the result: each cell is updated once. OctoMap's node count and the inner nodes are left
-  // for FinishUpdates.
-  std::array<std::vector<std::pair<std::uint64_t, octomap::OcTreeKey>>, 8> octants;
-  auto add = [&octants](const octomap::OcTreeKey& key, std::uint64_t occupied) {
-    const std::uint64_t code = MortonCode(key);
-    octants[code >> 45].emplace_back((code << 1) | occupied, key);
-  };
-  for (const auto& key : merged.free) add(key, 0);
-  for (const auto& key : merged.occupied) add(key, 1);
-  const float log_odds[2] = {tree.getProbMissLog(), tree.getProbHitLog()};
-  auto key_of = [](const auto& updates) {
-    return [&updates](std::size_t i) { return updates[i].second; };
-  };
-  auto log_odds_of = [&log_odds](const auto& updates) {
-    return [&updates, &log_odds](std::size_t i) { return log_odds[updates[i].first & 1]; };
-  };
-  for (auto& updates : octants) {
-    if (updates.empty()) continue;
-    tree.UpdateLeavesInOrder(1, key_of(updates), log_odds_of(updates));
-    updates.front() = updates.back();
-    updates.pop_back();
+  for (unsigned o = 0; o < 8; ++o) {
+    for (const auto& octants : split) {
+      if (octants[o].empty()) continue;
+      tree.CreatePath(octants[o].front().second);
+      break;
+    }
   }
+  const float log_odds[2] = {tree.getProbMissLog(), tree.getProbHitLog()};
+  std::array<std::size_t, 8> free_cells{};
+  std::array<std::size_t, 8> occupied_cells{};
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
   for (int o = 0; o < 8; ++o) {
-    auto& updates = octants[static_cast<std::size_t>(o)];
+    std::vector<Update> updates;
+    for (auto& octants : split) {
+      auto& part = octants[static_cast<std::size_t>(o)];
+      updates.insert(updates.end(), part.begin(), part.end());
+      std::vector<Update>().swap(part);
+    }
     std::sort(updates.begin(), updates.end(),
-              [](const auto& a, const auto& b) { return a.first < b.first; });
-    tree.UpdateLeavesInOrder(updates.size(), key_of(updates), log_odds_of(updates));
+              [](const Update& a, const Update& b) { return a.first < b.first; });
+    // A cell's copies are adjacent, free (0) before occupied (1): the last one is kept.
+    std::size_t kept = 0;
+    for (const Update& u : updates) {
+      if (kept > 0 && (updates[kept - 1].first >> 1) == (u.first >> 1)) {
+        updates[kept - 1] = u;
+      } else {
+        updates[kept++] = u;
+      }
+    }
+    updates.resize(kept);
+    for (const Update& u : updates) {
+      (u.first & 1 ? occupied_cells : free_cells)[static_cast<std::size_t>(o)] += 1;
+    }
+    tree.UpdateLeavesInOrder(
+        updates.size(), [&updates](std::size_t i) { return updates[i].second; },
+        [&updates, &log_odds](std::size_t i) { return log_odds[updates[i].first & 1]; });
   }
 
   BatchStats stats;
   stats.beams = beams.size();
   for (const auto& o : obstacles) stats.beams_with_obstacle += o.empty() ? 0 : 1;
   stats.ray_casts = beams.size() * directions.size();
-  stats.cell_visits = merged.visits;
-  stats.beam_free_cells = merged.beam_free_cells;
-  stats.free_cells = merged.free.size();
-  stats.occupied_cells = merged.occupied.size();
+  for (const auto& cells : per_thread) {
+    stats.cell_visits += cells.visits;
+    stats.beam_free_cells += cells.beam_free_cells;
+  }
+  for (unsigned o = 0; o < 8; ++o) {
+    stats.free_cells += free_cells[o];
+    stats.occupied_cells += occupied_cells[o];
+  }
   stats.cast_s = cast_done - start;
   stats.merge_s = merge_done - cast_done;
   stats.update_s = omp_get_wtime() - merge_done;

@@ -20,6 +20,13 @@ class MapTree : public octomap::OcTree {
     size_changed = true;
   }
 
+  /// Creates the root and the nodes on the path to `key`'s leaf, if missing, without changing
+  /// a value (a new leaf holds log-odds 0 until its update; adding 0 changes no value).
+  void CreatePath(const octomap::OcTreeKey& key) {
+    UpdateLeavesInOrder(
+        1, [&key](std::size_t) { return key; }, [](std::size_t) { return 0.0f; });
+  }
+
   /// Adds `log_odds(i)` to the leaf of `key(i)` for i in [0, count), creating missing nodes: the
   /// same tree as updateNode(key, log_odds, /*lazy_eval=*/true) for each in turn (OctoMap's early
   /// return at a clamped leaf only skips an update that clamping would undo). The keys must be
