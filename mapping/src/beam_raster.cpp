@@ -1,7 +1,6 @@
 #include "sonarbench/mapping/beam_raster.hpp"
 
 #include <algorithm>
-#include <array>
 #include <bit>
 
 #if defined(__x86_64__)
@@ -10,8 +9,6 @@
 
 namespace sonarbench::mapping {
 namespace {
-
-constexpr std::size_t kLanes = 8;
 
 // The box of cells the rays may visit, and the bitmap index of a cell in it: x, y and z offsets
 // from the box's low corner, each in a power-of-two field, so a step along an axis adds a
@@ -93,6 +90,8 @@ std::size_t WalkPortable(std::span<const RayWalk> walks, const Box& box, std::ui
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #define SONARBENCH_HAVE_AVX512_KERNEL 1
+
+constexpr std::size_t kLanes = 8;  // 64-bit lanes of an AVX-512 vector
 
 // The AVX-512 kernel: eight walks side by side, one per 64-bit lane, each step of WalkRay done
 // for all eight with masks instead of branches (the same IEEE additions and comparisons, so the
