@@ -177,8 +177,8 @@ int Main(int argc, char** argv) {
   std::printf(
       "distinct free cells per beam, summed: %zu (%.1f visits each)\n", totals.beam_free_cells,
       static_cast<double>(totals.cell_visits) / static_cast<double>(totals.beam_free_cells));
-  std::printf("stages of '%s' (last run): cast %.2f s, merge %.2f s, update %.2f s\n",
-              variants[4].name.c_str(), totals.cast_s, totals.merge_s, totals.update_s);
+  std::printf("stages of '%s' (last run): cast %.2f s, split %.2f s, update %.2f s\n",
+              variants[4].name.c_str(), totals.cast_s, totals.split_s, totals.update_s);
   return 0;
 }
 

@@ -232,7 +232,7 @@ std::size_t BeamRaster::Trace(const octomap::OcTree& tree, const octomap::point3
   for (unsigned i = 0; i < 3; ++i) {
     near_edge |= box.low[i] < 0 || static_cast<std::uint64_t>(box.low[i]) + extent[i] > 0x10000;
   }
-  if (box.cells > kMaxBoxCells || near_edge) return TraceOneByOne(tree, origin, ends, free_keys);
+  if (box.cells > kMaxBoxCells || near_edge) return TraceOneByOne(free_keys);
   if (marks_.size() < box.cells / 64 + 1) marks_.resize(box.cells / 64 + 1, 0);
   std::uint64_t* const marks = marks_.data();
   touched_.clear();
@@ -254,17 +254,16 @@ std::size_t BeamRaster::Trace(const octomap::OcTree& tree, const octomap::point3
   return visits;
 }
 
-std::size_t BeamRaster::TraceOneByOne(const octomap::OcTree& tree, const octomap::point3d& origin,
-                                      std::span<const octomap::point3d> ends,
-                                      std::vector<std::uint64_t>& free_keys) {
+std::size_t BeamRaster::TraceOneByOne(std::vector<std::uint64_t>& free_keys) {
   used_fallback_ = true;
   seen_.clear();
   std::size_t visits = 0;
-  for (const octomap::point3d& end : ends) {
-    ForEachRayKey(tree, origin, end, [&](std::uint64_t packed) {
-      ++visits;
-      if (seen_.insert_packed(packed)) free_keys.push_back(packed);
-    });
+  for (const RayWalk& walk : walks_) {
+    WalkRay(walk, PackKey(walk.origin_key), PackKey(walk.end_key), kPackedKeyUnit,
+            [&](std::uint64_t packed) {
+              ++visits;
+              if (seen_.insert_packed(packed)) free_keys.push_back(packed);
+            });
   }
   return visits;
 }

@@ -48,9 +48,8 @@ class BeamRaster {
   [[nodiscard]] bool used_fallback() const { return used_fallback_; }
 
  private:
-  std::size_t TraceOneByOne(const octomap::OcTree& tree, const octomap::point3d& origin,
-                            std::span<const octomap::point3d> ends,
-                            std::vector<std::uint64_t>& free_keys);
+  // The walks in walks_, one at a time, into a hash set.
+  std::size_t TraceOneByOne(std::vector<std::uint64_t>& free_keys);
 
   std::vector<RayWalk> walks_;
   std::vector<std::uint64_t> marks_;    // one bit per cell of the box; all zero between calls

@@ -44,7 +44,7 @@ struct BatchStats {
   /// Wall time [s] of the stages: ray casting into the threads' sets, splitting the sets' cells
   /// into octants, and per octant merging (occupied winning), sorting and applying the updates.
   double cast_s = 0.0;
-  double merge_s = 0.0;
+  double split_s = 0.0;
   double update_s = 0.0;
 
   BatchStats& operator+=(const BatchStats& o) {
@@ -56,7 +56,7 @@ struct BatchStats {
     free_cells += o.free_cells;
     occupied_cells += o.occupied_cells;
     cast_s += o.cast_s;
-    merge_s += o.merge_s;
+    split_s += o.split_s;
     update_s += o.update_s;
     return *this;
   }
@@ -112,7 +112,7 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
     for (const auto& key : cells.free) add(key, 0);
     for (const auto& key : cells.occupied) add(key, 1);
   }
-  const double merge_done = omp_get_wtime();
+  const double split_done = omp_get_wtime();
   for (unsigned o = 0; o < 8; ++o) {
     for (const auto& octants : split) {
       if (octants[o].empty()) continue;
@@ -164,8 +164,8 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
     stats.occupied_cells += occupied_cells[o];
   }
   stats.cast_s = cast_done - start;
-  stats.merge_s = merge_done - cast_done;
-  stats.update_s = omp_get_wtime() - merge_done;
+  stats.split_s = split_done - cast_done;
+  stats.update_s = omp_get_wtime() - split_done;
   return stats;
 }
 

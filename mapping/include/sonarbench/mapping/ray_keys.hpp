@@ -62,6 +62,10 @@ inline bool StartRayWalk(const octomap::OcTree& tree, const octomap::point3d& or
   return tx < ty ? (tx < tz ? 0u : 2u) : (ty < tz ? 1u : 2u);
 }
 
+/// One cell along x, y, z in a packed key (see PackKey).
+inline constexpr std::uint64_t kPackedKeyUnit[3] = {std::uint64_t{1} << 32, std::uint64_t{1} << 16,
+                                                    1};
+
 /// Walks the cells of `walk` after StartRayWalk returned true for a segment whose ends lie in
 /// different cells, in a cell numbering where one step along axis i adds `unit[i]` (modulo
 /// 2^64): calls `visit(number)` for the origin's cell, `start`, and every cell after it before
@@ -97,9 +101,7 @@ bool ForEachRayKey(const octomap::OcTree& tree, const octomap::point3d& origin,
   RayWalk walk;
   if (!StartRayWalk(tree, origin, end, walk)) return false;
   if (walk.origin_key == walk.end_key) return true;
-  // ± one cell along x, y, z in the packed key (wraps like key_type).
-  constexpr std::uint64_t kUnit[3] = {std::uint64_t{1} << 32, std::uint64_t{1} << 16, 1};
-  WalkRay(walk, PackKey(walk.origin_key), PackKey(walk.end_key), kUnit, visit);
+  WalkRay(walk, PackKey(walk.origin_key), PackKey(walk.end_key), kPackedKeyUnit, visit);
   return true;
 }
 
