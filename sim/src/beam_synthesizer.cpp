@@ -17,6 +17,10 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
 
 namespace {
 
+// Bistatic returns weaker than this (relative to a perfect reflector filling the beam) are not
+// worth the occlusion ray: 60 dB below the strongest echo, far under the AD window's 40 dB.
+constexpr double kNegligibleWeight = 1e-6;
+
 // cosⁿ, with the exponents scenes use most spared a pow().
 double CosPower(double c, double n) {
   if (n == 1.0) return c;
@@ -80,6 +84,66 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       out.echo_power[k] += power * overlap;
     }
   };
+  // The one-way pattern at a direction in the beam frame, or 0 outside the half-space ahead.
+  const Eigen::Matrix3d R_beam_world = R_world_beam.transpose();
+  auto one_way_pattern = [&](const Eigen::Vector3d& towards) {
+    const Eigen::Vector3d u = R_beam_world * towards;
+    if (u.x() <= 0.0) return 0.0;
+    const double theta = std::atan2(u.y(), u.x());
+    const double epsilon = std::asin(std::clamp(u.z(), -1.0, 1.0));
+    return std::exp(-0.5 * (k_h * theta * theta + k_v * epsilon * epsilon));
+  };
+  const Eigen::Vector3d sonar = T_world_sonar.translation();
+  const double spreading_db = a.spreading_db_per_decade;
+  // Multipath of a ray with two-way pattern weight `pattern` whose first hit is `first`: the ray
+  // goes on in the mirror direction with the specular fraction of its energy, up to max_bounces
+  // times. At each later hit P_k, after a path of length L from the sonar, two returns:
+  //  - back along the same path (through the same mirrors both ways): range L, weight
+  //    pattern · s² · ρ cosⁿ, where s is the product of the specular fractions so far;
+  //  - straight back to the sonar if P_k is in view (an occlusion ray) and in the receive lobe:
+  //    range R = (L + d)/2 with d = |P_k - sonar|, weight 2 · √pattern · p(P_k) · s · ρ (cos_i
+  //    cos_s)^(n/2) · (R/d)^(S/10); p is the one-way pattern towards P_k, the factor 2 counts
+  //    the reverse path (sonar → P_k → mirrors → sonar), equal by reciprocity, and (R/d)^(S/10)
+  //    turns the monostatic spreading at R into the last leg's own.
+  auto multipath = [&](const Eigen::Vector3f& first_direction, const Hit& first, double pattern) {
+    Eigen::Vector3f direction = first_direction;
+    Hit hit = first;
+    Eigen::Vector3f from = origin;
+    double path = hit.distance;
+    double specular = 1.0;
+    for (int bounce = 1; bounce <= a.max_bounces; ++bounce) {
+      specular *= materials_by_mesh_[hit.mesh].specular;
+      if (specular <= 0.0 || path >= 2.0 * max_range) return;
+      from += hit.distance * direction;
+      direction = (direction - 2.0f * direction.dot(hit.normal) * hit.normal).normalized();
+      const auto next = tracer_.Intersect(from + 1e-4f * direction, direction,
+                                          static_cast<float>(2.0 * max_range - path));
+      if (!next) return;
+      hit = *next;
+      path += hit.distance;
+      const Material& m = materials_by_mesh_[hit.mesh];
+      const double cos_in = std::abs(hit.normal.dot(direction));
+      if (path <= max_range) {
+        deposit(path, pattern * specular * specular * m.reflectivity *
+                          CosPower(cos_in, m.backscatter_exponent));
+      }
+      const Eigen::Vector3f at = from + hit.distance * direction;
+      const Eigen::Vector3d back = sonar - at.cast<double>();
+      const double d = back.norm();
+      const double range = 0.5 * (path + d);
+      if (range > max_range || d < g.bin_size_m) continue;
+      const double receive = one_way_pattern(-back / d);
+      const double weight = 2.0 * std::sqrt(pattern) * receive * specular * m.reflectivity;
+      if (weight < kNegligibleWeight) continue;
+      const Eigen::Vector3f to_sonar = (back / d).cast<float>();
+      if (tracer_.Occluded(at + 1e-4f * to_sonar, to_sonar, static_cast<float>(d) - 2e-4f)) {
+        continue;
+      }
+      const double cos_out = std::abs(hit.normal.dot(to_sonar));
+      deposit(range, weight * CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) *
+                         std::pow(range / d, spreading_db / 10.0));
+    }
+  };
   double weight_sum = 0.0;
   for (int i = 0; i < a.rays_horizontal; ++i) {
     for (int j = 0; j < a.rays_vertical; ++j) {
@@ -100,21 +164,8 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       const double cos_incidence = std::abs(hit->normal.dot(direction));
       deposit(range, pattern * material.reflectivity *
                          CosPower(cos_incidence, material.backscatter_exponent));
-      // One specular bounce: the mirrored ray's first hit echoes back along the same path, so it
-      // is heard at range d1 + d2, through two specular reflections at the first surface.
-      if (material.specular > 0.0) {
-        const Eigen::Vector3f mirrored =
-            (direction - 2.0f * direction.dot(hit->normal) * hit->normal).normalized();
-        const Eigen::Vector3f from = origin + hit->distance * direction + 1e-4f * mirrored;
-        const auto second =
-            tracer_.Intersect(from, mirrored, static_cast<float>(max_range - range));
-        if (second) {
-          const Material& far = materials_by_mesh_[second->mesh];
-          const double cos_far = std::abs(second->normal.dot(mirrored));
-          deposit(range + second->distance, pattern * material.specular * material.specular *
-                                                far.reflectivity *
-                                                CosPower(cos_far, far.backscatter_exponent));
-        }
+      if (a.max_bounces > 0 && material.specular > 0.0) {
+        multipath(direction, *hit, pattern);
       }
     }
   }

@@ -151,6 +151,7 @@ mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
                                const octomap::OcTree& key_space) {
   mapping::KeySet cells;
   for (const TriangleMesh& mesh : meshes) {
+    if (!mesh.truth) continue;
     for (const auto& t : mesh.triangles) {
       AddTriangleCells(mesh.vertices[t[0]].cast<double>(), mesh.vertices[t[1]].cast<double>(),
                        mesh.vertices[t[2]].cast<double>(), key_space, cells);

@@ -148,6 +148,7 @@ std::vector<TriangleMesh> BuildSceneMeshes(const Scene& scene) {
     TriangleMesh& mesh = meshes.back();
     mesh.check = CheckMesh(mesh, where);
     mesh.fill = spec.fill;
+    mesh.truth = spec.truth;
     if (spec.fill && (mesh.check.boundary_edges > 0 || mesh.check.non_manifold_edges > 0)) {
       throw InputError(where + ": 'fill' needs a closed mesh, but it has " +
                        std::to_string(mesh.check.boundary_edges) + " open and " +

@@ -71,6 +71,25 @@ std::optional<Hit> RayTracer::Intersect(const Eigen::Vector3f& origin,
   return hit;
 }
 
+bool RayTracer::Occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                         float max_distance) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay ray{};
+  ray.org_x = origin.x();
+  ray.org_y = origin.y();
+  ray.org_z = origin.z();
+  ray.dir_x = direction.x();
+  ray.dir_y = direction.y();
+  ray.dir_z = direction.z();
+  ray.tnear = 0.0f;
+  ray.tfar = max_distance;
+  ray.mask = std::numeric_limits<unsigned>::max();
+  rtcOccluded1(scene_.get(), &context, &ray);
+  // Embree marks an occluded ray by setting tfar to -inf.
+  return ray.tfar < 0.0f;
+}
+
 namespace {
 
 struct NearestQuery {

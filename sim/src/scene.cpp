@@ -54,6 +54,7 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
     node.Optional("roughness_m", m.roughness_m, NonNegative());
   }
   node.Optional("fill", m.fill);
+  node.Optional("truth", m.truth);
   std::string material;
   node.Required("material", material);
   bool found = false;
@@ -165,6 +166,14 @@ Scene LoadScene(const std::string& path) {
     T_vehicle_sonar = ReadPose(*mounting);
     mounting->RejectUnknownKeys();
   }
+  // Settings the operator chooses per deployment (gain, AD window) and how much multipath the
+  // place needs are the scene's to change: read now to check them, applied over the model below.
+  std::optional<YamlReader> acoustics = root.OptionalChild("sonar_acoustics");
+  if (acoustics) {
+    Acoustics checked;
+    ReadAcoustics(*acoustics, checked);
+    acoustics->RejectUnknownKeys();
+  }
   if (auto mapping = root.OptionalChild("mapping")) {
     scene.mapping = mapping::ReadMapperConfig(*mapping);
   }
@@ -197,6 +206,7 @@ Scene LoadScene(const std::string& path) {
   scene.sensor_model_file = sensor_path.lexically_normal().string();
   scene.sensor = LoadSensorModel(scene.sensor_model_file);
   if (T_vehicle_sonar) scene.sensor.geometry.T_vehicle_sonar = *T_vehicle_sonar;
+  if (acoustics) ReadAcoustics(*acoustics, scene.sensor.acoustics);
   return scene;
 }
 

@@ -143,7 +143,11 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
   for (const auto& key : cells.free) m.free_on_surface_cells += truth.contains(key) ? 1 : 0;
   m.free_accuracy = cells.free.empty() ? 0.0 : 1.0 - Ratio(m.free_on_surface_cells, m.free_cells);
 
+  std::vector<TriangleMesh> truth_meshes;
   for (const TriangleMesh& mesh : meshes) {
+    if (mesh.truth) truth_meshes.push_back(mesh);
+  }
+  for (const TriangleMesh& mesh : truth_meshes) {
     MapMetrics::MeshRecall r;
     r.name = mesh.name;
     for (const auto& key : VoxelizeMeshes(std::span(&mesh, 1), map)) {
@@ -156,8 +160,8 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
   }
 
   const double res = map.getResolution();
-  if (!meshes.empty()) {
-    const RayTracer tracer(meshes);
+  if (!truth_meshes.empty()) {
+    const RayTracer tracer(truth_meshes);
     std::vector<double> d;
     d.reserve(cells.occupied.size());
     for (const auto& key : cells.occupied) {

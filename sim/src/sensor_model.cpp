@@ -2,13 +2,7 @@
 
 namespace sonarbench::sim {
 
-SensorModel ReadSensorModel(YamlReader& root) {
-  SensorModel model;
-  root.Required("name", model.name);
-  YamlReader geometry = root.Child("geometry");
-  model.geometry = mapping::ReadSensorGeometry(geometry);
-  YamlReader node = root.Child("acoustics");
-  Acoustics& a = model.acoustics;
+void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("rays_horizontal", a.rays_horizontal, IntInRange(1, 1024));
   node.Optional("rays_vertical", a.rays_vertical, IntInRange(1, 8192));
   node.Optional("aperture_scale", a.aperture_scale, InRange(0.1, 4.0));
@@ -18,10 +12,20 @@ SensorModel ReadSensorModel(YamlReader& root) {
   node.Optional("gain_db", a.gain_db, InRange(-200.0, 200.0));
   node.Optional("pulse_length_m", a.pulse_length_m, Positive());
   node.Optional("noise_level_db", a.noise_level_db, InRange(-300.0, 100.0));
+  node.Optional("max_bounces", a.max_bounces, IntInRange(0, 16));
   node.Optional("speckle", a.speckle);
   node.Optional("ad_low_db", a.ad_low_db, InRange(-300.0, 100.0));
   node.Optional("ad_span_db", a.ad_span_db, InRange(1.0, 200.0));
   node.Optional("self_reflection_db", a.self_reflection_db);
+}
+
+SensorModel ReadSensorModel(YamlReader& root) {
+  SensorModel model;
+  root.Required("name", model.name);
+  YamlReader geometry = root.Child("geometry");
+  model.geometry = mapping::ReadSensorGeometry(geometry);
+  YamlReader node = root.Child("acoustics");
+  ReadAcoustics(node, model.acoustics);
   node.RejectUnknownKeys();
   root.RejectUnknownKeys();
   return model;

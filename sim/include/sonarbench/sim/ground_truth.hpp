@@ -20,6 +20,7 @@ namespace sonarbench::sim {
 
 /// Every cell of `key_space`'s grid whose box the surface of a mesh crosses (cells half-open, as
 /// OctoMap assigns points), and, for a mesh with `fill`, every cell whose centre lies inside it.
+/// Meshes that are not `truth` (the water surface) add nothing.
 [[nodiscard]] mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
                                              const octomap::OcTree& key_space);
 

@@ -25,6 +25,8 @@ struct TriangleMesh {
   std::size_t material = 0;
   /// Its inside counts as occupied truth too (a closed mesh: checked by BuildSceneMeshes).
   bool fill = false;
+  /// Scored as ground truth (see MeshSpec::truth); the simulator traces every mesh.
+  bool truth = true;
   MeshCheck check;
 };
 

@@ -36,6 +36,10 @@ class RayTracer {
                                              const Eigen::Vector3f& direction,
                                              float max_distance) const;
 
+  /// Whether any surface lies along `direction` (unit) from `origin` within `max_distance` [m].
+  [[nodiscard]] bool Occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                              float max_distance) const;
+
  private:
   struct DeviceDeleter {
     void operator()(RTCDeviceTy* device) const { rtcReleaseDevice(device); }

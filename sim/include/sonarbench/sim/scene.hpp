@@ -50,6 +50,9 @@ struct MeshSpec {
   std::size_t material = 0;
   /// Count the cells inside the (closed) mesh as occupied truth, not only its surface.
   bool fill = false;
+  /// Part of the ground truth the map is scored against. False for a surface the sonar hears but
+  /// a map should not hold, such as the water surface (a mirror for multipath).
+  bool truth = true;
 };
 
 /// A waypoint of the vehicle: time [s] and pose of the vehicle in the world.
@@ -88,7 +91,9 @@ struct Scene {
   std::string file;
   std::string sensor_model_file;
   /// The sensor model; the scene's optional `sonar_mounting` (position_m, rpy_deg) replaces the
-  /// model's mounting, since where the sonar sits is the vehicle's business, not the sonar's.
+  /// model's mounting, since where the sonar sits is the vehicle's business, not the sonar's, and
+  /// its optional `sonar_acoustics` (keys of the model's `acoustics`) replaces those it names:
+  /// gain and AD window are set per deployment, and a tank needs more multipath than open water.
   SensorModel sensor;
   std::vector<Material> materials;
   std::vector<MeshSpec> meshes;

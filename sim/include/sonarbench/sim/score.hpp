@@ -50,7 +50,7 @@ struct MapMetrics {
   /// distance), and from each observable surface cell's centre to the nearest occupied cell's.
   DistanceStats map_to_mesh;
   DistanceStats mesh_to_map;
-  /// Recall per mesh (scene order; only when meshes are given): of the observable cells that
+  /// Recall per truth mesh (scene order; only when meshes are given): of the observable cells that
   /// mesh's own surface crosses, the share mapped occupied. An object on a floor is judged by
   /// its own cells, not lost among the floor's.
   struct MeshRecall {
@@ -64,7 +64,7 @@ struct MapMetrics {
 
 /// Scores `map` against the surface cells `truth` and the subset `observable` a perfect sensor
 /// could see (cells of `observable` outside `truth` are ignored); `meshes` give the exact surface
-/// for distances (none: distances are not computed).
+/// for distances (none: distances are not computed); meshes that are not `truth` are left out.
 [[nodiscard]] MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
                                   const mapping::KeySet& observable,
                                   std::span<const TriangleMesh> meshes = {});

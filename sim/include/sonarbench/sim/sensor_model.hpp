@@ -29,6 +29,10 @@ struct Acoustics {
   double pulse_length_m = 0.0375;
   /// Mean background noise power at the receiver output [dB].
   double noise_level_db = -40.0;
+  /// Specular reflections a ray follows after its first hit (0: no multipath). Every hit after
+  /// one echoes back along its path and, when the sonar is in view and in the beam's lobe, also
+  /// straight to the sonar (see BeamSynthesizer).
+  int max_bounces = 1;
   /// Multiplicative speckle: echo power scaled by an exponential draw of mean 1 (Rayleigh
   /// amplitude).
   bool speckle = true;
@@ -49,6 +53,9 @@ struct SensorModel {
 
 /// Loads a sensor model YAML file; throws InputError naming the file and key on bad input.
 [[nodiscard]] SensorModel LoadSensorModel(const std::string& path);
+/// Reads the keys of an `acoustics` mapping that are present into `a` (absent ones keep their
+/// value), without rejecting unknown keys: the caller does, once.
+void ReadAcoustics(YamlReader& node, Acoustics& a);
 /// Reads a sensor model from an already-open reader (the root of a sensor model file).
 [[nodiscard]] SensorModel ReadSensorModel(YamlReader& root);
 
