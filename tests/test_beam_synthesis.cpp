@@ -154,6 +154,67 @@ TEST(BeamSynthesis, SpecularBounceEchoesAtTheSummedRange) {
   EXPECT_EQ(TotalPower(without.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 3)), 0.0);
 }
 
+// Multipath off a mirror floor 0.3 m below a sonar pitched 10° down, facing a wall 1 m ahead
+// (the wall scatters, the floor only mirrors). Seen directly, the wall spans ranges 1 m to
+// √(1 + 0.3² + tan²1.5°) = 1.0444 m. Rays steeper than atan(0.3) meet the floor first, no nearer
+// than 0.3 / tan 27.5° = 0.576 m, and go up to the wall no higher than z = -0.3 + 0.424·tan 27.5°
+// = -0.0793 m; through the floor's image of the sonar that point lies at
+// √(1 + 0.5207² + tan²1.5°) = 1.1277 m, the longest mirror path, and the straight return is
+// shorter. So one bounce adds echoes past the direct echo's last bin and none past 1.1277 m plus
+// the pulse, and changes nothing of the direct echo (the same random draws).
+TEST(BeamSynthesis, MultipathOffAMirrorFloorLiesWithinItsMirrorPaths) {
+  SensorModel sensor = QuietSensor();
+  MeshSpec floor;
+  floor.type = MeshSpec::Type::kPlane;
+  floor.size_m = {20.0, 20.0, 0.0};
+  floor.T_world_mesh = mapping::PoseFromXyzRpy({0, 0, -0.3}, {0, 0, 0});
+  std::vector<TriangleMesh> meshes = Wall(1.0, 0.0);
+  meshes.push_back(BuildMesh(floor, 0));
+  const RayTracer tracer(meshes);
+  Material wall;
+  wall.reflectivity = 1.0;
+  Material mirror;
+  mirror.reflectivity = 0.0;
+  mirror.specular = 1.0;
+  const Eigen::Isometry3d pitched_down =
+      mapping::PoseFromXyzRpy({0, 0, 0}, {0, 10.0 * kDegToRad, 0});
+  auto ping = [&](int bounces) {
+    sensor.acoustics.max_bounces = bounces;
+    const BeamSynthesizer synthesizer(sensor, tracer, {wall, mirror});
+    return synthesizer.Synthesize(0.0, 0.0, pitched_down, 5).echo_power;
+  };
+  const std::vector<double> direct = ping(0);
+  const std::vector<double> multipath = ping(1);
+  const double bin = sensor.geometry.bin_size_m;
+  const double pulse = sensor.acoustics.pulse_length_m;
+  const auto last_direct = static_cast<std::size_t>((1.0444 + pulse) / bin);
+  const auto last_mirror = static_cast<std::size_t>((1.1277 + pulse) / bin);
+  double past_direct = 0.0;
+  for (std::size_t k = 0; k < direct.size(); ++k) {
+    if (k > last_direct) {
+      EXPECT_EQ(direct[k], 0.0) << "bin " << k;
+    }
+    if (k > last_mirror) {
+      EXPECT_EQ(multipath[k], 0.0) << "bin " << k;
+    }
+    EXPECT_GE(multipath[k], direct[k] * (1.0 - 1e-12)) << "bin " << k;
+    if (k > last_direct) past_direct += multipath[k];
+  }
+  EXPECT_GT(past_direct, 0.0);
+}
+
+// The straight return's occlusion ray: a wall 1 m ahead blocks a segment that reaches it, not
+// one that stops 1 cm short, from either side.
+TEST(RayTracer, OccludedOnlyBySurfacesWithinTheSegment) {
+  const std::vector<TriangleMesh> meshes = Wall(1.0, 0.0);
+  const RayTracer tracer(meshes);
+  const Eigen::Vector3f x = Eigen::Vector3f::UnitX();
+  EXPECT_FALSE(tracer.Occluded(Eigen::Vector3f::Zero(), x, 0.99f));
+  EXPECT_TRUE(tracer.Occluded(Eigen::Vector3f::Zero(), x, 1.01f));
+  EXPECT_FALSE(tracer.Occluded(Eigen::Vector3f(2.0f, 0, 0), -x, 0.99f));
+  EXPECT_TRUE(tracer.Occluded(Eigen::Vector3f(2.0f, 0, 0), -x, 1.01f));
+}
+
 // The speckle and noise draws are exponential with mean 1 (the power of a Rayleigh amplitude).
 // Kolmogorov-Smirnov against F(x) = 1 - exp(-x) on 200000 draws, fixed seed: the critical value
 // at a 0.1% false-alarm rate is 1.949 / sqrt(n).

@@ -5,6 +5,7 @@
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/scene.hpp"
+#include "sonarbench/sim/sensor_model.hpp"
 #include "test_util.hpp"
 
 namespace sonarbench {
@@ -115,6 +116,40 @@ TEST(SceneFile, UnknownMaterialIsNamed) {
                       << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
   EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
                                    {"bad.yaml:7:", "'meshes[0].material'", "'mud'"}));
+}
+
+// A scene's sonar_acoustics replaces only the keys it names; the rest come from the model.
+TEST(SceneFile, SonarAcousticsOverrideTheModelsKeysItNames) {
+  const sim::SensorModel model =
+      sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
+  const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  EXPECT_EQ(scene.sensor.acoustics.gain_db, 6.0);
+  EXPECT_EQ(scene.sensor.acoustics.max_bounces, 8);
+  EXPECT_NE(model.acoustics.gain_db, 6.0);
+  EXPECT_EQ(scene.sensor.acoustics.rays_vertical, model.acoustics.rays_vertical);
+  EXPECT_EQ(scene.sensor.acoustics.self_reflection_db, model.acoustics.self_reflection_db);
+  // The water surface is traced but not scored.
+  bool surface_found = false;
+  for (const sim::MeshSpec& mesh : scene.meshes) {
+    if (mesh.name != "surface") continue;
+    surface_found = true;
+    EXPECT_FALSE(mesh.truth);
+  }
+  EXPECT_TRUE(surface_found);
+}
+
+TEST(SceneFile, BadSonarAcousticsAreNamed) {
+  test::TempDir dir;
+  const std::string path = (dir.path() / "bad.yaml").string();
+  std::ofstream(path) << "name: x\nsensor_model: "
+                      << test::SourcePath("sensor-models/shad-micron.yaml")
+                      << "\nsweeps: 1\nsonar_acoustics: {max_bounces: 40, gain: 3}\n"
+                      << "materials:\n  - {name: rock, reflectivity: 0.5}\n"
+                      << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
+                      << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [&] { (void)sim::LoadScene(path); },
+      {"bad.yaml:4:", "'sonar_acoustics.max_bounces'", "'40'", "'sonar_acoustics.gain'"}));
 }
 
 TEST(SceneFile, MissingFileIsAnInputError) {

@@ -174,6 +174,28 @@ TEST(ScoreMap, SurfaceDistancesOfKnownOffsets) {
   EXPECT_NEAR(m.mesh_to_map.max_m, 0.05 * std::hypot(10.0, 10.0), 1e-6);
 }
 
+// A mesh that is not truth (a water surface) adds no cells, no per-mesh recall, and is not a
+// surface that occupied cells are measured to: the test above, with a second plane right on the
+// occupied cells, gives the same distances.
+TEST(ScoreMap, MeshesThatAreNotTruthAreLeftOut) {
+  TriangleMesh surface = SmallPlane();
+  for (Eigen::Vector3f& v : surface.vertices) v.z() += 0.15f;
+  surface.truth = false;
+  const std::vector<TriangleMesh> meshes{SmallPlane(), surface};
+  const octomap::OcTree key_space(0.05);
+  const mapping::KeySet truth = VoxelizeMeshes(meshes, key_space);
+  EXPECT_EQ(truth.size(), 400u);
+  mapping::KeySet occupied;
+  const octomap::key_type z0 = key_space.coordToKey(0.012);
+  for (const int layer : {0, 1, 3}) {
+    occupied.insert(octomap::OcTreeKey(32768, 32768, static_cast<octomap::key_type>(z0 + layer)));
+  }
+  const MapMetrics m = ScoreMap(MapWith(occupied, {}), truth, truth, meshes);
+  ASSERT_EQ(m.per_mesh.size(), 1u);
+  ASSERT_EQ(m.map_to_mesh.count, 3u);
+  EXPECT_NEAR(m.map_to_mesh.max_m, 0.025 + 0.15 - 0.012, 1e-6);
+}
+
 TEST(ScoreMap, FreeCellsOnTheSurfaceLowerFreeAccuracy) {
   const mapping::KeySet truth = Row(0, 10);
   const MapMetrics m = ScoreMap(MapWith({}, Row(5, 25)), truth, truth);
