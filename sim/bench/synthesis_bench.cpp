@@ -1,8 +1,8 @@
 // Google Benchmark of beam synthesis against raw Embree (issue 3's speed goals), one sweep of the
 // default tank scenario:
 //   BM_RawEmbree        the same number of rays, in the same stratified pattern, intersected only
-//   BM_Synthesis/1, /2  the whole synthesis (hits, backscatter, the specular bounce's extra ray,
-//                       range spreading, noise, quantisation) on 1 and 2 threads
+//   BM_Synthesis/1, /2  the whole synthesis (hits, backscatter, the scene's multipath: mirrored and
+//                       occlusion rays, range spreading, noise, quantisation) on 1 and 2 threads
 // Counters: primary rays per second (compare BM_Synthesis/1 with BM_RawEmbree) and, for the
 // synthesis, the real-time factor: the real sonar's time for the sweep over ours.
 #include <benchmark/benchmark.h>
@@ -72,20 +72,26 @@ void BM_RawEmbree(benchmark::State& state) {
 void BM_Synthesis(benchmark::State& state) {
   Tank& tank = TheTank();
   const auto threads = static_cast<int>(state.range(0));
+  double traced = 0.0;
   for (auto _ : state) {
     auto beams = SimulateScene(tank.scene, tank.tracer, 1, threads);
+    for (const SynthesizedBeam& beam : beams) traced += static_cast<double>(beam.traced_rays);
     benchmark::DoNotOptimize(beams);
   }
   const auto& g = tank.scene.sensor.geometry;
   state.counters["rays/s"] = benchmark::Counter(
       PrimaryRaysPerSweep(tank.scene) * state.iterations(), benchmark::Counter::kIsRate);
+  // Every ray traced (mirrored and occlusion rays too), per second and per primary ray.
+  state.counters["traced_rays/s"] = benchmark::Counter(traced, benchmark::Counter::kIsRate);
+  state.counters["traced_per_primary"] =
+      traced / (PrimaryRaysPerSweep(tank.scene) * static_cast<double>(state.iterations()));
   // Real time of a sweep over the (wall-clock) time per sweep: the counter is a rate of sweeps,
   // scaled by the sonar's seconds per sweep.
   state.counters["real_time_factor"] = benchmark::Counter(
       g.BeamsPerSweep() / g.beams_per_second * state.iterations(), benchmark::Counter::kIsRate);
 }
 
-// The same without the specular bounce's second ray per hit.
+// The same without multipath: one ray per primary, the raw benchmark's rays exactly.
 void BM_SynthesisNoMultipath(benchmark::State& state) {
   Tank& tank = TheTank();
   Scene scene = tank.scene;

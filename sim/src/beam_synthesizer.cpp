@@ -116,6 +116,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       if (specular <= 0.0 || path >= 2.0 * max_range) return;
       from += hit.distance * direction;
       direction = (direction - 2.0f * direction.dot(hit.normal) * hit.normal).normalized();
+      ++out.traced_rays;
       const auto next = tracer_.Intersect(from + 1e-4f * direction, direction,
                                           static_cast<float>(2.0 * max_range - path));
       if (!next) return;
@@ -136,6 +137,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       const double weight = 2.0 * std::sqrt(pattern) * receive * specular * m.reflectivity;
       if (weight < kNegligibleWeight) continue;
       const Eigen::Vector3f to_sonar = (back / d).cast<float>();
+      ++out.traced_rays;
       if (tracer_.Occluded(at + 1e-4f * to_sonar, to_sonar, static_cast<float>(d) - 2e-4f)) {
         continue;
       }
@@ -153,6 +155,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       weight_sum += pattern;
       const Eigen::Vector3f direction =
           (R_world_beam * mapping::SonarRayDirection(theta, epsilon)).cast<float>();
+      ++out.traced_rays;
       const auto hit = tracer_.Intersect(origin, direction, static_cast<float>(max_range));
       if (!hit) continue;
       const double range = std::max<double>(hit->distance, g.bin_size_m);

@@ -28,6 +28,8 @@ struct SynthesizedBeam {
   BeamTruth truth;
   /// Noise-free echo power per bin [linear, relative to a perfect reflector at 1 m].
   std::vector<double> echo_power;
+  /// Rays traced for it: primaries, mirrored rays and occlusion rays (for speed reports).
+  std::size_t traced_rays = 0;
 };
 
 /// Synthesises MSIS beams by tracing stratified-jittered rays across the beam's aperture.
