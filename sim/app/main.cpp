@@ -181,7 +181,9 @@ int Fidelity(const FidelityArgs& args) {
                             real_all.first(std::min(per_sweep, real_all.size())), g, args.scene,
                             args.log);
   std::cout << "mean intensity vs range: correlation " << report.profile_correlation_all
-            << " (all bins), " << report.profile_correlation_usable << " (past self-reflection)\n"
+            << " (all bins), " << report.profile_correlation_usable
+            << " (past self-reflection); mean |difference| " << report.profile_mean_abs_difference
+            << " (past self-reflection)\n"
             << "wall range: median difference " << report.median_wall_difference_bins
             << " bins over " << report.wall_angles_compared << " head angles\n"
             << "intensity histograms: intersection " << report.histogram_intersection << "\n"

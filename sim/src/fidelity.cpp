@@ -114,6 +114,9 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   const auto first = static_cast<std::size_t>(sensor.FirstUsableBin());
   r.profile_correlation_usable = PearsonCorrelation(std::span(r.sim_mean).subspan(first),
                                                     std::span(r.real_mean).subspan(first));
+  double abs_sum = 0.0;
+  for (std::size_t k = first; k < bins; ++k) abs_sum += std::abs(r.sim_mean[k] - r.real_mean[k]);
+  r.profile_mean_abs_difference = first < bins ? abs_sum / static_cast<double>(bins - first) : 0.0;
   r.sim_wall_m = WallRanges(sim, sensor, wall_min_range_m);
   r.real_wall_m = WallRanges(real, sensor, wall_min_range_m);
   std::vector<double> differences;
@@ -191,6 +194,7 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"log", log_file},
                  {"profile_correlation_all_bins", r.profile_correlation_all},
                  {"profile_correlation_usable_bins", r.profile_correlation_usable},
+                 {"profile_mean_abs_difference_usable_bins", r.profile_mean_abs_difference},
                  {"median_wall_range_difference_bins", r.median_wall_difference_bins},
                  {"wall_angles_compared", r.wall_angles_compared},
                  {"histogram_intersection", r.histogram_intersection},

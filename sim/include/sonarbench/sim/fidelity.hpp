@@ -20,6 +20,9 @@ struct FidelityReport {
   /// (past the self-reflection range).
   double profile_correlation_all = 0.0;
   double profile_correlation_usable = 0.0;
+  /// Mean absolute difference of the two mean profiles over the usable bins [intensity]: the
+  /// level, which a correlation ignores.
+  double profile_mean_abs_difference = 0.0;
   /// Per head-angle step (index = angle / step): the median, over sweeps, of the range [m] of
   /// the strongest echo beyond `wall_min_range_m` (the wall, in a tank).
   std::vector<std::optional<double>> sim_wall_m;
