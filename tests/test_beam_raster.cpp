@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <random>
 #include <sstream>
 #include <string>
@@ -91,6 +92,40 @@ TEST(BeamRaster, PortableKernelGivesOneRayAtATimesCells) {
 TEST(BeamRaster, VectorKernelGivesOneRayAtATimesCells) {
   if (!BeamRaster::HasVectorKernel()) GTEST_SKIP() << "this processor has no AVX-512";
   ExpectSameCellsAsOneRayAtATime(BeamRaster::Kernel::kFastest);
+}
+
+// The vector set-up of the walks gives StartRayWalkFromKey's values bit for bit (an ulp off
+// would change a cell only at a rare tie, which the cell comparisons above could miss).
+TEST(BeamRaster, VectorWalkSetUpIsStartRayWalksBitForBit) {
+  if (!BeamRaster::HasVectorKernel()) GTEST_SKIP() << "this processor has no AVX-512";
+  for (const double resolution : {0.05, 0.1, 0.0137}) {
+    octomap::OcTree tree(resolution);
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<float> coordinate(-3.0f, 3.0f);
+    for (int beam = 0; beam < 100; ++beam) {
+      const octomap::point3d origin(coordinate(rng), coordinate(rng), coordinate(rng));
+      const auto ends = RandomBeam(rng, origin, 1 + beam % 61);
+      std::vector<RayWalk> scalar;
+      std::vector<RayWalk> vector;
+      StartRayWalks(tree, origin, ends, false, scalar);
+      StartRayWalks(tree, origin, ends, true, vector);
+      ASSERT_EQ(vector.size(), scalar.size()) << "beam " << beam;
+      for (std::size_t w = 0; w < scalar.size(); ++w) {
+        const RayWalk& a = scalar[w];
+        const RayWalk& b = vector[w];
+        EXPECT_TRUE(a.origin_key == b.origin_key && a.end_key == b.end_key);
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(a.length), std::bit_cast<std::uint64_t>(b.length));
+        for (unsigned i = 0; i < 3; ++i) {
+          EXPECT_EQ(a.step[i], b.step[i]);
+          EXPECT_EQ(std::bit_cast<std::uint64_t>(a.t_max[i]),
+                    std::bit_cast<std::uint64_t>(b.t_max[i]))
+              << "beam " << beam << " walk " << w << " axis " << i;
+          EXPECT_EQ(std::bit_cast<std::uint64_t>(a.t_delta[i]),
+                    std::bit_cast<std::uint64_t>(b.t_delta[i]));
+        }
+      }
+    }
+  }
 }
 
 // A box too large for the marks (5 mm cells, 4 m rays: 1600^2 x 800 cells) is walked into a
@@ -196,16 +231,59 @@ TEST(IntegrateBatch, BuildsTheMapOfOneUpdateNodePerCell) {
   reference.updateInnerOccupancy();
   std::ostringstream expected;
   WriteOctomapBinary(reference, expected);
+  auto check = [&](const MapTree& ours, const std::string& what) {
+    std::ostringstream actual;
+    WriteOctomapBinary(ours, actual);
+    EXPECT_EQ(ours.size(), reference.size()) << what;
+    EXPECT_TRUE(actual.str() == expected.str()) << what;
+  };
   for (const int threads : {1, 2}) {
     MapTree ours(0.05);
     for (int batch = 0; batch < 3; ++batch) {
       IntegrateBatch<KeyOpenSet>(ours, beams, obstacles, directions, free_range_m, threads);
     }
     FinishUpdates(ours);
-    std::ostringstream actual;
-    WriteOctomapBinary(ours, actual);
-    EXPECT_EQ(ours.size(), reference.size()) << threads << " threads";
-    EXPECT_TRUE(actual.str() == expected.str()) << threads << " threads";
+    check(ours, std::to_string(threads) + " threads");
+  }
+  // As a Mapper runs it: one workspace kept from batch to batch (its sets and recent-key
+  // filters must start each batch empty), whatever the thread count of each batch.
+  MapTree ours(0.05);
+  BatchWorkspace<KeyOpenSet> workspace;
+  for (int batch = 0; batch < 3; ++batch) {
+    IntegrateBatch(ours, beams, obstacles, directions, free_range_m, 2 - batch % 2, workspace);
+  }
+  FinishUpdates(ours);
+  check(ours, "one workspace");
+  MapTree ours_std(0.05);
+  BatchWorkspace<KeySet> std_workspace;
+  for (int batch = 0; batch < 3; ++batch) {
+    IntegrateBatch(ours_std, beams, obstacles, directions, free_range_m, 1 + batch % 2,
+                   std_workspace);
+  }
+  FinishUpdates(ours_std);
+  check(ours_std, "one workspace, std::unordered_set");
+}
+
+// The radix sort sorts as std::sort does: random codes, codes that share their high bits (one
+// region of space), all equal, and the Morton code round trip it relies on.
+TEST(IntegrateBatch, RadixSortSortsAndMortonCodesRoundTrip) {
+  std::mt19937_64 rng(21);
+  std::vector<std::uint64_t> scratch;
+  for (const std::uint64_t mask : {~std::uint64_t{0}, std::uint64_t{0xfffff}, std::uint64_t{0}}) {
+    for (const std::size_t n : {0u, 1u, 2u, 1000u, 70000u}) {
+      std::vector<std::uint64_t> values(n);
+      for (auto& v : values) v = (0x5a5a00000000ULL | (rng() & mask));
+      std::vector<std::uint64_t> expected = values;
+      std::sort(expected.begin(), expected.end());
+      RadixSort(values, scratch);
+      ASSERT_EQ(values, expected) << "n " << n << " mask " << mask;
+    }
+  }
+  for (int i = 0; i < 10000; ++i) {
+    const octomap::OcTreeKey key(static_cast<octomap::key_type>(rng()),
+                                 static_cast<octomap::key_type>(rng()),
+                                 static_cast<octomap::key_type>(rng()));
+    ASSERT_TRUE(KeyFromMortonCode(MortonCode(key)) == key);
   }
 }
 

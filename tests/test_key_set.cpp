@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <span>
 #include <unordered_set>
 #include <vector>
 
@@ -160,6 +161,42 @@ TEST(OpenKeySet, InPlaceResizeNeedsLessPeakMemory) {
   ASSERT_EQ(in_place.capacity(), all_at_once.capacity());
   EXPECT_EQ(in_place.peak_bytes(), in_place.capacity() * sizeof(std::uint64_t));
   EXPECT_EQ(all_at_once.peak_bytes(), in_place.capacity() * sizeof(std::uint64_t) * 3 / 2);
+}
+
+// Inserting packed keys as a batch (with prefetching) leaves the set that inserting them one by
+// one leaves, duplicates and growth included.
+TEST(OpenKeySet, BatchInsertMatchesOneByOne) {
+  std::mt19937_64 rng(9);
+  OpenKeySet<Probing::kQuadratic, Resize::kInPlace> batched;
+  Reference reference;
+  for (int round = 0; round < 20; ++round) {
+    std::vector<std::uint64_t> keys;
+    for (int i = 0; i < 3000; ++i) {
+      const auto key = RandomKey(rng, round % 2 == 0);
+      keys.push_back(PackKey(key));
+      reference.insert(key);
+    }
+    batched.insert_packed(std::span<const std::uint64_t>(keys));
+    ASSERT_TRUE(SameKeys(batched, reference)) << "round " << round;
+  }
+}
+
+// The recent-key filter never claims a key it was not given (a false "seen" would drop a cell
+// from the map), and remembers the key it was given last.
+TEST(RecentKeys, OnlyRemembersKeysItWasGiven) {
+  std::mt19937_64 rng(10);
+  RecentKeys recent;
+  std::unordered_set<std::uint64_t> given;
+  for (int i = 0; i < 200000; ++i) {
+    const std::uint64_t packed = PackKey(RandomKey(rng, i % 3 != 0));
+    if (recent.CheckAndRemember(packed)) {
+      ASSERT_TRUE(given.contains(packed)) << i;
+    }
+    given.insert(packed);
+    ASSERT_TRUE(recent.CheckAndRemember(packed));
+  }
+  recent.clear();
+  for (const std::uint64_t packed : given) ASSERT_FALSE(recent.CheckAndRemember(packed));
 }
 
 // The cells a beam marks do not depend on the set that collects them.

@@ -61,11 +61,12 @@ std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sens
   const auto directions = BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical);
   const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
   const std::span<const Beam> all(beams);
+  BatchWorkspace<Set> workspace;
   for (std::size_t first = 0; first < all.size(); first += per_sweep) {
     const auto sweep = all.subspan(first, std::min(per_sweep, all.size() - first));
     const auto obstacles = DetectObstacles(sweep, sensor, config.detection);
     const BatchStats stats =
-        IntegrateBatch<Set>(tree, sweep, obstacles, directions, sensor.MaxRangeM(), threads);
+        IntegrateBatch(tree, sweep, obstacles, directions, sensor.MaxRangeM(), threads, workspace);
     if (totals != nullptr) *totals += stats;
   }
   FinishUpdates(tree);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <limits>
 
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -100,12 +101,11 @@ __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWal
                                                           const Box& box, std::uint64_t* marks,
                                                           std::vector<std::uint64_t>& touched) {
   // kGroups independent groups of eight walks step in turn: one group's step waits on its
-  // previous step's comparisons (≈20 cycles), the others' fill that wait.
+  // previous step's comparisons (≈20 cycles), the others' fill that wait. The group loop is
+  // unrolled so that each group's state stays in registers.
   constexpr std::size_t kGroups = 4;
   constexpr std::size_t kBatch = kGroups * kLanes;
   const std::int64_t unit[3] = {std::int64_t{1} << box.shift_x, std::int64_t{1} << box.shift_y, 1};
-  const __m512i low6 = _mm512_set1_epi64(63);
-  const __m512i one = _mm512_set1_epi64(1);
   std::size_t visits = 0;
   alignas(64) double lane_t[3][kBatch];
   alignas(64) double lane_delta[3][kBatch];
@@ -148,6 +148,7 @@ __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWal
     }
     for (;;) {
       unsigned any = 0;
+#pragma GCC unroll 4
       for (std::size_t g = 0; g < kGroups; ++g) {
         const std::size_t o = g * kLanes;
         const __mmask8 x_first = _mm512_cmp_pd_mask(tx[g], ty[g], _CMP_LT_OQ);
@@ -172,24 +173,25 @@ __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWal
                                _mm512_cmp_pd_mask(tz[g], length, _CMP_GT_OQ));
         active[g] = active[g] & static_cast<__mmask8>(~done);
         any |= active[g];
-        // Most visits repeat a cell (≈70 per distinct cell of a beam): the words holding the
-        // lanes' marks are gathered at once, and only lanes on an unmarked cell go on, one by
-        // one, to set it.
-        const __m512i words = _mm512_mask_i64gather_epi64(_mm512_setzero_si512(), active[g],
-                                                          _mm512_maskz_srli_epi64(0xff, cell[g], 6),
-                                                          static_cast<const void*>(marks), 8);
-        const __m512i bits = _mm512_maskz_srlv_epi64(0xff, words, _mm512_and_si512(cell[g], low6));
-        const __mmask8 fresh =
-            active[g] & static_cast<__mmask8>(~_mm512_test_epi64_mask(bits, one));
-        if (fresh != 0) {
+        // Most visits repeat a cell (≈70 per distinct cell of a beam). Walks from one origin
+        // stand in the same cell only after the same number of steps (each step is one cell
+        // along one axis), and neighbouring rays sit in neighbouring lanes: a lane on the same
+        // cell as the lane before it is not checked against the marks, being that lane's visit
+        // again. The others are checked one by one (on these processors faster than a gather).
+        const __m512i before = _mm512_maskz_alignr_epi64(0xff, cell[g], cell[g], 7);
+        const __mmask8 repeat = _mm512_mask_cmpeq_epi64_mask(
+            static_cast<__mmask8>(active[g] & (active[g] << 1)), cell[g], before);
+        unsigned check = active[g] & static_cast<__mmask8>(~repeat);
+        if (check != 0) {
           _mm512_store_si512(index, cell[g]);
-          for (unsigned l = 0; l < kLanes; ++l) {
-            // Two lanes may share a fresh cell: the mark is checked again.
-            if (((fresh >> l) & 1u) != 0 && !IsMarked(marks, index[l])) {
+          do {
+            const unsigned l = static_cast<unsigned>(__builtin_ctz(check));
+            check &= check - 1;
+            if (!IsMarked(marks, index[l])) {
               Mark(marks, index[l]);
               touched.push_back(index[l]);
             }
-          }
+          } while (check != 0);
         }
         visits += static_cast<std::size_t>(__builtin_popcount(active[g]));
       }
@@ -198,9 +200,122 @@ __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWal
   }
   return visits;
 }
+
+// StartRayWalkFromKey for eight segments at a time: the float difference, the float norm (as
+// OctoMap's Vector3::norm: float squares summed in float, the square root in double, rounded to
+// float), the float division, then the double arithmetic of the borders and steps. The file is
+// compiled without contraction into fused multiply-adds, so each operation rounds as the
+// scalar code's does.
+__attribute__((target("avx512f"))) void StartWalksAvx512(const octomap::OcTree& tree,
+                                                         const octomap::point3d& origin,
+                                                         const octomap::OcTreeKey& origin_key,
+                                                         std::span<const octomap::point3d> ends,
+                                                         std::vector<RayWalk>& walks) {
+  const double resolution = tree.getResolution();
+  const double factor = 1.0 / resolution;  // OcTreeBaseImpl's resolution_factor
+  const auto max_val = static_cast<std::int64_t>(tree.coordToKey(0.0));  // tree_max_val
+  // The cell border a walk first meets, per axis, for a step of +1 and of -1.
+  double border_up[3];
+  double border_down[3];
+  for (unsigned i = 0; i < 3; ++i) {
+    const double centre = tree.keyToCoord(origin_key[i]);
+    border_up[i] = centre + static_cast<float>(1 * resolution * 0.5);
+    border_down[i] = centre + static_cast<float>(-1 * resolution * 0.5);
+  }
+  const __m512d v_factor = _mm512_set1_pd(factor);
+  const __m512d v_resolution = _mm512_set1_pd(resolution);
+  const __m512d v_max = _mm512_set1_pd(std::numeric_limits<double>::max());
+  const __m512i v_max_val = _mm512_set1_epi64(max_val);
+  const __m512i v_key_limit = _mm512_set1_epi64(2 * max_val);
+  alignas(64) float coordinate[3][kLanes];
+  alignas(64) std::int64_t key[3][kLanes];
+  alignas(64) double t_max[3][kLanes];
+  alignas(64) double t_delta[3][kLanes];
+  alignas(64) double length[kLanes];
+  for (std::size_t first = 0; first < ends.size(); first += kLanes) {
+    const std::size_t count = std::min(kLanes, ends.size() - first);
+    for (std::size_t l = 0; l < kLanes; ++l) {
+      const octomap::point3d& end = ends[first + std::min(l, count - 1)];
+      for (unsigned i = 0; i < 3; ++i) coordinate[i][l] = end(i);
+    }
+    __mmask8 valid = static_cast<__mmask8>((1u << count) - 1);
+    __m256 d[3];
+    for (unsigned i = 0; i < 3; ++i) {
+      // coordToKeyChecked: (int) floor(resolution_factor * coordinate) + tree_max_val, in
+      // [0, 2 tree_max_val).
+      const __m256 c = _mm256_load_ps(coordinate[i]);
+      const __m512d scaled =
+          _mm512_maskz_roundscale_pd(0xff, _mm512_mul_pd(v_factor, _mm512_maskz_cvtps_pd(0xff, c)),
+                                     _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+      // (int): outside the int range the conversion gives INT_MIN, which fails the check (as
+      // the scalar conversion does on this processor).
+      const __m512i k = _mm512_add_epi64(
+          _mm512_maskz_cvtepi32_epi64(0xff, _mm512_maskz_cvttpd_epi32(0xff, scaled)), v_max_val);
+      valid &= _mm512_cmpge_epi64_mask(k, _mm512_setzero_si512()) &
+               _mm512_cmplt_epi64_mask(k, v_key_limit);
+      _mm512_store_si512(key[i], k);
+      d[i] = _mm256_sub_ps(c, _mm256_set1_ps(origin(i)));
+    }
+    // Vector3::norm(), rounded to float as StartRayWalkFromKey does.
+    const __m256 norm_sq =
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(d[0], d[0]), _mm256_mul_ps(d[1], d[1])),
+                      _mm256_mul_ps(d[2], d[2]));
+    const __m256 len = _mm512_maskz_cvtpd_ps(
+        0xff, _mm512_maskz_sqrt_pd(0xff, _mm512_maskz_cvtps_pd(0xff, norm_sq)));
+    _mm512_store_pd(length, _mm512_maskz_cvtps_pd(0xff, len));
+    __mmask8 up[3];
+    __mmask8 down[3];
+    for (unsigned i = 0; i < 3; ++i) {
+      const __m512d u = _mm512_maskz_cvtps_pd(0xff, _mm256_div_ps(d[i], len));  // exact widening
+      up[i] = _mm512_cmp_pd_mask(u, _mm512_setzero_pd(), _CMP_GT_OQ);
+      down[i] = _mm512_cmp_pd_mask(u, _mm512_setzero_pd(), _CMP_LT_OQ);
+      const __m512d border =
+          _mm512_mask_blend_pd(up[i], _mm512_set1_pd(border_down[i]), _mm512_set1_pd(border_up[i]));
+      const __m512d from = _mm512_set1_pd(static_cast<double>(origin(i)));
+      const auto moving = static_cast<__mmask8>(up[i] | down[i]);
+      _mm512_store_pd(t_max[i], _mm512_mask_div_pd(v_max, moving, _mm512_sub_pd(border, from), u));
+      _mm512_store_pd(t_delta[i],
+                      _mm512_mask_div_pd(v_max, moving, v_resolution, _mm512_abs_pd(u)));
+    }
+    for (std::size_t l = 0; l < count; ++l) {
+      if (((valid >> l) & 1u) == 0) continue;
+      RayWalk walk;
+      walk.origin_key = origin_key;
+      for (unsigned i = 0; i < 3; ++i) {
+        walk.end_key[i] = static_cast<octomap::key_type>(key[i][l]);
+      }
+      if (walk.end_key == origin_key) continue;
+      for (unsigned i = 0; i < 3; ++i) {
+        walk.t_max[i] = t_max[i][l];
+        walk.t_delta[i] = t_delta[i][l];
+        walk.step[i] = static_cast<int>((up[i] >> l) & 1u) - static_cast<int>((down[i] >> l) & 1u);
+      }
+      walk.length = length[l];
+      walks.push_back(walk);
+    }
+  }
+}
 #endif
 
 }  // namespace
+
+void StartRayWalks(const octomap::OcTree& tree, const octomap::point3d& origin,
+                   std::span<const octomap::point3d> ends, bool vector,
+                   std::vector<RayWalk>& walks) {
+  RayWalk walk;
+  if (!tree.coordToKeyChecked(origin, walk.origin_key)) return;
+#ifdef SONARBENCH_HAVE_AVX512_KERNEL
+  if (vector && BeamRaster::HasVectorKernel()) {
+    StartWalksAvx512(tree, origin, walk.origin_key, ends, walks);
+    return;
+  }
+#endif
+  for (const octomap::point3d& end : ends) {
+    if (StartRayWalkFromKey(tree, origin, end, walk) && walk.origin_key != walk.end_key) {
+      walks.push_back(walk);
+    }
+  }
+}
 
 bool BeamRaster::HasVectorKernel() {
 #ifdef SONARBENCH_HAVE_AVX512_KERNEL
@@ -215,13 +330,7 @@ std::size_t BeamRaster::Trace(const octomap::OcTree& tree, const octomap::point3
                               std::vector<std::uint64_t>& free_keys) {
   used_fallback_ = false;
   walks_.clear();
-  RayWalk walk;
-  if (!tree.coordToKeyChecked(origin, walk.origin_key)) return 0;
-  for (const octomap::point3d& end : ends) {
-    if (StartRayWalkFromKey(tree, origin, end, walk) && walk.origin_key != walk.end_key) {
-      walks_.push_back(walk);
-    }
-  }
+  StartRayWalks(tree, origin, ends, kernel_ == Kernel::kFastest, walks_);
   if (walks_.empty()) return 0;
   const Box box = MakeBox(walks_);
   // Keys near the edge of the key range would put the spare cells outside it.

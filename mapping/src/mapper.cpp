@@ -49,9 +49,11 @@ BatchStats Mapper::Integrate(std::span<const Beam> beams,
                              std::span<const std::vector<double>> obstacles) {
   stale_ = true;
   if (config_.key_set == KeySetKind::kStd) {
-    return IntegrateBatch<KeySet>(*tree_, beams, obstacles, directions_, free_range_m_, threads_);
+    return IntegrateBatch(*tree_, beams, obstacles, directions_, free_range_m_, threads_,
+                          std_workspace_);
   }
-  return IntegrateBatch<KeyOpenSet>(*tree_, beams, obstacles, directions_, free_range_m_, threads_);
+  return IntegrateBatch(*tree_, beams, obstacles, directions_, free_range_m_, threads_,
+                        open_workspace_);
 }
 
 void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out) {

@@ -12,6 +12,14 @@
 
 namespace sonarbench::mapping {
 
+/// Appends to `walks` the start of OctoMap's DDA (StartRayWalkFromKey, bit for bit) for each
+/// segment from `origin` to one of `ends` whose points both lie in the tree's key range and in
+/// different cells, in the order of `ends`. With `vector` true and a processor with AVX-512,
+/// eight segments are set up at a time (the same IEEE operations, in the same order).
+void StartRayWalks(const octomap::OcTree& tree, const octomap::point3d& origin,
+                   std::span<const octomap::point3d> ends, bool vector,
+                   std::vector<RayWalk>& walks);
+
 /// Collects the distinct cells that many rays from one origin cross: the free cells of one beam.
 ///
 /// The rays are OctoMap's DDA (ForEachRayKey's cells, exactly). Each visited cell sets a mark in

@@ -41,16 +41,34 @@ struct BasicBeamCells {
   BeamRaster raster;
   std::vector<octomap::point3d> ends;
   std::vector<std::uint64_t> beam_free;
-  /// Per obstacle, the previous ray's occupied cell (packed), or kNoKey.
-  std::vector<std::uint64_t> previous_occupied;
-  static constexpr std::uint64_t kNoKey = ~std::uint64_t{0};
+  /// A beam's keys that go on to the sets: not caught by recent_free / recent_occupied.
+  std::vector<std::uint64_t> fresh_free;
+  std::vector<std::uint64_t> fresh_occupied;
+  /// What was inserted into `free` and `occupied` lately: inserts these catch are skipped.
+  RecentKeys recent_free;
+  RecentKeys recent_occupied;
 
-  /// Inserts a free key (packed).
-  void InsertFree(std::uint64_t packed) {
-    if constexpr (requires(Set & s) { s.insert_packed(packed); }) {
-      free.insert_packed(packed);
+  /// Empties the sets and zeroes the counts, for the next batch. Each set keeps room for as
+  /// many keys as it held (abseil's clear() frees a large table; the reserve gets it back).
+  void Clear() {
+    const std::size_t free_keys = free.size();
+    const std::size_t occupied_keys = occupied.size();
+    free.clear();
+    occupied.clear();
+    free.reserve(free_keys);
+    occupied.reserve(occupied_keys);
+    recent_free.clear();
+    recent_occupied.clear();
+    visits = 0;
+    beam_free_cells = 0;
+  }
+
+  /// Inserts keys (packed) into `set`, one of the two.
+  static void Insert(Set& set, std::span<const std::uint64_t> packed) {
+    if constexpr (requires { set.insert_packed(packed); }) {
+      set.insert_packed(packed);
     } else {
-      free.insert(UnpackKey(packed));
+      for (const std::uint64_t key : packed) set.insert(UnpackKey(key));
     }
   }
 };
@@ -79,9 +97,7 @@ void CastBeam(const octomap::OcTree& tree, const Beam& beam,
                             static_cast<float>(v.z()));
   };
   cells.ends.clear();
-  // Neighbouring rays mostly end in the same cell: a repeat of the previous ray's cell at the
-  // same obstacle is not inserted again.
-  cells.previous_occupied.assign(obstacle_ranges_m.size(), BasicBeamCells<Set>::kNoKey);
+  cells.fresh_occupied.clear();
   for (const Eigen::Vector3d& direction : directions) {
     const Eigen::Vector3d d_world = R_world_beam * direction;
     // The cells crossed before the end point's cell, which is left for the occupied update (or,
@@ -91,16 +107,22 @@ void CastBeam(const octomap::OcTree& tree, const Beam& beam,
       octomap::OcTreeKey key;
       if (tree.coordToKeyChecked(to_point(origin + obstacle_ranges_m[k] * d_world), key)) {
         ++cells.visits;
-        if (PackKey(key) == cells.previous_occupied[k]) continue;
-        cells.occupied.insert(key);
-        cells.previous_occupied[k] = PackKey(key);
+        // Neighbouring rays mostly end in the same cell.
+        if (!cells.recent_occupied.CheckAndRemember(PackKey(key))) {
+          cells.fresh_occupied.push_back(PackKey(key));
+        }
       }
     }
   }
+  cells.Insert(cells.occupied, cells.fresh_occupied);
   cells.beam_free.clear();
   cells.visits += cells.raster.Trace(tree, to_point(origin), cells.ends, cells.beam_free);
   cells.beam_free_cells += cells.beam_free.size();
-  for (const std::uint64_t packed : cells.beam_free) cells.InsertFree(packed);
+  cells.fresh_free.clear();
+  for (const std::uint64_t packed : cells.beam_free) {
+    if (!cells.recent_free.CheckAndRemember(packed)) cells.fresh_free.push_back(packed);
+  }
+  cells.Insert(cells.free, cells.fresh_free);
 }
 
 }  // namespace sonarbench::mapping

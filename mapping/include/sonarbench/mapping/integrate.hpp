@@ -29,6 +29,46 @@ namespace sonarbench::mapping {
   return (spread(key[0]) << 2) | (spread(key[1]) << 1) | spread(key[2]);
 }
 
+/// The key whose Morton code is `code` (the inverse of MortonCode).
+[[nodiscard]] inline octomap::OcTreeKey KeyFromMortonCode(std::uint64_t code) {
+  auto compact = [](std::uint64_t v) {  // every third of 48 bits to 16
+    v &= 0x249249249249ULL;
+    v = (v | (v >> 2)) & 0x0c30c30c30c3ULL;
+    v = (v | (v >> 4)) & 0x00f00f00f00fULL;
+    v = (v | (v >> 8)) & 0x0000ff0000ffULL;
+    v = (v | (v >> 16)) & 0x00000000ffffULL;
+    return static_cast<octomap::key_type>(v);
+  };
+  return {compact(code >> 2), compact(code >> 1), compact(code)};
+}
+
+/// Sorts `values` in increasing order: a least-significant-digit radix sort, 11 bits a pass,
+/// that skips a pass whose digit is the same in every value (the high bits of the Morton codes
+/// of one region of space). `scratch` is reused between calls.
+inline void RadixSort(std::vector<std::uint64_t>& values, std::vector<std::uint64_t>& scratch) {
+  constexpr unsigned kBits = 11;
+  constexpr std::size_t kBuckets = std::size_t{1} << kBits;
+  if (values.size() < 2) return;
+  std::uint64_t all_or = 0;
+  std::uint64_t all_and = ~std::uint64_t{0};
+  for (const std::uint64_t v : values) {
+    all_or |= v;
+    all_and &= v;
+  }
+  const std::uint64_t varying = all_or ^ all_and;  // the bits that differ between values
+  scratch.resize(values.size());
+  std::array<std::size_t, kBuckets> start;
+  for (unsigned shift = 0; shift < 64; shift += kBits) {
+    if (((varying >> shift) & (kBuckets - 1)) == 0) continue;
+    start.fill(0);
+    for (const std::uint64_t v : values) ++start[(v >> shift) & (kBuckets - 1)];
+    std::size_t sum = 0;
+    for (std::size_t& s : start) sum += std::exchange(s, sum);
+    for (const std::uint64_t v : values) scratch[start[(v >> shift) & (kBuckets - 1)]++] = v;
+    values.swap(scratch);
+  }
+}
+
 /// Per-batch counts, for reports and benchmarks.
 struct BatchStats {
   std::size_t beams = 0;
@@ -71,6 +111,26 @@ inline void FinishUpdates(MapTree& tree) {
   tree.updateInnerOccupancy();
 }
 
+/// What IntegrateBatch needs besides the tree: each thread's key sets and buffers, and each
+/// octant's updates. Kept from batch to batch, a workspace's tables are already grown to a
+/// sweep's size when the next sweep starts, so a mapper resizes them in its first sweep only.
+template <typename Set>
+struct BatchWorkspace {
+  std::vector<BasicBeamCells<Set>> per_thread;
+  /// Per thread, per octant of the root: Morton code << 1 | occupied of its cells.
+  std::vector<std::array<std::vector<std::uint64_t>, 8>> split;
+  /// Per octant: the threads' updates together, and a radix sort's scratch.
+  std::array<std::vector<std::uint64_t>, 8> updates;
+  std::array<std::vector<std::uint64_t>, 8> scratch;
+
+  /// Makes it ready for a batch on `threads` threads: empty sets, zero counts.
+  void Reset(int threads) {
+    per_thread.resize(static_cast<std::size_t>(threads));
+    for (auto& cells : per_thread) cells.Clear();
+    split.resize(per_thread.size());
+  }
+};
+
 /// Casts the rays of a batch of beams on `threads` threads, each into its own key sets of type
 /// `Set`, merges the threads' cells (no lock per key), lets occupied win over free, and applies
 /// one log-odds update per cell. The result does not depend on `threads` or on `Set`: a set's
@@ -80,9 +140,10 @@ template <typename Set>
 BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
                           std::span<const std::vector<double>> obstacles,
                           std::span<const Eigen::Vector3d> directions, double free_range_m,
-                          int threads) {
+                          int threads, BatchWorkspace<Set>& workspace) {
   const double start = omp_get_wtime();
-  std::vector<BasicBeamCells<Set>> per_thread(static_cast<std::size_t>(threads));
+  workspace.Reset(threads);
+  auto& per_thread = workspace.per_thread;
   const auto count = static_cast<std::int64_t>(beams.size());
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 4)
   for (std::int64_t b = 0; b < count; ++b) {
@@ -99,16 +160,17 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
   // and each octant's path to one of its keys are created first, serially, so no two threads
   // create the same node. Neither the order nor the threads change the result: each cell is
   // updated once. OctoMap's node count and the inner nodes are left for FinishUpdates.
-  using Update = std::pair<std::uint64_t, octomap::OcTreeKey>;  // Morton code << 1 | occupied
-  std::vector<std::array<std::vector<Update>, 8>> split(per_thread.size());
+  // An update is the cell's Morton code << 1 | occupied.
+  auto& split = workspace.split;
 #pragma omp parallel for num_threads(threads) schedule(static, 1)
   for (int t = 0; t < threads; ++t) {
     auto& octants = split[static_cast<std::size_t>(t)];
     const auto& cells = per_thread[static_cast<std::size_t>(t)];
     auto add = [&octants](const octomap::OcTreeKey& key, std::uint64_t occupied) {
       const std::uint64_t code = MortonCode(key);
-      octants[code >> 45].emplace_back((code << 1) | occupied, key);
+      octants[code >> 45].push_back((code << 1) | occupied);
     };
+    for (auto& part : octants) part.clear();
     for (const auto& key : cells.free) add(key, 0);
     for (const auto& key : cells.occupied) add(key, 1);
   }
@@ -116,7 +178,7 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
   for (unsigned o = 0; o < 8; ++o) {
     for (const auto& octants : split) {
       if (octants[o].empty()) continue;
-      tree.CreatePath(octants[o].front().second);
+      tree.CreatePath(KeyFromMortonCode(octants[o].front() >> 1));
       break;
     }
   }
@@ -125,30 +187,29 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
   std::array<std::size_t, 8> occupied_cells{};
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
   for (int o = 0; o < 8; ++o) {
-    std::vector<Update> updates;
-    for (auto& octants : split) {
-      auto& part = octants[static_cast<std::size_t>(o)];
+    auto& updates = workspace.updates[static_cast<std::size_t>(o)];
+    updates.clear();
+    for (const auto& octants : split) {
+      const auto& part = octants[static_cast<std::size_t>(o)];
       updates.insert(updates.end(), part.begin(), part.end());
-      std::vector<Update>().swap(part);
     }
-    std::sort(updates.begin(), updates.end(),
-              [](const Update& a, const Update& b) { return a.first < b.first; });
+    RadixSort(updates, workspace.scratch[static_cast<std::size_t>(o)]);
     // A cell's copies are adjacent, free (0) before occupied (1): the last one is kept.
     std::size_t kept = 0;
-    for (const Update& u : updates) {
-      if (kept > 0 && (updates[kept - 1].first >> 1) == (u.first >> 1)) {
+    for (const std::uint64_t u : updates) {
+      if (kept > 0 && (updates[kept - 1] >> 1) == (u >> 1)) {
         updates[kept - 1] = u;
       } else {
         updates[kept++] = u;
       }
     }
     updates.resize(kept);
-    for (const Update& u : updates) {
-      (u.first & 1 ? occupied_cells : free_cells)[static_cast<std::size_t>(o)] += 1;
+    for (const std::uint64_t u : updates) {
+      (u & 1 ? occupied_cells : free_cells)[static_cast<std::size_t>(o)] += 1;
     }
     tree.UpdateLeavesInOrder(
-        updates.size(), [&updates](std::size_t i) { return updates[i].second; },
-        [&updates, &log_odds](std::size_t i) { return log_odds[updates[i].first & 1]; });
+        updates.size(), [&updates](std::size_t i) { return KeyFromMortonCode(updates[i] >> 1); },
+        [&updates, &log_odds](std::size_t i) { return log_odds[updates[i] & 1]; });
   }
 
   BatchStats stats;
@@ -167,6 +228,16 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
   stats.split_s = split_done - cast_done;
   stats.update_s = omp_get_wtime() - split_done;
   return stats;
+}
+
+/// The same with a workspace of its own, for a single batch.
+template <typename Set>
+BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
+                          std::span<const std::vector<double>> obstacles,
+                          std::span<const Eigen::Vector3d> directions, double free_range_m,
+                          int threads) {
+  BatchWorkspace<Set> workspace;
+  return IntegrateBatch(tree, beams, obstacles, directions, free_range_m, threads, workspace);
 }
 
 }  // namespace sonarbench::mapping

@@ -3,12 +3,14 @@
 #include <octomap/OcTreeKey.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <new>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -79,6 +81,17 @@ class OpenKeySet {
   bool insert(const octomap::OcTreeKey& key) { return InsertPacked(PackKey(key)); }
   /// Inserts a key already packed with PackKey.
   bool insert_packed(std::uint64_t packed) { return InsertPacked(packed); }
+  /// Inserts keys already packed, fetching each one's home slot into the cache a few keys
+  /// ahead, so that the misses of a large table overlap instead of waiting in turn.
+  void insert_packed(std::span<const std::uint64_t> keys) {
+    constexpr std::size_t kAhead = 8;
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      if (i + kAhead < keys.size() && capacity_ > 0) {
+        __builtin_prefetch(slots_ + Home(Hash(keys[i + kAhead])), 1);
+      }
+      InsertPacked(keys[i]);
+    }
+  }
   template <typename It>
   void insert(It first, It last) {
     for (; first != last; ++first) InsertPacked(PackKey(*first));
@@ -412,6 +425,28 @@ class OpenKeySet {
   std::size_t tombstones_ = 0;
   std::uint64_t collisions_ = 0;
   std::size_t peak_bytes_ = 0;
+};
+
+/// The keys most recently inserted into one set, in a direct-mapped table small enough to stay
+/// in the first-level cache: a key found here is in the set already, so its insert (a probe of
+/// a table that may be megabytes) can be skipped; a key not found may or may not be in the set.
+/// Neighbouring beams share most of their cells, so most repeats are caught here. Clear it
+/// whenever its set is cleared.
+class RecentKeys {
+ public:
+  RecentKeys() { clear(); }
+  /// Whether `packed` was remembered; remembers it (evicting the key in its slot) if not.
+  bool CheckAndRemember(std::uint64_t packed) {
+    std::uint64_t& slot = slots_[(packed * 0x9e3779b97f4a7c15ULL) >> (64 - kBits)];
+    if (slot == packed) return true;
+    slot = packed;
+    return false;
+  }
+  void clear() { slots_.fill(~std::uint64_t{0}); }  // no packed key is all ones
+
+ private:
+  static constexpr unsigned kBits = 12;  // 4096 keys, 32 KiB
+  std::array<std::uint64_t, std::size_t{1} << kBits> slots_;
 };
 
 /// The set the mapper uses: quadratic probing (the paper's best) with all-at-once resize, which

@@ -10,6 +10,7 @@
 
 #include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/mapping/integrate.hpp"
+#include "sonarbench/mapping/key_set.hpp"
 #include "sonarbench/mapping/map_tree.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
@@ -63,6 +64,9 @@ class Mapper {
   int threads_ = 1;
   std::vector<Eigen::Vector3d> directions_;
   std::unique_ptr<MapTree> tree_;
+  /// The key sets and buffers of the batches, kept between them (the one of config.key_set).
+  BatchWorkspace<KeySet> std_workspace_;
+  BatchWorkspace<KeyOpenSet> open_workspace_;
   /// Whether the tree's node count and inner nodes lag its leaves (see FinishUpdates).
   mutable bool stale_ = false;
 };
