@@ -34,6 +34,17 @@ template <typename Set>
   for (const auto& key : reference) {
     if (!set.contains(key)) return ::testing::AssertionFailure() << "lost a key";
   }
+  if constexpr (requires { set.for_each_packed([](std::uint64_t) {}); }) {
+    // The blockwise walk yields what the iterator yields, in the same order.
+    std::vector<std::uint64_t> iterated;
+    std::vector<std::uint64_t> walked;
+    for (const auto& key : set) iterated.push_back(PackKey(key));
+    set.for_each_packed([&walked](std::uint64_t packed) { walked.push_back(packed); });
+    if (walked != iterated) {
+      return ::testing::AssertionFailure() << "for_each_packed yields " << walked.size()
+                                           << " keys, not the iterator's " << iterated.size();
+    }
+  }
   return ::testing::AssertionSuccess();
 }
 

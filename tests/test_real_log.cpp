@@ -133,6 +133,30 @@ LineFit FitWall(const std::vector<Eigen::Vector2d>& points, double band_m,
   return best;
 }
 
+// `sonarbench map` takes the real log's folder as well as the file: a directory that is not a
+// dataset and holds one .mat log means that log; two are refused, naming both.
+TEST(RealLogMap, FolderHoldingOneLogMeansThatLog) {
+  REQUIRE_REAL_LOG();
+  const std::filesystem::path log(RealLogPath());
+  EXPECT_EQ(std::filesystem::path(sim::MatLogInDirectory(log.parent_path().string())), log);
+  EXPECT_EQ(sim::MatLogInDirectory(log.string()), "");  // a file is read as it is
+  test::TempDir dir;
+  EXPECT_EQ(sim::MatLogInDirectory(dir.path().string()), "");  // left to the dataset reader
+  std::filesystem::create_symlink(log, dir.path() / "a.mat");
+  EXPECT_EQ(sim::MatLogInDirectory(dir.path().string()), (dir.path() / "a.mat").string());
+  std::filesystem::create_symlink(log, dir.path() / "b.mat");
+  try {
+    (void)sim::MatLogInDirectory(dir.path().string());
+    ADD_FAILURE() << "two logs accepted";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("2 .mat logs"), std::string::npos) << message;
+    EXPECT_NE(message.find("b.mat"), std::string::npos) << message;
+  }
+  std::ofstream(dir.path() / "manifest.json") << "{}";
+  EXPECT_EQ(sim::MatLogInDirectory(dir.path().string()), "");  // a dataset stays a dataset
+}
+
 // The real tank through `sonarbench map`'s defaults: its walls must come out straight and the
 // square closed. Wall candidates are the occupied cells at the sonar's height (|z| ≤ one cell)
 // beyond 1.6 m (inside lie the floor ring and the vehicle's own echoes), binned by 1° of bearing.

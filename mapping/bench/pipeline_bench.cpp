@@ -3,18 +3,21 @@
 // run, against a naive OctoMap pipeline. Prints a table with each variant's median time over
 // --repeats runs and its speed-up against the naive pipeline and against std::unordered_set.
 //
-//   pipeline_bench [LOG.mat] [--repeats N] [--resolution M]
+//   pipeline_bench [LOG.mat] [--repeats N] [--resolution M] [--sets-only]
 //
-// Every mapper variant must produce the same map, byte for byte (checked; a mismatch is an
+// Every mapper variant must produce the same map, leaf for leaf (checked; a mismatch is an
 // error). The naive pipeline is: one thread, per beam OctoMap's computeRayKeys into its KeySet,
 // then updateNode per key: a cell seen by k beams of a sweep is updated k times, so its map
 // differs.
+//
+// A second table isolates the key sets' share: every insert and iteration the mapper's threads
+// made into their sets, recorded from a mapper run and replayed alone into each set type (the
+// issue's "within the mapper" comparison, without the ray casting around it).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <functional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -38,10 +41,19 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// The map's leaves, each as its key, depth and log-odds bytes, in tree order: equal exactly
+// when the maps are (OctoMap's own writeBinary would do, but prints to stderr on Debian's build).
 std::string Bytes(const octomap::OcTree& tree) {
-  std::ostringstream out;
-  tree.writeBinaryConst(out);
-  return out.str();
+  std::string bytes;
+  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
+    const octomap::OcTreeKey key = it.getKey();
+    const unsigned depth = it.getDepth();
+    const float log_odds = it->getLogOdds();
+    bytes.append(reinterpret_cast<const char*>(&key[0]), 3 * sizeof(key[0]));
+    bytes.append(reinterpret_cast<const char*>(&depth), sizeof(depth));
+    bytes.append(reinterpret_cast<const char*>(&log_odds), sizeof(log_odds));
+  }
+  return bytes;
 }
 
 MapTree MakeTree(const MapperConfig& config) {
@@ -107,29 +119,88 @@ std::string RunNaive(const std::vector<Beam>& beams, const SensorGeometry& senso
   return Bytes(tree);
 }
 
-int Main(int argc, char** argv) {
-  std::string path = SONARBENCH_REAL_LOG;
-  int repeats = 3;
-  MapperConfig config;
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) {
-      repeats = std::max(1, std::atoi(argv[++i]));
-    } else if (std::strcmp(argv[i], "--resolution") == 0 && i + 1 < argc) {
-      config.resolution_m = std::atof(argv[++i]);
-    } else if (argv[i][0] != '-') {
-      path = argv[i];
-    } else {
-      std::fprintf(stderr, "usage: pipeline_bench [LOG.mat] [--repeats N] [--resolution M]\n");
-      return 2;
+// A KeyOpenSet that logs every key it is given, batch by batch (a clear() starts a batch): the
+// key sets' share of the mapper's work, recorded to be replayed into other sets.
+class RecordingSet {
+ public:
+  void insert_packed(std::span<const std::uint64_t> keys) {
+    log.back().insert(log.back().end(), keys.begin(), keys.end());
+    set_.insert_packed(keys);
+  }
+  bool insert(const octomap::OcTreeKey& key) {
+    log.back().push_back(PackKey(key));
+    return set_.insert(key);
+  }
+  void clear() {
+    set_.clear();
+    log.emplace_back();
+  }
+  void reserve(std::size_t n) { set_.reserve(n); }
+  [[nodiscard]] std::size_t size() const { return set_.size(); }
+  [[nodiscard]] auto begin() const { return set_.begin(); }
+  [[nodiscard]] auto end() const { return set_.end(); }
+  template <typename F>
+  void for_each_packed(F&& f) const {
+    set_.for_each_packed(f);
+  }
+
+  std::vector<std::vector<std::uint64_t>> log{1};
+
+ private:
+  KeyOpenSet set_;
+};
+
+// Per thread of a mapper run, the keys its free and its occupied set were given, per sweep.
+struct SetStreams {
+  std::vector<std::vector<std::uint64_t>> free;
+  std::vector<std::vector<std::uint64_t>> occupied;
+};
+
+std::vector<SetStreams> RecordSetStreams(const std::vector<Beam>& beams,
+                                         const SensorGeometry& sensor, const MapperConfig& config,
+                                         int threads) {
+  MapTree tree = MakeTree(config);
+  const auto directions = BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical);
+  const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
+  const std::span<const Beam> all(beams);
+  BatchWorkspace<RecordingSet> workspace;
+  for (std::size_t first = 0; first < all.size(); first += per_sweep) {
+    const auto sweep = all.subspan(first, std::min(per_sweep, all.size() - first));
+    const auto obstacles = DetectObstacles(sweep, sensor, config.detection);
+    IntegrateBatch(tree, sweep, obstacles, directions, sensor.MaxRangeM(), threads, workspace);
+  }
+  std::vector<SetStreams> streams;
+  for (auto& cells : workspace.per_thread) {
+    streams.push_back({std::move(cells.free.log), std::move(cells.occupied.log)});
+  }
+  return streams;
+}
+
+// Replays the recorded streams into sets of type `Set` as the mapper uses them: per sweep,
+// empty the set keeping its room (BasicBeamCells::Clear), insert the sweep's keys, iterate them
+// (the split into octants). Returns the wall time [s]; `checksum` keeps the work observable.
+template <typename Set>
+double ReplaySetStreams(const std::vector<SetStreams>& streams, std::uint64_t& checksum) {
+  const auto start = std::chrono::steady_clock::now();
+  for (const SetStreams& stream : streams) {
+    for (const auto* batches : {&stream.free, &stream.occupied}) {
+      Set set;
+      for (const auto& keys : *batches) {
+        const std::size_t held = set.size();
+        set.clear();
+        set.reserve(held);
+        BasicBeamCells<Set>::Insert(set, keys);
+        BasicBeamCells<Set>::ForEach(set,
+                                     [&checksum](std::uint64_t packed) { checksum += packed; });
+      }
     }
   }
-  const MatLog log = ReadMatLog(path);
-  const SensorGeometry sensor;
-  const int cores = omp_get_max_threads();
-  std::printf("log %s: %zu beams; resolution %.3f m; %d x %d rays per beam; %d cores\n",
-              path.c_str(), log.beams.size(), config.resolution_m, config.rays_horizontal,
-              config.rays_vertical, cores);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
+// The whole mapper with each key set against the naive pipeline (Table 1).
+int PipelineTable(const MatLog& log, const SensorGeometry& sensor, const MapperConfig& config,
+                  int cores, int repeats) {
   BatchStats totals;
   const std::vector<Variant> variants = {
       {"naive OctoMap (computeRayKeys + KeySet + updateNode per beam)", 1,
@@ -180,7 +251,91 @@ int Main(int argc, char** argv) {
       static_cast<double>(totals.cell_visits) / static_cast<double>(totals.beam_free_cells));
   std::printf("stages of '%s' (last run): cast %.2f s, split %.2f s, update %.2f s\n",
               variants[4].name.c_str(), totals.cast_s, totals.split_s, totals.update_s);
+
   return 0;
+}
+
+// The key sets' work inside the mapper, replayed alone.
+int SetTable(const MatLog& log, const SensorGeometry& sensor, const MapperConfig& config, int cores,
+             int repeats) {
+  const auto streams = RecordSetStreams(log.beams, sensor, config, cores);
+  std::size_t inserts = 0;
+  std::size_t batches = 0;
+  for (const SetStreams& stream : streams) {
+    for (const auto* part : {&stream.free, &stream.occupied}) {
+      for (const auto& keys : *part) inserts += keys.size();
+      batches += part->size();
+    }
+  }
+  struct Replay {
+    const char* name;
+    double (*run)(const std::vector<SetStreams>&, std::uint64_t&);
+  };
+  const Replay replays[] = {
+      {"std::unordered_set (OctoMap KeySet)", &ReplaySetStreams<KeySet>},
+      {"abseil flat_hash_set", &ReplaySetStreams<AbslKeySet>},
+      {"OpenKeySet quadratic, all-at-once resize", &ReplaySetStreams<QuadraticAllAtOnce>},
+      {"OpenKeySet quadratic, in-place resize", &ReplaySetStreams<Quadratic>},
+  };
+  std::vector<double> replay_times;
+  std::uint64_t reference_checksum = 0;
+  for (std::size_t r = 0; r < std::size(replays); ++r) {
+    std::vector<double> runs;
+    for (int i = 0; i < repeats; ++i) {
+      std::uint64_t checksum = 0;
+      runs.push_back(replays[r].run(streams, checksum));
+      if (r == 0 && i == 0) reference_checksum = checksum;
+      if (checksum != reference_checksum) {
+        std::fprintf(stderr, "error: '%s' replayed to different keys\n", replays[r].name);
+        return 1;
+      }
+    }
+    replay_times.push_back(Median(runs));
+  }
+  std::printf(
+      "\nthe key sets' work inside the mapper, replayed alone: %zu inserts in %zu set-sweeps "
+      "(every insert and iteration the mapper's %d threads made, 1 thread)\n%-62s %9s %9s %9s\n",
+      inserts, batches, cores, "set", "median s", "vs std", "vs abseil");
+  for (std::size_t r = 0; r < std::size(replays); ++r) {
+    std::printf("%-62s %9.3f %8.2fx %8.2fx\n", replays[r].name, replay_times[r],
+                replay_times[0] / replay_times[r], replay_times[1] / replay_times[r]);
+  }
+  return 0;
+}
+
+int Main(int argc, char** argv) {
+  std::string path = SONARBENCH_REAL_LOG;
+  int repeats = 3;
+  bool sets_only = false;
+  MapperConfig config;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) {
+      repeats = std::max(1, std::atoi(argv[++i]));
+    } else if (std::strcmp(argv[i], "--sets-only") == 0) {
+      sets_only = true;
+    } else if (std::strcmp(argv[i], "--resolution") == 0 && i + 1 < argc) {
+      config.resolution_m = std::atof(argv[++i]);
+    } else if (argv[i][0] != '-') {
+      path = argv[i];
+    } else {
+      std::fprintf(
+          stderr, "usage: pipeline_bench [LOG.mat] [--repeats N] [--resolution M] [--sets-only]\n");
+      return 2;
+    }
+  }
+  const MatLog log = ReadMatLog(path);
+  const SensorGeometry sensor;
+  const int cores = omp_get_max_threads();
+  std::printf("log %s: %zu beams; resolution %.3f m; %d x %d rays per beam; %d cores\n",
+              path.c_str(), log.beams.size(), config.resolution_m, config.rays_horizontal,
+              config.rays_vertical, cores);
+
+  if (!sets_only) {
+    if (const int status = PipelineTable(log, sensor, config, cores, repeats); status != 0) {
+      return status;
+    }
+  }
+  return SetTable(log, sensor, config, cores, repeats);
 }
 
 }  // namespace

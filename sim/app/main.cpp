@@ -150,7 +150,8 @@ int Map(const MapArgs& args) {
   std::cout << result.beams << " beams (" << result.truncated_beams << " truncated) in "
             << result.sweeps << " sweeps; " << t.beams_with_obstacle << " with an obstacle\n"
             << "timing [s]: import " << result.import_s << ", map " << result.map_s << "\n"
-            << "wrote " << args.out << "/report.json, map.bt, map.ot, map_top.png\n";
+            << "wrote " << args.out
+            << "/report.json, map.bt, map.ot, map_top.png, polar.png, fan.png\n";
   return 0;
 }
 
@@ -375,12 +376,15 @@ int main(int argc, char** argv) {
       "map",
       "Map a recorded log with the production mapper: INPUT is a sonarbench dataset directory "
       "(from `simulate` or `import`; its manifest's sensor is used) or a real MSIS log in MATLAB "
-      ".mat form (the CRAS lab's parsedData layout; the vehicle static at the origin). Writes "
+      ".mat form (the CRAS lab's parsedData layout; the vehicle static at the origin), or a folder "
+      "holding one such log. Writes "
       "map.bt "
       "and map.ot (octovis), map_top.png (occupied cells from above), polar.png and fan.png (the "
       "first sweep) and report.json into --out. The sensor is the SHAD Micron and the mapper "
       "uses its defaults unless --scene, --sensor or --mapping say otherwise.");
-  map_cmd->add_option("input", map.input, "A dataset directory or a .mat log")
+  map_cmd
+      ->add_option("input", map.input,
+                   "A dataset directory, a .mat log, or a folder holding one .mat log")
       ->required()
       ->check(CLI::ExistingPath);
   map_cmd->add_option("-o,--out", map.out, "Output directory (created if needed)")

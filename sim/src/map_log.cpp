@@ -1,5 +1,6 @@
 #include "sonarbench/sim/map_log.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,26 @@
 
 namespace sonarbench::sim {
 
+std::string MatLogInDirectory(const std::string& input) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_directory(input, error) || fs::exists(fs::path(input) / "manifest.json", error)) {
+    return {};
+  }
+  std::vector<std::string> logs;
+  for (const auto& entry : fs::directory_iterator(input, error)) {
+    if (entry.is_regular_file(error) && entry.path().extension() == ".mat") {
+      logs.push_back(entry.path().string());
+    }
+  }
+  if (logs.size() <= 1) return logs.empty() ? std::string() : logs.front();
+  std::sort(logs.begin(), logs.end());
+  std::string names;
+  for (const auto& log : logs) names += "\n  " + log;
+  throw InputError(input + ": not a sonarbench dataset and holds " + std::to_string(logs.size()) +
+                   " .mat logs; name the one to map:" + names);
+}
+
 LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
                     const mapping::MapperConfig& config) {
   LogMapResult result;
@@ -21,16 +42,18 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
   auto start = std::chrono::steady_clock::now();
   std::vector<mapping::Beam> beams;
   mapping::SensorGeometry geometry = sensor;
-  if (std::filesystem::is_directory(input)) {
+  const std::string log_file = MatLogInDirectory(input);
+  if (log_file.empty() && std::filesystem::is_directory(input)) {
     mapping::Dataset dataset = mapping::ReadDataset(input);
     geometry = dataset.sensor;  // a dataset carries its sensor
     beams = std::move(dataset.beams);
     result.source = "dataset";
   } else {
-    mapping::MatLog log = mapping::ReadMatLog(input);
+    mapping::MatLog log = mapping::ReadMatLog(log_file.empty() ? input : log_file);
     beams = std::move(log.beams);
     result.truncated_beams = log.truncated_beams;
     result.source = "mat";
+    if (!log_file.empty()) result.input = log_file;
   }
   auto now = std::chrono::steady_clock::now();
   result.import_s = std::chrono::duration<double>(now - start).count();

@@ -63,6 +63,16 @@ struct BasicBeamCells {
     beam_free_cells = 0;
   }
 
+  /// Calls `f(packed)` for each key of `set`, one of the two, in the set's order.
+  template <typename F>
+  static void ForEach(const Set& set, F&& f) {
+    if constexpr (requires { set.for_each_packed(f); }) {
+      set.for_each_packed(f);
+    } else {
+      for (const octomap::OcTreeKey& key : set) f(PackKey(key));
+    }
+  }
+
   /// Inserts keys (packed) into `set`, one of the two.
   static void Insert(Set& set, std::span<const std::uint64_t> packed) {
     if constexpr (requires { set.insert_packed(packed); }) {

@@ -166,13 +166,15 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
   for (int t = 0; t < threads; ++t) {
     auto& octants = split[static_cast<std::size_t>(t)];
     const auto& cells = per_thread[static_cast<std::size_t>(t)];
-    auto add = [&octants](const octomap::OcTreeKey& key, std::uint64_t occupied) {
-      const std::uint64_t code = MortonCode(key);
-      octants[code >> 45].push_back((code << 1) | occupied);
-    };
     for (auto& part : octants) part.clear();
-    for (const auto& key : cells.free) add(key, 0);
-    for (const auto& key : cells.occupied) add(key, 1);
+    using Cells = BasicBeamCells<Set>;
+    for (const std::uint64_t occupied : {0u, 1u}) {
+      Cells::ForEach(occupied != 0 ? cells.occupied : cells.free,
+                     [&octants, occupied](std::uint64_t packed) {
+                       const std::uint64_t code = MortonCode(UnpackKey(packed));
+                       octants[code >> 45].push_back((code << 1) | occupied);
+                     });
+    }
   }
   const double split_done = omp_get_wtime();
   for (unsigned o = 0; o < 8; ++o) {

@@ -23,9 +23,15 @@ struct LogMapResult {
   std::vector<mapping::Beam> first_sweep;
 };
 
-/// Reads a real `.mat` log or a dataset directory (mapping::ReadDataset; its own sensor geometry
-/// replaces `sensor`) and maps it sweep by sweep (BeamsPerSweep() consecutive beams each; the
-/// last sweep may be partial). Throws InputError for input that is not a readable log.
+/// The `.mat` log to read when `input` is a directory that is not a dataset (no manifest.json)
+/// and holds exactly one `.mat` file, as the real log's folder does; "" when `input` is a
+/// dataset, a file, or a directory without one. Throws InputError when it holds several.
+[[nodiscard]] std::string MatLogInDirectory(const std::string& input);
+
+/// Reads a real `.mat` log (a file, or a folder holding just one, see MatLogInDirectory) or a
+/// dataset directory (mapping::ReadDataset; its own sensor geometry replaces `sensor`) and maps it
+/// sweep by sweep (BeamsPerSweep() consecutive beams each; the last sweep may be partial). Throws
+/// InputError for input that is not a readable log.
 [[nodiscard]] LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
                                   const mapping::MapperConfig& config);
 
