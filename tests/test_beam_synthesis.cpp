@@ -3,10 +3,14 @@
 #include <cmath>
 #include <fstream>
 #include <numeric>
+#include <optional>
 #include <sstream>
+#include <stdexcept>
+#include <utility>
 
 #include "sonarbench/mapping/detection.hpp"
 #include "sonarbench/sim/beam_synthesizer.hpp"
+#include "sonarbench/sim/fast_math.hpp"
 #include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/random.hpp"
 #include "sonarbench/sim/simulation.hpp"
@@ -215,6 +219,105 @@ TEST(RayTracer, OccludedOnlyBySurfacesWithinTheSegment) {
   EXPECT_TRUE(tracer.Occluded(Eigen::Vector3f(2.0f, 0, 0), -x, 1.01f));
 }
 
+// The synthesis traces each beam's rays as one coherent stream: it must find what one query per
+// ray finds. Rays in every direction from inside a tank (walls, floor, open top, and a box
+// whose edges some rays graze): the same rays hit, the same meshes, the same distances to
+// float rounding (1e-5 relative: a few ulps of the float tfar), the same normals.
+TEST(RayTracer, BundleFindsWhatSingleRaysFind) {
+  MeshSpec tank;
+  tank.type = MeshSpec::Type::kTank;
+  tank.size_m = {4.4, 4.4, 2.0};
+  MeshSpec box;
+  box.size_m = {0.5, 0.3, 0.4};
+  box.T_world_mesh = mapping::PoseFromXyzRpy({1.0, 0.5, 0.3}, {0, 0, 0.4});
+  const std::vector<TriangleMesh> meshes = {BuildMesh(tank, 1), BuildMesh(box, 1)};
+  const RayTracer tracer(meshes);
+  Rng rng(77);
+  const Eigen::Vector3f origin(0.2f, -0.1f, 0.8f);
+  std::vector<Eigen::Vector3f> directions(1000);
+  for (auto& d : directions) {
+    d = Eigen::Vector3f(static_cast<float>(rng.Normal()), static_cast<float>(rng.Normal()),
+                        static_cast<float>(rng.Normal()))
+            .normalized();
+  }
+  std::vector<std::optional<Hit>> bundle(directions.size());
+  tracer.IntersectBundle(origin, directions, 3.0f, bundle);
+  int hits = 0;
+  for (std::size_t i = 0; i < directions.size(); ++i) {
+    const auto single = tracer.Intersect(origin, directions[i], 3.0f);
+    ASSERT_EQ(single.has_value(), bundle[i].has_value()) << "ray " << i;
+    if (!single) continue;
+    ++hits;
+    EXPECT_EQ(single->mesh, bundle[i]->mesh) << "ray " << i;
+    EXPECT_NEAR(single->distance, bundle[i]->distance, 1e-5f * single->distance) << "ray " << i;
+    EXPECT_GT(std::abs(single->normal.dot(bundle[i]->normal)), 1.0f - 1e-5f) << "ray " << i;
+  }
+  EXPECT_GT(hits, 500);   // the walls and floor within 3 m of most directions
+  EXPECT_LT(hits, 1000);  // the open top lets some out
+  std::vector<std::optional<Hit>> short_hits(3);
+  EXPECT_THROW(tracer.IntersectBundle(origin, directions, 3.0f, short_hits), std::invalid_argument);
+}
+
+// The ray directions' sine and cosine: the series agrees with libm to a few ulps over the
+// angles a beam uses, and beyond them is libm's.
+TEST(SmallAngleSinCos, AgreesWithLibm) {
+  for (int i = -1000; i <= 1000; ++i) {
+    const double x = 0.8 * i / 1000.0;
+    const SinCos sc = SmallAngleSinCos(x);
+    EXPECT_NEAR(sc.sin, std::sin(x), 4e-16) << x;
+    EXPECT_NEAR(sc.cos, std::cos(x), 4e-16) << x;
+  }
+  for (const double x : {0.81, -1.0, 3.0, 100.0}) {
+    EXPECT_EQ(SmallAngleSinCos(x).sin, std::sin(x)) << x;
+    EXPECT_EQ(SmallAngleSinCos(x).cos, std::cos(x)) << x;
+  }
+}
+
+// The synthesis quantises powers without a logarithm and takes range losses from a table:
+// the same AD step as the dB formula for powers across and beyond the AD window (away from
+// the steps' edges, where the two roundings may differ by one ulp), and the loss within its
+// stated 1e-4 of the exact one, for the default sensor and for one whose spreading exceeds its
+// TVG by 20 dB per decade (the table's steepest case).
+TEST(BeamSynthesis, QuantisedPowersAndTabledLossesMatchTheirFormulas) {
+  std::vector<TriangleMesh> meshes = Wall(1.0, 0.0);
+  const RayTracer tracer(meshes);
+  SensorModel sensor;
+  const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
+  const Acoustics& a = sensor.acoustics;
+  int compared = 0;
+  for (double db = a.ad_low_db - 20.0; db <= a.ad_low_db + a.ad_span_db + 20.0; db += 0.0137) {
+    const double steps = (db - a.ad_low_db) / a.ad_span_db * 255.0;
+    if (std::abs(steps - std::round(steps - 0.5) - 0.5) < 1e-9) continue;  // on an edge
+    ASSERT_EQ(synthesizer.QuantisePower(std::pow(10.0, db / 10.0)), synthesizer.Quantise(db))
+        << db << " dB";
+    ++compared;
+  }
+  EXPECT_GT(compared, 5000);
+  EXPECT_EQ(synthesizer.QuantisePower(0.0), 0);
+  // AD windows of other spans: the table's buckets narrow with the step, the result stays exact.
+  for (const double span : {3.0, 120.0}) {
+    SensorModel other = sensor;
+    other.acoustics.ad_span_db = span;
+    const BeamSynthesizer s(other, tracer, {Material{}});
+    for (double db = a.ad_low_db - 5.0; db <= a.ad_low_db + span + 5.0; db += span / 2917.0) {
+      const double steps = (db - a.ad_low_db) / span * 255.0;
+      if (std::abs(steps - std::round(steps - 0.5) - 0.5) < 1e-9) continue;
+      ASSERT_EQ(s.QuantisePower(std::pow(10.0, db / 10.0)), s.Quantise(db))
+          << db << " dB, span " << span;
+    }
+  }
+  for (const double spreading : {a.spreading_db_per_decade, a.tvg_db_per_decade + 20.0}) {
+    SensorModel steep = sensor;
+    steep.acoustics.spreading_db_per_decade = spreading;
+    const BeamSynthesizer s(steep, tracer, {Material{}});
+    const double bin = steep.geometry.bin_size_m;
+    for (double r = 0.5 * bin; r <= steep.geometry.MaxRangeM() + 2 * bin; r += 0.0173 * bin) {
+      const double exact = s.RangeLoss(r);
+      ASSERT_NEAR(s.RangeLossFromTable(r), exact, 1e-4 * exact) << r << " m, S " << spreading;
+    }
+  }
+}
+
 // The speckle and noise draws are exponential with mean 1 (the power of a Rayleigh amplitude).
 // Kolmogorov-Smirnov against F(x) = 1 - exp(-x) on 200000 draws, fixed seed: the critical value
 // at a 0.1% false-alarm rate is 1.949 / sqrt(n).
@@ -230,6 +333,31 @@ TEST(Rng, ExponentialDrawsFollowTheirDistribution) {
     d = std::max({d, f - static_cast<double>(i) / kDraws, static_cast<double>(i + 1) / kDraws - f});
   }
   EXPECT_LT(d, 1.949 / std::sqrt(static_cast<double>(kDraws)));
+}
+
+// The ziggurat's rare paths: the tail beyond its last edge R = 7.697 and the wedges between
+// layers. Over 4 M draws, the counts beyond R, beyond 10 and in (1, 1.01] are binomial with
+// p = e^-R, e^-10 and e^-1 - e^-1.01; each must lie within 3.29 standard deviations of n·p (a
+// 0.1% false-alarm rate each, two-sided), fixed seed.
+TEST(Rng, ExponentialTailAndWedgesHaveTheirProbabilities) {
+  constexpr double kDraws = 4e6;
+  Rng rng(4242);
+  double beyond_r = 0;
+  double beyond_10 = 0;
+  double in_wedge = 0;
+  for (int i = 0; i < static_cast<int>(kDraws); ++i) {
+    const double x = rng.Exponential();
+    ASSERT_GE(x, 0.0);
+    beyond_r += x > ExponentialZiggurat::kR ? 1 : 0;
+    beyond_10 += x > 10.0 ? 1 : 0;
+    in_wedge += (x > 1.0 && x <= 1.01) ? 1 : 0;
+  }
+  for (const auto& [count, p] : {std::pair{beyond_r, std::exp(-ExponentialZiggurat::kR)},
+                                 std::pair{beyond_10, std::exp(-10.0)},
+                                 std::pair{in_wedge, std::exp(-1.0) - std::exp(-1.01)}}) {
+    const double mean = kDraws * p;
+    EXPECT_NEAR(count, mean, 3.29 * std::sqrt(mean * (1 - p))) << "p " << p;
+  }
 }
 
 // With nothing to echo, a bin holds noise of exponential power with mean N (noise_level_db); it

@@ -1,13 +1,18 @@
 // Google Benchmark of beam synthesis against raw Embree (issue 3's speed goals), one sweep of the
 // default tank scenario:
-//   BM_RawEmbree        the same number of rays, in the same stratified pattern, intersected only
+//   BM_RawEmbree        the synthesis's primary rays, generated beforehand, intersected only:
+//                       one rtcIntersect1 per ray
+//   BM_RawEmbreeBundle  the same, each beam's rays as one coherent stream (rtcIntersect1M), the
+//                       query the synthesis makes
 //   BM_Synthesis/1, /2  the whole synthesis (hits, backscatter, the scene's multipath: mirrored and
 //                       occlusion rays, range spreading, noise, quantisation) on 1 and 2 threads
-// Counters: primary rays per second (compare BM_Synthesis/1 with BM_RawEmbree) and, for the
-// synthesis, the real-time factor: the real sonar's time for the sweep over ours.
+// Counters: primary rays per second (compare BM_SynthesisNoMultipath with the faster raw one) and,
+// for the synthesis, the real-time factor: the real sonar's time for the sweep over ours.
 #include <benchmark/benchmark.h>
 
 #include <numbers>
+#include <optional>
+#include <vector>
 
 #include "sonarbench/sim/beam_synthesizer.hpp"
 #include "sonarbench/sim/mesh.hpp"
@@ -38,32 +43,75 @@ double PrimaryRaysPerSweep(const Scene& scene) {
          scene.sensor.geometry.BeamsPerSweep();
 }
 
-void BM_RawEmbree(benchmark::State& state) {
-  Tank& tank = TheTank();
-  const auto& g = tank.scene.sensor.geometry;
-  const Acoustics& a = tank.scene.sensor.acoustics;
-  const auto max_range = static_cast<float>(g.MaxRangeM());
-  for (auto _ : state) {
-    std::size_t hits = 0;
+// One sweep's primary rays, as the synthesis draws them (same seeds, same stratified jitter),
+// generated once, outside any timing.
+struct SweepRays {
+  std::vector<Eigen::Vector3f> origins;                  // per beam
+  std::vector<std::vector<Eigen::Vector3f>> directions;  // per beam, per ray
+};
+
+const SweepRays& TheSweepRays() {
+  static const SweepRays rays = [] {
+    const Tank& tank = TheTank();
+    const auto& g = tank.scene.sensor.geometry;
+    const Acoustics& a = tank.scene.sensor.acoustics;
+    SweepRays out;
     for (int b = 0; b < g.BeamsPerSweep(); ++b) {
       const ScheduledBeam s = ScheduleBeam(tank.scene, static_cast<std::size_t>(b));
       const Eigen::Matrix3d R =
           s.pose.T_world_sonar.linear() *
           Eigen::AngleAxisd(s.pose.head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      const Eigen::Vector3f origin = s.pose.T_world_sonar.translation().cast<float>();
+      out.origins.push_back(s.pose.T_world_sonar.translation().cast<float>());
+      auto& directions = out.directions.emplace_back();
       Rng rng(DeriveSeed(1, static_cast<std::uint64_t>(b)));
       for (int i = 0; i < a.rays_horizontal; ++i) {
         for (int j = 0; j < a.rays_vertical; ++j) {
-          const double theta =
-              ((i + rng.Uniform()) / a.rays_horizontal - 0.5) * g.beam_width_horizontal_rad;
-          const double epsilon =
-              ((j + rng.Uniform()) / a.rays_vertical - 0.5) * g.beam_width_vertical_rad;
-          const Eigen::Vector3f d = (R * mapping::SonarRayDirection(theta, epsilon)).cast<float>();
-          hits += tank.tracer.Intersect(origin, d, max_range).has_value() ? 1 : 0;
+          const double theta = ((i + rng.Uniform()) / a.rays_horizontal - 0.5) * a.aperture_scale *
+                               g.beam_width_horizontal_rad;
+          const double epsilon = ((j + rng.Uniform()) / a.rays_vertical - 0.5) * a.aperture_scale *
+                                 g.beam_width_vertical_rad;
+          directions.push_back((R * mapping::SonarRayDirection(theta, epsilon)).cast<float>());
         }
       }
     }
+    return out;
+  }();
+  return rays;
+}
+
+// Raw Embree, one rtcIntersect1 per ray (RayTracer::Intersect), of the precomputed rays.
+void BM_RawEmbree(benchmark::State& state) {
+  Tank& tank = TheTank();
+  const SweepRays& rays = TheSweepRays();
+  const auto max_range = static_cast<float>(tank.scene.sensor.geometry.MaxRangeM());
+  for (auto _ : state) {
+    std::size_t hits = 0;
+    for (std::size_t b = 0; b < rays.origins.size(); ++b) {
+      for (const Eigen::Vector3f& d : rays.directions[b]) {
+        hits += tank.tracer.Intersect(rays.origins[b], d, max_range).has_value() ? 1 : 0;
+      }
+    }
     benchmark::DoNotOptimize(hits);
+  }
+  state.counters["rays/s"] = benchmark::Counter(
+      PrimaryRaysPerSweep(tank.scene) * state.iterations(), benchmark::Counter::kIsRate);
+}
+
+// Raw Embree, each beam's rays as one coherent stream (RayTracer::IntersectBundle, the query
+// the synthesis makes), of the precomputed rays.
+void BM_RawEmbreeBundle(benchmark::State& state) {
+  Tank& tank = TheTank();
+  const SweepRays& rays = TheSweepRays();
+  const auto max_range = static_cast<float>(tank.scene.sensor.geometry.MaxRangeM());
+  std::vector<std::optional<Hit>> hits;
+  for (auto _ : state) {
+    std::size_t hit_count = 0;
+    for (std::size_t b = 0; b < rays.origins.size(); ++b) {
+      hits.resize(rays.directions[b].size());
+      tank.tracer.IntersectBundle(rays.origins[b], rays.directions[b], max_range, hits);
+      for (const auto& hit : hits) hit_count += hit.has_value() ? 1 : 0;
+    }
+    benchmark::DoNotOptimize(hit_count);
   }
   state.counters["rays/s"] = benchmark::Counter(
       PrimaryRaysPerSweep(tank.scene) * state.iterations(), benchmark::Counter::kIsRate);
@@ -105,6 +153,7 @@ void BM_SynthesisNoMultipath(benchmark::State& state) {
 }
 
 BENCHMARK(BM_RawEmbree)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RawEmbreeBundle)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SynthesisNoMultipath)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Synthesis)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 

@@ -4,6 +4,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "sonarbench/sim/score.hpp"
 
@@ -69,6 +70,49 @@ std::optional<Hit> RayTracer::Intersect(const Eigen::Vector3f& origin,
   hit.normal = Eigen::Vector3f(query.hit.Ng_x, query.hit.Ng_y, query.hit.Ng_z).normalized();
   hit.mesh = query.hit.geomID;
   return hit;
+}
+
+void RayTracer::IntersectBundle(const Eigen::Vector3f& origin,
+                                std::span<const Eigen::Vector3f> directions, float max_distance,
+                                std::span<std::optional<Hit>> hits) const {
+  if (hits.size() != directions.size()) {
+    throw std::invalid_argument("RayTracer::IntersectBundle: " + std::to_string(hits.size()) +
+                                " hits for " + std::to_string(directions.size()) + " rays");
+  }
+  std::vector<RTCRayHit> queries(directions.size());
+  for (std::size_t i = 0; i < directions.size(); ++i) {
+    RTCRayHit& query = queries[i];
+    query.ray.org_x = origin.x();
+    query.ray.org_y = origin.y();
+    query.ray.org_z = origin.z();
+    query.ray.dir_x = directions[i].x();
+    query.ray.dir_y = directions[i].y();
+    query.ray.dir_z = directions[i].z();
+    query.ray.tnear = 0.0f;
+    query.ray.tfar = max_distance;
+    query.ray.time = 0.0f;
+    query.ray.mask = std::numeric_limits<unsigned>::max();
+    query.ray.id = static_cast<unsigned>(i);
+    query.ray.flags = 0;
+    query.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    query.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcIntersect1M(scene_.get(), &context, queries.data(), static_cast<unsigned>(queries.size()),
+                 sizeof(RTCRayHit));
+  for (std::size_t i = 0; i < queries.size(); ++i) {
+    const RTCRayHit& query = queries[i];
+    if (query.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+      hits[i].reset();
+      continue;
+    }
+    Hit& hit = hits[i].emplace();
+    hit.distance = query.ray.tfar;
+    hit.normal = Eigen::Vector3f(query.hit.Ng_x, query.hit.Ng_y, query.hit.Ng_z).normalized();
+    hit.mesh = query.hit.geomID;
+  }
 }
 
 bool RayTracer::Occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,

@@ -36,6 +36,13 @@ class RayTracer {
                                              const Eigen::Vector3f& direction,
                                              float max_distance) const;
 
+  /// The first hits of a bundle of rays from one `origin`, traced together as one coherent
+  /// stream (Embree's rtcIntersect1M, which packs neighbouring rays into SIMD packets):
+  /// `hits[i]` is ray i's hit along `directions[i]` (unit) within `max_distance` [m], or
+  /// nothing. The same hits as Intersect() ray by ray, to within Embree's float rounding.
+  void IntersectBundle(const Eigen::Vector3f& origin, std::span<const Eigen::Vector3f> directions,
+                       float max_distance, std::span<std::optional<Hit>> hits) const;
+
   /// Whether any surface lies along `direction` (unit) from `origin` within `max_distance` [m].
   [[nodiscard]] bool Occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
                               float max_distance) const;
