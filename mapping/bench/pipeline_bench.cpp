@@ -65,15 +65,16 @@ MapTree MakeTree(const MapperConfig& config) {
   return tree;
 }
 
-// The production pipeline with key set `Set` on `threads` threads, sweep by sweep.
+// The production pipeline with key set `Set` on `threads` threads, sweep by sweep, its sets
+// kept in `workspace`.
 template <typename Set>
 std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sensor,
-                      const MapperConfig& config, int threads, BatchStats* totals) {
+                      const MapperConfig& config, int threads, BatchStats* totals,
+                      BatchWorkspace<Set>& workspace) {
   MapTree tree = MakeTree(config);
   const auto directions = BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical);
   const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
   const std::span<const Beam> all(beams);
-  BatchWorkspace<Set> workspace;
   for (std::size_t first = 0; first < all.size(); first += per_sweep) {
     const auto sweep = all.subspan(first, std::min(per_sweep, all.size() - first));
     const auto obstacles = DetectObstacles(sweep, sensor, config.detection);
@@ -83,6 +84,13 @@ std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sens
   }
   FinishUpdates(tree);
   return Bytes(tree);
+}
+
+template <typename Set>
+std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sensor,
+                      const MapperConfig& config, int threads, BatchStats* totals) {
+  BatchWorkspace<Set> workspace;
+  return RunMapper(beams, sensor, config, threads, totals, workspace);
 }
 
 std::string RunNaive(const std::vector<Beam>& beams, const SensorGeometry& sensor,
@@ -159,16 +167,8 @@ struct SetStreams {
 std::vector<SetStreams> RecordSetStreams(const std::vector<Beam>& beams,
                                          const SensorGeometry& sensor, const MapperConfig& config,
                                          int threads) {
-  MapTree tree = MakeTree(config);
-  const auto directions = BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical);
-  const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
-  const std::span<const Beam> all(beams);
   BatchWorkspace<RecordingSet> workspace;
-  for (std::size_t first = 0; first < all.size(); first += per_sweep) {
-    const auto sweep = all.subspan(first, std::min(per_sweep, all.size() - first));
-    const auto obstacles = DetectObstacles(sweep, sensor, config.detection);
-    IntegrateBatch(tree, sweep, obstacles, directions, sensor.MaxRangeM(), threads, workspace);
-  }
+  (void)RunMapper(beams, sensor, config, threads, nullptr, workspace);
   std::vector<SetStreams> streams;
   for (auto& cells : workspace.per_thread) {
     streams.push_back({std::move(cells.free.log), std::move(cells.occupied.log)});
