@@ -318,6 +318,54 @@ TEST(BeamSynthesis, QuantisedPowersAndTabledLossesMatchTheirFormulas) {
   }
 }
 
+// Frozen speckle: with a correlation length, two pings from the same pose and head angle but
+// different ping seeds hear the same echo (same ray jitter, same speckle) and differ only by
+// background noise: with the noise 300 dB down, byte for byte. Another run seed, or no
+// correlation length, gives other speckle. Along a wall at normal incidence (the same echo from
+// anywhere along it), a 2 cm move within the 5 cm cell keeps the speckle, a move into the next
+// cell draws new speckle on most of the wall's bins.
+TEST(BeamSynthesis, SpeckleIsFrozenPerPlaceWithACorrelationLength) {
+  const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
+  const RayTracer tracer(meshes);
+  Material wall;
+  wall.reflectivity = 0.5;
+  SensorModel sensor;
+  sensor.acoustics.noise_level_db = -300.0;
+  sensor.acoustics.speckle_correlation_m = 0.05;
+  const BeamSynthesizer frozen(sensor, tracer, {wall}, 7);
+  Eigen::Isometry3d here = Eigen::Isometry3d::Identity();
+  here.translation() = Eigen::Vector3d(0.01, 0.01, 0.01);
+  const auto a = frozen.Synthesize(0.0, 0.0, here, 1);
+  const auto b = frozen.Synthesize(8.5, 0.0, here, 2);
+  EXPECT_EQ(a.echo_power, b.echo_power);  // the same jitter: the same rays, the same echoes
+  EXPECT_EQ(a.beam.intensities, b.beam.intensities);
+  const BeamSynthesizer other_run(sensor, tracer, {wall}, 8);
+  EXPECT_NE(a.beam.intensities, other_run.Synthesize(0.0, 0.0, here, 1).beam.intensities);
+  // Bins of the wall's echo where two beams differ by more than 2 intensity units.
+  const auto differing = [&a](const SynthesizedBeam& other) {
+    int wall_bins = 0;
+    int differ = 0;
+    for (std::size_t k = 0; k < a.echo_power.size(); ++k) {
+      if (a.echo_power[k] < 1e-4) continue;
+      ++wall_bins;
+      differ += std::abs(int{a.beam.intensities[k]} - int{other.beam.intensities[k]}) > 2;
+    }
+    return std::pair{differ, wall_bins};
+  };
+  Eigen::Isometry3d along = here;
+  along.translation().y() += 0.02;  // the same cell
+  const auto [same_cell_differ, wall_bins] = differing(frozen.Synthesize(0.0, 0.0, along, 3));
+  ASSERT_GE(wall_bins, 4);  // the pulse spans 4 bins
+  EXPECT_LE(same_cell_differ, 1) << "of " << wall_bins;
+  along.translation().y() += 0.03;  // the next cell
+  const auto [next_cell_differ, bins] = differing(frozen.Synthesize(0.0, 0.0, along, 3));
+  EXPECT_GE(2 * next_cell_differ, bins);
+  sensor.acoustics.speckle_correlation_m = 0.0;
+  const BeamSynthesizer fresh(sensor, tracer, {wall}, 7);
+  EXPECT_NE(fresh.Synthesize(0.0, 0.0, here, 1).beam.intensities,
+            fresh.Synthesize(8.5, 0.0, here, 2).beam.intensities);
+}
+
 // The speckle and noise draws are exponential with mean 1 (the power of a Rayleigh amplitude).
 // Kolmogorov-Smirnov against F(x) = 1 - exp(-x) on 200000 draws, fixed seed: the critical value
 // at a 0.1% false-alarm rate is 1.949 / sqrt(n).

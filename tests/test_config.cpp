@@ -125,6 +125,8 @@ TEST(SceneFile, SonarAcousticsOverrideTheModelsKeysItNames) {
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   EXPECT_EQ(scene.sensor.acoustics.gain_db, 6.0);
   EXPECT_EQ(scene.sensor.acoustics.max_bounces, 8);
+  EXPECT_EQ(scene.sensor.acoustics.speckle_correlation_m, 0.05);
+  EXPECT_EQ(model.acoustics.speckle_correlation_m, 0.0);
   EXPECT_NE(model.acoustics.gain_db, 6.0);
   EXPECT_EQ(scene.sensor.acoustics.rays_vertical, model.acoustics.rays_vertical);
   EXPECT_EQ(scene.sensor.acoustics.self_reflection_db, model.acoustics.self_reflection_db);
@@ -143,13 +145,15 @@ TEST(SceneFile, BadSonarAcousticsAreNamed) {
   const std::string path = (dir.path() / "bad.yaml").string();
   std::ofstream(path) << "name: x\nsensor_model: "
                       << test::SourcePath("sensor-models/shad-micron.yaml")
-                      << "\nsweeps: 1\nsonar_acoustics: {max_bounces: 40, gain: 3}\n"
+                      << "\nsweeps: 1\nsonar_acoustics: {max_bounces: 40, gain: 3, "
+                      << "speckle_correlation_m: -0.1}\n"
                       << "materials:\n  - {name: rock, reflectivity: 0.5}\n"
                       << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
                       << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
   EXPECT_TRUE(ThrowsInputErrorWith(
       [&] { (void)sim::LoadScene(path); },
-      {"bad.yaml:4:", "'sonar_acoustics.max_bounces'", "'40'", "'sonar_acoustics.gain'"}));
+      {"bad.yaml:4:", "'sonar_acoustics.max_bounces'", "'40'", "'sonar_acoustics.gain'",
+       "'sonar_acoustics.speckle_correlation_m'", "'-0.1'"}));
 }
 
 TEST(SceneFile, MissingFileIsAnInputError) {

@@ -259,5 +259,31 @@ TEST(Fidelity, SelfComparisonAgreesAndShiftsAreMeasuredInBins) {
               1e-9);
 }
 
+// The sweep-to-sweep spread: two identical sweeps spread 0; a second sweep brighter by d in
+// every bin spreads d/√2 in every cell (the sample standard deviation of {v, v + d}).
+TEST(Fidelity, SweepSpreadIsTheStandardDeviationAcrossSweepsPerAngleAndBin) {
+  const mapping::SensorGeometry sensor;
+  std::vector<mapping::Beam> two_sweeps;
+  for (int b = 0; b < 2 * sensor.BeamsPerSweep(); ++b) {
+    mapping::Beam beam;
+    beam.head_angle_rad = b * sensor.step_angle_rad;
+    beam.bin_size_m = sensor.bin_size_m;
+    beam.intensities.assign(static_cast<std::size_t>(sensor.num_bins), 0);
+    for (int k = 0; k < sensor.num_bins; ++k) {
+      beam.intensities[static_cast<std::size_t>(k)] =
+          static_cast<std::uint8_t>((k * 7 + b % sensor.BeamsPerSweep()) % 200);
+    }
+    two_sweeps.push_back(beam);
+  }
+  EXPECT_EQ(sim::CompareWithLog(two_sweeps, two_sweeps, sensor, 1.6).sim_sweep_spread, 0.0);
+  for (std::size_t b = static_cast<std::size_t>(sensor.BeamsPerSweep()); b < two_sweeps.size();
+       ++b) {
+    for (auto& v : two_sweeps[b].intensities) v = static_cast<std::uint8_t>(v + 6);
+  }
+  const auto report = sim::CompareWithLog(two_sweeps, two_sweeps, sensor, 1.6);
+  EXPECT_NEAR(report.sim_sweep_spread, 6.0 / std::sqrt(2.0), 1e-9);
+  EXPECT_NEAR(report.real_sweep_spread, 6.0 / std::sqrt(2.0), 1e-9);
+}
+
 }  // namespace
 }  // namespace sonarbench

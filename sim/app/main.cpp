@@ -188,6 +188,8 @@ int Fidelity(const FidelityArgs& args) {
             << "wall range: median difference " << report.median_wall_difference_bins
             << " bins over " << report.wall_angles_compared << " head angles\n"
             << "intensity histograms: intersection " << report.histogram_intersection << "\n"
+            << "sweep-to-sweep spread per head angle and bin: sim " << report.sim_sweep_spread
+            << ", real " << report.real_sweep_spread << "\n"
             << "wrote " << args.out << "/fidelity.json\n";
   return 0;
 }

@@ -12,8 +12,11 @@
 namespace sonarbench::sim {
 
 BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tracer,
-                                 std::vector<Material> materials_by_mesh)
-    : sensor_(sensor), tracer_(tracer), materials_by_mesh_(std::move(materials_by_mesh)) {
+                                 std::vector<Material> materials_by_mesh, std::uint64_t run_seed)
+    : sensor_(sensor),
+      tracer_(tracer),
+      materials_by_mesh_(std::move(materials_by_mesh)),
+      place_seed_(DeriveSeed(run_seed, 0x706c616365ULL)) {
   for (const double db : sensor_.acoustics.self_reflection_db) {
     self_reflection_power_.push_back(std::pow(10.0, db / 10.0));
   }
@@ -131,6 +134,23 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       T_world_sonar.linear() *
       Eigen::AngleAxisd(head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3f origin = T_world_sonar.translation().cast<float>();
+  // The echo's own randomness (ray jitter, speckle) is the ping's, or, with a correlation
+  // length, the place's: the same for every ping from the same azimuth, tilt and position cell.
+  std::optional<Rng> place_rng;
+  if (a.speckle_correlation_m > 0.0) {
+    const auto step = [&](double angle) {
+      return static_cast<std::uint64_t>(std::llround(angle / g.step_angle_rad));
+    };
+    const Eigen::Vector3d axis = R_world_beam.col(0);
+    std::uint64_t place = DeriveSeed(place_seed_, step(std::atan2(axis.y(), axis.x())));
+    place = DeriveSeed(place, step(std::asin(std::clamp(axis.z(), -1.0, 1.0))));
+    for (int i = 0; i < 3; ++i) {
+      const double cell = std::floor(T_world_sonar.translation()[i] / a.speckle_correlation_m);
+      place = DeriveSeed(place, static_cast<std::uint64_t>(static_cast<std::int64_t>(cell)));
+    }
+    place_rng.emplace(place);
+  }
+  Rng& echo_rng = place_rng ? *place_rng : rng;
   const double width_h = a.aperture_scale * g.beam_width_horizontal_rad;
   const double width_v = a.aperture_scale * g.beam_width_vertical_rad;
   const double k_h =
@@ -222,8 +242,8 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   double weight_sum = 0.0;
   for (int i = 0, r = 0; i < a.rays_horizontal; ++i) {
     for (int j = 0; j < a.rays_vertical; ++j, ++r) {
-      const double theta = ((i + rng.Uniform()) / a.rays_horizontal - 0.5) * width_h;
-      const double epsilon = ((j + rng.Uniform()) / a.rays_vertical - 0.5) * width_v;
+      const double theta = ((i + echo_rng.Uniform()) / a.rays_horizontal - 0.5) * width_h;
+      const double epsilon = ((j + echo_rng.Uniform()) / a.rays_vertical - 0.5) * width_v;
       const double pattern = std::exp(-k_h * theta * theta - k_v * epsilon * epsilon);
       weight_sum += pattern;
       patterns[static_cast<std::size_t>(r)] = pattern;
@@ -268,7 +288,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   for (std::size_t k = 0; k < bins; ++k) {
     double signal = gain * out.echo_power[k];
     if (k < self_reflection_power_.size()) signal += self_reflection_power_[k];
-    if (a.speckle) signal *= rng.Exponential();
+    if (a.speckle) signal *= echo_rng.Exponential();
     const double power = signal + noise_power * rng.Exponential();
     out.beam.intensities[k] = QuantisePower(power);
   }

@@ -29,6 +29,13 @@ std::vector<double> MeanProfile(std::span<const mapping::Beam> beams, std::size_
   return sum;
 }
 
+// The head-angle step of a beam, in [0, steps).
+std::size_t StepIndex(const mapping::Beam& beam, const mapping::SensorGeometry& sensor) {
+  const int steps = sensor.BeamsPerSweep();
+  const long step = std::lround(beam.head_angle_rad / sensor.step_angle_rad);
+  return static_cast<std::size_t>(((step % steps) + steps) % steps);
+}
+
 std::vector<std::optional<double>> WallRanges(std::span<const mapping::Beam> beams,
                                               const mapping::SensorGeometry& sensor,
                                               double min_range_m) {
@@ -39,9 +46,7 @@ std::vector<std::optional<double>> WallRanges(std::span<const mapping::Beam> bea
     if (first >= beam.intensities.size()) continue;
     const auto strongest = std::max_element(beam.intensities.begin() + static_cast<long>(first),
                                             beam.intensities.end());
-    const long step = std::lround(beam.head_angle_rad / sensor.step_angle_rad);
-    const auto index = static_cast<std::size_t>(((step % steps) + steps) % steps);
-    per_angle[index].push_back(
+    per_angle[StepIndex(beam, sensor)].push_back(
         beam.BinCentreRange(static_cast<std::size_t>(strongest - beam.intensities.begin())));
   }
   std::vector<std::optional<double>> out(per_angle.size());
@@ -52,6 +57,32 @@ std::vector<std::optional<double>> WallRanges(std::span<const mapping::Beam> bea
     out[a] = v[v.size() / 2];
   }
   return out;
+}
+
+double SweepSpread(std::span<const mapping::Beam> beams, const mapping::SensorGeometry& sensor) {
+  const auto bins = static_cast<std::size_t>(sensor.num_bins);
+  const auto first = static_cast<std::size_t>(sensor.FirstUsableBin());
+  const auto cells = static_cast<std::size_t>(sensor.BeamsPerSweep()) * bins;
+  std::vector<double> n(cells, 0.0), sum(cells, 0.0), sum_sq(cells, 0.0);
+  for (const auto& beam : beams) {
+    const std::size_t row = StepIndex(beam, sensor) * bins;
+    for (std::size_t k = first; k < std::min(bins, beam.intensities.size()); ++k) {
+      const double v = beam.intensities[k];
+      n[row + k] += 1.0;
+      sum[row + k] += v;
+      sum_sq[row + k] += v * v;
+    }
+  }
+  double spread = 0.0;
+  double counted = 0.0;
+  for (std::size_t c = 0; c < cells; ++c) {
+    if (n[c] < 2.0) continue;
+    const double mean = sum[c] / n[c];
+    const double variance = std::max(0.0, (sum_sq[c] - n[c] * mean * mean) / (n[c] - 1.0));
+    spread += std::sqrt(variance);
+    counted += 1.0;
+  }
+  return counted > 0.0 ? spread / counted : 0.0;
 }
 
 std::array<double, 256> Histogram(std::span<const mapping::Beam> beams, std::size_t first) {
@@ -132,6 +163,8 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
                      differences.end());
     r.median_wall_difference_bins = differences[differences.size() / 2];
   }
+  r.sim_sweep_spread = SweepSpread(sim, sensor);
+  r.real_sweep_spread = SweepSpread(real, sensor);
   r.sim_histogram = Histogram(sim, first);
   r.real_histogram = Histogram(real, first);
   for (std::size_t v = 0; v < 256; ++v) {
@@ -198,6 +231,8 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"median_wall_range_difference_bins", r.median_wall_difference_bins},
                  {"wall_angles_compared", r.wall_angles_compared},
                  {"histogram_intersection", r.histogram_intersection},
+                 {"sweep_spread_sim", r.sim_sweep_spread},
+                 {"sweep_spread_real", r.real_sweep_spread},
                  {"outputs",
                   {"profile.csv", "profile.png", "wall_range.csv", "histogram.csv", "polar.png",
                    "fan.png"}}});

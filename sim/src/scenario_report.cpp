@@ -74,7 +74,9 @@ nlohmann::json SensorJson(const SensorModel& s) {
             {"gain_db", a.gain_db},
             {"pulse_length_m", a.pulse_length_m},
             {"noise_level_db", a.noise_level_db},
+            {"max_bounces", a.max_bounces},
             {"speckle", a.speckle},
+            {"speckle_correlation_m", a.speckle_correlation_m},
             {"ad_low_db", a.ad_low_db},
             {"ad_span_db", a.ad_span_db},
             {"self_reflection_db", a.self_reflection_db}}}};

@@ -51,7 +51,7 @@ std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const RayTracer& 
   std::vector<Material> materials_by_mesh;
   for (const MeshSpec& mesh : scene.meshes)
     materials_by_mesh.push_back(scene.materials[mesh.material]);
-  const BeamSynthesizer synthesizer(scene.sensor, tracer, std::move(materials_by_mesh));
+  const BeamSynthesizer synthesizer(scene.sensor, tracer, std::move(materials_by_mesh), seed);
   std::vector<SynthesizedBeam> beams(last - first);
   const int n_threads = threads > 0 ? threads : omp_get_max_threads();
 #pragma omp parallel for num_threads(n_threads) schedule(dynamic, 8)

@@ -49,9 +49,11 @@ struct SynthesizedBeam {
 class BeamSynthesizer {
  public:
   BeamSynthesizer(const SensorModel& sensor, const RayTracer& tracer,
-                  std::vector<Material> materials_by_mesh);
+                  std::vector<Material> materials_by_mesh, std::uint64_t run_seed = 0);
 
-  /// One beam at head angle `head_angle_rad` from a sonar at `T_world_sonar`.
+  /// One beam at head angle `head_angle_rad` from a sonar at `T_world_sonar`. `seed` drives its
+  /// background noise and, unless the acoustics' speckle_correlation_m is set (then the run seed
+  /// and the place do), its ray jitter and speckle.
   [[nodiscard]] SynthesizedBeam Synthesize(double time_s, double head_angle_rad,
                                            const Eigen::Isometry3d& T_world_sonar,
                                            std::uint64_t seed) const;
@@ -76,6 +78,8 @@ class BeamSynthesizer {
   SensorModel sensor_;
   const RayTracer& tracer_;
   std::vector<Material> materials_by_mesh_;
+  /// Seeds the echoes' randomness per place when the acoustics' speckle_correlation_m is set.
+  std::uint64_t place_seed_ = 0;
   /// The self-reflection profile as linear power per bin.
   std::vector<double> self_reflection_power_;
   /// Power at which each AD step begins: step q for power ≥ ad_thresholds_[q] (index 0 unused).

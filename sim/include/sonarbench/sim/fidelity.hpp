@@ -30,6 +30,11 @@ struct FidelityReport {
   /// Median over head angles of |sim - real| wall range, in bins; and how many angles had both.
   double median_wall_difference_bins = 0.0;
   std::size_t wall_angles_compared = 0;
+  /// Sweep-to-sweep spread [intensity]: per head-angle step and usable bin, the standard
+  /// deviation of the intensity over the sweeps that saw it, averaged over those cells (with two
+  /// or more sweeps). A static sonar's echoes and speckle repeat; only noise varies.
+  double sim_sweep_spread = 0.0;
+  double real_sweep_spread = 0.0;
   /// Intensity histograms (fractions of all usable bins), and their intersection Σ min(p, q):
   /// 1 for identical distributions, 0 for disjoint ones.
   std::array<double, 256> sim_histogram{};

@@ -36,6 +36,12 @@ struct Acoustics {
   /// Multiplicative speckle: echo power scaled by an exponential draw of mean 1 (Rayleigh
   /// amplitude).
   bool speckle = true;
+  /// How far [m] the sonar moves before its echoes decorrelate. 0: every ping draws its ray
+  /// jitter and speckle afresh. Positive: both come from a stream seeded by the run seed, the
+  /// beam's world azimuth and tilt in head steps and the sonar's position in cells of this size,
+  /// so a static sonar hears the same echoes sweep after sweep, as the real tank log does, and
+  /// only the background noise varies; a moving one decorrelates cell by cell.
+  double speckle_correlation_m = 0.0;
   /// Level mapped to intensity 0, and the span [dB] mapped onto 0..255 (the Micron's ADLow/ADSpan).
   double ad_low_db = -40.0;
   double ad_span_db = 40.0;
