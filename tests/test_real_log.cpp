@@ -233,20 +233,28 @@ TEST(RealLogMap, TankWallsAreStraightAndClosed) {
 namespace sonarbench {
 namespace {
 
-// Comparing a run with itself is perfect agreement; with a copy shifted by k bins, the wall
-// ranges differ by exactly k bins.
-TEST(Fidelity, SelfComparisonAgreesAndShiftsAreMeasuredInBins) {
-  const mapping::SensorGeometry sensor;
+// Two sweeps of beams at the sensor's head steps, beam b's bin k holding intensity(b, k).
+template <typename Intensity>
+std::vector<mapping::Beam> TwoSweeps(const mapping::SensorGeometry& sensor, Intensity intensity) {
   std::vector<mapping::Beam> beams;
   for (int b = 0; b < 2 * sensor.BeamsPerSweep(); ++b) {
     mapping::Beam beam;
     beam.head_angle_rad = b * sensor.step_angle_rad;
     beam.bin_size_m = sensor.bin_size_m;
-    beam.intensities.assign(static_cast<std::size_t>(sensor.num_bins), 10);
-    for (int k = 0; k < 40; ++k) beam.intensities[static_cast<std::size_t>(k)] = 100;
-    beam.intensities[static_cast<std::size_t>(170 + b % 7)] = 200;
+    for (int k = 0; k < sensor.num_bins; ++k) beam.intensities.push_back(intensity(b, k));
     beams.push_back(beam);
   }
+  return beams;
+}
+
+// Comparing a run with itself is perfect agreement; with a copy shifted by k bins, the wall
+// ranges differ by exactly k bins.
+TEST(Fidelity, SelfComparisonAgreesAndShiftsAreMeasuredInBins) {
+  const mapping::SensorGeometry sensor;
+  const std::vector<mapping::Beam> beams = TwoSweeps(sensor, [](int b, int k) -> std::uint8_t {
+    if (k < 40) return 100;
+    return k == 170 + b % 7 ? 200 : 10;
+  });
   const auto same = sim::CompareWithLog(beams, beams, sensor, 1.6);
   EXPECT_NEAR(same.profile_correlation_all, 1.0, 1e-12);
   EXPECT_NEAR(same.histogram_intersection, 1.0, 1e-12);
@@ -263,18 +271,9 @@ TEST(Fidelity, SelfComparisonAgreesAndShiftsAreMeasuredInBins) {
 // every bin spreads d/√2 in every cell (the sample standard deviation of {v, v + d}).
 TEST(Fidelity, SweepSpreadIsTheStandardDeviationAcrossSweepsPerAngleAndBin) {
   const mapping::SensorGeometry sensor;
-  std::vector<mapping::Beam> two_sweeps;
-  for (int b = 0; b < 2 * sensor.BeamsPerSweep(); ++b) {
-    mapping::Beam beam;
-    beam.head_angle_rad = b * sensor.step_angle_rad;
-    beam.bin_size_m = sensor.bin_size_m;
-    beam.intensities.assign(static_cast<std::size_t>(sensor.num_bins), 0);
-    for (int k = 0; k < sensor.num_bins; ++k) {
-      beam.intensities[static_cast<std::size_t>(k)] =
-          static_cast<std::uint8_t>((k * 7 + b % sensor.BeamsPerSweep()) % 200);
-    }
-    two_sweeps.push_back(beam);
-  }
+  std::vector<mapping::Beam> two_sweeps = TwoSweeps(sensor, [&sensor](int b, int k) {
+    return static_cast<std::uint8_t>((k * 7 + b % sensor.BeamsPerSweep()) % 200);
+  });
   EXPECT_EQ(sim::CompareWithLog(two_sweeps, two_sweeps, sensor, 1.6).sim_sweep_spread, 0.0);
   for (std::size_t b = static_cast<std::size_t>(sensor.BeamsPerSweep()); b < two_sweeps.size();
        ++b) {

@@ -201,14 +201,6 @@ class OpenKeySet {
     }
   }
 
-  /// Calls `f(key)` for every key, in table order.
-  template <typename F>
-  void for_each(F&& f) const {
-    for (std::size_t i = 0; i < capacity_; ++i) {
-      if (IsKey(slots_[i])) f(UnpackKey(slots_[i]));
-    }
-  }
-
  private:
   static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
   static constexpr std::uint64_t kTombstone = kEmpty - 1;  // packed keys stay below 2^48
