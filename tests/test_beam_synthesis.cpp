@@ -10,8 +10,8 @@
 
 #include "sonarbench/mapping/detection.hpp"
 #include "sonarbench/sim/beam_synthesizer.hpp"
-#include "sonarbench/sim/fast_math.hpp"
 #include "sonarbench/sim/mesh.hpp"
+#include "sonarbench/sim/pulse_spreader.hpp"
 #include "sonarbench/sim/random.hpp"
 #include "sonarbench/sim/simulation.hpp"
 #include "test_util.hpp"
@@ -258,19 +258,135 @@ TEST(RayTracer, BundleFindsWhatSingleRaysFind) {
   EXPECT_THROW(tracer.IntersectBundle(origin, directions, 3.0f, short_hits), std::invalid_argument);
 }
 
-// The ray directions' sine and cosine: the series agrees with libm to a few ulps over the
-// angles a beam uses, and beyond them is libm's.
-TEST(SmallAngleSinCos, AgreesWithLibm) {
-  for (int i = -1000; i <= 1000; ++i) {
-    const double x = 0.8 * i / 1000.0;
-    const SinCos sc = SmallAngleSinCos(x);
-    EXPECT_NEAR(sc.sin, std::sin(x), 4e-16) << x;
-    EXPECT_NEAR(sc.cos, std::cos(x), 4e-16) << x;
+// A beam's rays: ray (i, j) lies in horizontal stratum i and vertical stratum j of the aperture,
+// at one of the slots (the slot centres, to rounding), with the two-way pattern weight of its
+// direction; over pings every slot of a stratum is used (32 slots, 2000 draws: a slot missed
+// with probability 32 · (31/32)^2000 < 1e-26).
+TEST(BeamSynthesis, RaysFillTheirStrataWithThePatternsWeights) {
+  const SensorModel sensor;
+  const mapping::SensorGeometry& g = sensor.geometry;
+  const Acoustics& a = sensor.acoustics;
+  const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
+  const RayTracer tracer(meshes);
+  const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
+  constexpr int kSlots = BeamSynthesizer::kJitterSlots;
+  const double stratum_h = g.beam_width_horizontal_rad / a.rays_horizontal;
+  const double stratum_v = g.beam_width_vertical_rad / a.rays_vertical;
+  const double k_h = 4.0 * std::log(2.0) / std::pow(g.beam_width_horizontal_rad, 2);
+  const double k_v = 4.0 * std::log(2.0) / std::pow(g.beam_width_vertical_rad, 2);
+  Rng rng(3);
+  std::vector<Eigen::Vector3f> directions;
+  std::vector<double> patterns;
+  std::vector<int> slot_uses(kSlots, 0);
+  for (int ping = 0; ping < 2000; ++ping) {
+    const double sum = synthesizer.DrawRays(Eigen::Matrix3d::Identity(), rng, directions, patterns);
+    ASSERT_EQ(directions.size(), static_cast<std::size_t>(a.rays_horizontal * a.rays_vertical));
+    EXPECT_NEAR(sum, std::accumulate(patterns.begin(), patterns.end(), 0.0), 1e-9 * sum);
+    for (int i = 0, r = 0; i < a.rays_horizontal; ++i) {
+      for (int j = 0; j < a.rays_vertical; ++j, ++r) {
+        if (ping > 0 && r > 0) break;  // every ray of the first ping, then ray 0's slots
+        const Eigen::Vector3d d = directions[static_cast<std::size_t>(r)].cast<double>();
+        const double theta = std::atan2(d.y(), d.x());
+        const double epsilon = std::asin(d.z());
+        // Positions in slots of the stratum: within float rounding of a slot centre.
+        const double slot_h = (theta / stratum_h + 0.5 * a.rays_horizontal - i) * kSlots - 0.5;
+        const double slot_v = (epsilon / stratum_v + 0.5 * a.rays_vertical - j) * kSlots - 0.5;
+        ASSERT_NEAR(slot_h, std::round(slot_h), 1e-2) << "ray " << i << ", " << j;
+        ASSERT_NEAR(slot_v, std::round(slot_v), 1e-2) << "ray " << i << ", " << j;
+        ASSERT_GE(std::round(slot_h), 0);
+        ASSERT_LT(std::round(slot_h), kSlots);
+        ASSERT_GE(std::round(slot_v), 0);
+        ASSERT_LT(std::round(slot_v), kSlots);
+        EXPECT_NEAR(patterns[static_cast<std::size_t>(r)],
+                    std::exp(-k_h * theta * theta - k_v * epsilon * epsilon), 1e-6);
+        if (r == 0) ++slot_uses[static_cast<std::size_t>(std::round(slot_v))];
+      }
+    }
   }
-  for (const double x : {0.81, -1.0, 3.0, 100.0}) {
-    EXPECT_EQ(SmallAngleSinCos(x).sin, std::sin(x)) << x;
-    EXPECT_EQ(SmallAngleSinCos(x).cos, std::cos(x)) << x;
+  for (int slot = 0; slot < kSlots; ++slot) EXPECT_GT(slot_uses[slot], 0) << "slot " << slot;
+}
+
+// Rays from anywhere in the tank, traced as one incoherent stream, and their occlusion tests as
+// another: the same answers as one query per ray (distances to float rounding, as above).
+TEST(RayTracer, StreamsFindWhatSingleRaysFind) {
+  MeshSpec tank;
+  tank.type = MeshSpec::Type::kTank;
+  tank.size_m = {4.4, 4.4, 2.0};
+  const std::vector<TriangleMesh> meshes = {BuildMesh(tank, 1)};
+  const RayTracer tracer(meshes);
+  Rng rng(78);
+  std::vector<Ray> rays(1000);
+  for (Ray& ray : rays) {
+    ray.origin = Eigen::Vector3f(static_cast<float>(4.0 * rng.Uniform() - 2.0),
+                                 static_cast<float>(4.0 * rng.Uniform() - 2.0),
+                                 static_cast<float>(1.8 * rng.Uniform() + 0.1));
+    ray.direction =
+        Eigen::Vector3f(static_cast<float>(rng.Normal()), static_cast<float>(rng.Normal()),
+                        static_cast<float>(rng.Normal()))
+            .normalized();
+    ray.max_distance = static_cast<float>(3.0 * rng.Uniform());
   }
+  std::vector<std::optional<Hit>> hits(rays.size());
+  tracer.IntersectStream(rays, hits);
+  std::vector<bool> occluded;
+  tracer.OccludedStream(rays, occluded);
+  ASSERT_EQ(occluded.size(), rays.size());
+  int found = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const Ray& ray = rays[i];
+    const auto single = tracer.Intersect(ray.origin, ray.direction, ray.max_distance);
+    ASSERT_EQ(single.has_value(), hits[i].has_value()) << "ray " << i;
+    EXPECT_EQ(tracer.Occluded(ray.origin, ray.direction, ray.max_distance), occluded[i])
+        << "ray " << i;
+    if (!single) continue;
+    ++found;
+    EXPECT_EQ(single->mesh, hits[i]->mesh) << "ray " << i;
+    EXPECT_NEAR(single->distance, hits[i]->distance, 1e-5f * single->distance) << "ray " << i;
+    EXPECT_GT(std::abs(single->normal.dot(hits[i]->normal)), 1.0f - 1e-5f) << "ray " << i;
+  }
+  EXPECT_GT(found, 200);  // segments up to 3 m long inside a 4.4 m tank: many reach a wall,
+  EXPECT_LT(found, 900);  // many do not
+  EXPECT_THROW(tracer.IntersectStream(rays, std::span(hits).first(3)), std::invalid_argument);
+}
+
+// Echo boxes summed by their edges give each bin what the box covers of it, as the direct sum
+// over the bins would: boxes inside one bin, across many, starting before bin 0 and running
+// past the last. The two differ only by rounding: each bin's sum is a running sum over at most
+// 2 · 500 edges, so within 1000 · 2^-52 < 1e-12 of the total power; and bins no box reaches
+// hold exactly 0.
+TEST(PulseSpreader, SpreadsEachBoxOverTheBinsItCovers) {
+  constexpr std::size_t kBins = 120;
+  Rng rng(5);
+  PulseSpreader spreader(kBins);
+  std::vector<double> direct(kBins, 0.0);
+  double total = 0.0;
+  for (int box = 0; box < 500; ++box) {
+    // Boxes between bins -2 and 100 (none reaches bins 105 on), half a bin to 5 bins long
+    // and powers over six decades.
+    const double start = 102.0 * rng.Uniform() - 2.0;
+    const double end = start + (box % 10 == 0 ? 0.3 : 0.5 + 4.5 * rng.Uniform());
+    const double power = std::pow(10.0, 6.0 * rng.Uniform() - 3.0);
+    spreader.Add(start, end, power);
+    total += power * (end - start);
+    for (std::size_t k = 0; k < kBins; ++k) {
+      const double overlap =
+          std::min(static_cast<double>(k + 1), end) - std::max(static_cast<double>(k), start);
+      if (overlap > 0.0) direct[k] += power * overlap;
+    }
+  }
+  std::vector<double> spread(kBins, 0.0);
+  spreader.AddTo(spread);
+  for (std::size_t k = 0; k < kBins; ++k) {
+    EXPECT_NEAR(spread[k], direct[k], 1e-12 * total) << "bin " << k;
+    if (direct[k] == 0.0) {
+      EXPECT_EQ(spread[k], 0.0) << "bin " << k;
+    }
+  }
+  EXPECT_EQ(spread[kBins - 1], 0.0);
+  // Emptied: a second read-out adds nothing.
+  std::vector<double> again(kBins, 0.0);
+  spreader.AddTo(again);
+  EXPECT_EQ(again, std::vector<double>(kBins, 0.0));
 }
 
 // The synthesis quantises powers without a logarithm and takes range losses from a table:

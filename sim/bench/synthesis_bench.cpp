@@ -43,8 +43,9 @@ double PrimaryRaysPerSweep(const Scene& scene) {
          scene.sensor.geometry.BeamsPerSweep();
 }
 
-// One sweep's primary rays, as the synthesis draws them (same seeds, same stratified jitter),
-// generated once, outside any timing.
+// One sweep's primary rays, drawn as the synthesis draws them (BeamSynthesizer::DrawRays: the
+// same strata and jitter slots, from the benchmark's own seeds), generated once, outside any
+// timing.
 struct SweepRays {
   std::vector<Eigen::Vector3f> origins;                  // per beam
   std::vector<std::vector<Eigen::Vector3f>> directions;  // per beam, per ray
@@ -53,26 +54,18 @@ struct SweepRays {
 const SweepRays& TheSweepRays() {
   static const SweepRays rays = [] {
     const Tank& tank = TheTank();
-    const auto& g = tank.scene.sensor.geometry;
-    const Acoustics& a = tank.scene.sensor.acoustics;
+    const BeamSynthesizer synthesizer(tank.scene.sensor, tank.tracer,
+                                      std::vector<Material>(tank.meshes.size()));
     SweepRays out;
-    for (int b = 0; b < g.BeamsPerSweep(); ++b) {
+    std::vector<double> patterns;
+    for (int b = 0; b < tank.scene.sensor.geometry.BeamsPerSweep(); ++b) {
       const ScheduledBeam s = ScheduleBeam(tank.scene, static_cast<std::size_t>(b));
       const Eigen::Matrix3d R =
           s.pose.T_world_sonar.linear() *
           Eigen::AngleAxisd(s.pose.head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
       out.origins.push_back(s.pose.T_world_sonar.translation().cast<float>());
-      auto& directions = out.directions.emplace_back();
       Rng rng(DeriveSeed(1, static_cast<std::uint64_t>(b)));
-      for (int i = 0; i < a.rays_horizontal; ++i) {
-        for (int j = 0; j < a.rays_vertical; ++j) {
-          const double theta = ((i + rng.Uniform()) / a.rays_horizontal - 0.5) * a.aperture_scale *
-                               g.beam_width_horizontal_rad;
-          const double epsilon = ((j + rng.Uniform()) / a.rays_vertical - 0.5) * a.aperture_scale *
-                                 g.beam_width_vertical_rad;
-          directions.push_back((R * mapping::SonarRayDirection(theta, epsilon)).cast<float>());
-        }
-      }
+      synthesizer.DrawRays(R, rng, out.directions.emplace_back(), patterns);
     }
     return out;
   }();

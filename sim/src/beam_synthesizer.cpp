@@ -6,7 +6,7 @@
 #include <optional>
 #include <vector>
 
-#include "sonarbench/sim/fast_math.hpp"
+#include "sonarbench/sim/pulse_spreader.hpp"
 #include "sonarbench/sim/random.hpp"
 
 namespace sonarbench::sim {
@@ -48,12 +48,33 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
   }
 
   range_step_m_ = sensor_.geometry.bin_size_m / 16.0;
+  range_steps_per_m_ = 16.0 / sensor_.geometry.bin_size_m;
   const auto steps =
       static_cast<std::size_t>(std::ceil(sensor_.geometry.MaxRangeM() / range_step_m_));
   range_loss_.resize(steps + 2);
   for (std::size_t k = 0; k < range_loss_.size(); ++k) {
     range_loss_[k] = RangeLoss(static_cast<double>(k) * range_step_m_);
   }
+
+  // Slot a of stratum i sits at (i + (a + ½)/slots)/strata of the aperture (scaled by the
+  // aperture scale), centred on the axis; its pattern factor is exp(-4 ln2 · angle²/w²), w the
+  // nominal beam width in that direction, so the two factors' product is the two-way pattern.
+  const auto tabulate = [](int strata, double aperture, double beam_width) {
+    const double k = 4.0 * std::log(2.0) / (beam_width * beam_width);
+    std::vector<JitterSlot> slots;
+    for (int i = 0; i < strata; ++i) {
+      for (int slot = 0; slot < kJitterSlots; ++slot) {
+        const double angle = ((i + (slot + 0.5) / kJitterSlots) / strata - 0.5) * aperture;
+        slots.push_back({std::sin(angle), std::cos(angle), std::exp(-k * angle * angle)});
+      }
+    }
+    return slots;
+  };
+  const mapping::SensorGeometry& g = sensor_.geometry;
+  horizontal_slots_ = tabulate(a.rays_horizontal, a.aperture_scale * g.beam_width_horizontal_rad,
+                               g.beam_width_horizontal_rad);
+  vertical_slots_ = tabulate(a.rays_vertical, a.aperture_scale * g.beam_width_vertical_rad,
+                             g.beam_width_vertical_rad);
 }
 
 double BeamSynthesizer::RangeLoss(double range_m) const {
@@ -64,17 +85,6 @@ double BeamSynthesizer::RangeLoss(double range_m) const {
       (spreading_exponent != 0.0 ? spreading_exponent * std::log(range_m) : 0.0) +
       absorption_per_m * range_m;
   return std::exp(-exponent);
-}
-
-double BeamSynthesizer::RangeLossFromTable(double range_m) const {
-  const double x = range_m / range_step_m_;
-  // From 8 bins out (128 steps) to the table's last interval. The interpolation's relative
-  // error is at most h²/8 · f''/f, with f''/f = s(s+1)/r² + 2sα/r + α² for f = r^-s·e^-αr:
-  // under 5e-5 at 8 bins for |s| ≤ 2 (|S - G| ≤ 20 dB per decade). Nearer, exactly.
-  if (!(x >= 128.0 && x < static_cast<double>(range_loss_.size() - 1))) return RangeLoss(range_m);
-  const auto k = static_cast<std::size_t>(x);
-  const double f = x - static_cast<double>(k);
-  return range_loss_[k] + f * (range_loss_[k + 1] - range_loss_[k]);
 }
 
 std::uint8_t BeamSynthesizer::QuantisePower(double power) const {
@@ -113,6 +123,71 @@ std::uint8_t BeamSynthesizer::Quantise(double level_db) const {
   return static_cast<std::uint8_t>(std::clamp(scaled, 0.0, 255.0));
 }
 
+double BeamSynthesizer::DrawRays(const Eigen::Matrix3d& R_world_beam, Rng& rng,
+                                 std::vector<Eigen::Vector3f>& directions,
+                                 std::vector<double>& patterns) const {
+  const Acoustics& a = sensor_.acoustics;
+  directions.resize(static_cast<std::size_t>(a.rays_horizontal) * a.rays_vertical);
+  patterns.resize(directions.size());
+  double weight_sum = 0.0;
+  const Eigen::Vector3d ahead = R_world_beam.col(0);
+  const Eigen::Vector3d left = R_world_beam.col(1);
+  const Eigen::Vector3d up = R_world_beam.col(2);
+  constexpr unsigned kSlotMask = kJitterSlots - 1;
+  static_assert((kJitterSlots & kSlotMask) == 0, "slots are picked by masking a draw's bits");
+  for (int i = 0, r = 0; i < a.rays_horizontal; ++i) {
+    const JitterSlot* stratum_h = &horizontal_slots_[static_cast<std::size_t>(i) * kJitterSlots];
+    for (int j = 0; j < a.rays_vertical; ++j, ++r) {
+      const std::uint64_t draw = rng.Next();
+      const JitterSlot& h = stratum_h[(draw >> 32) & kSlotMask];
+      const JitterSlot& v =
+          vertical_slots_[static_cast<std::size_t>(j) * kJitterSlots + ((draw >> 48) & kSlotMask)];
+      const double pattern = h.weight * v.weight;
+      weight_sum += pattern;
+      patterns[static_cast<std::size_t>(r)] = pattern;
+      directions[static_cast<std::size_t>(r)] =
+          (v.cos * (h.cos * ahead + h.sin * left) + v.sin * up).cast<float>();
+    }
+  }
+  return weight_sum;
+}
+
+namespace {
+
+// A mirrored ray of a beam's multipath, between bounces: the hit it last made, from where, along
+// which direction, the path so far and the product of the specular fractions met.
+struct MirrorPath {
+  Eigen::Vector3f from;
+  Eigen::Vector3f direction;
+  Hit hit;
+  double path = 0.0;
+  double specular = 1.0;
+  double pattern = 0.0;
+};
+
+// A straight return to the sonar, heard at `range` with strength `weight` unless its occlusion
+// ray finds a surface in the way.
+struct StraightReturn {
+  double range = 0.0;
+  double weight = 0.0;
+};
+
+// Synthesize()'s working memory, one per thread, kept between beams: a beam allocates only its
+// output.
+struct Scratch {
+  std::vector<Eigen::Vector3f> directions;
+  std::vector<double> patterns;
+  std::vector<std::optional<Hit>> hits;
+  std::vector<MirrorPath> paths;
+  std::vector<MirrorPath> next_paths;
+  std::vector<Ray> rays;
+  std::vector<StraightReturn> returns;
+  std::vector<bool> occluded;
+  PulseSpreader spreader;
+};
+
+}  // namespace
+
 SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad,
                                             const Eigen::Isometry3d& T_world_sonar,
                                             std::uint64_t seed) const {
@@ -121,6 +196,8 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const auto bins = static_cast<std::size_t>(g.num_bins);
   const double max_range = g.MaxRangeM();
   Rng rng(seed);
+  thread_local Scratch scratch;
+  scratch.spreader.Reset(bins);
 
   SynthesizedBeam out;
   out.beam.time_s = time_s;
@@ -151,26 +228,19 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
     place_rng.emplace(place);
   }
   Rng& echo_rng = place_rng ? *place_rng : rng;
-  const double width_h = a.aperture_scale * g.beam_width_horizontal_rad;
-  const double width_v = a.aperture_scale * g.beam_width_vertical_rad;
   const double k_h =
       4.0 * std::log(2.0) / (g.beam_width_horizontal_rad * g.beam_width_horizontal_rad);
   const double k_v = 4.0 * std::log(2.0) / (g.beam_width_vertical_rad * g.beam_width_vertical_rad);
   const double pulse_bins = a.pulse_length_m / g.bin_size_m;
+  const double bins_per_m = 1.0 / g.bin_size_m;
 
   // Adds an echo of strength `strength` (before range losses) from range `range` [m]: the echo
   // of a point lasts while the pulse passes it, so it is heard at every range in [r, r + L), and
   // each bin gets the power times the fraction of the bin that span covers.
   // The range loss from its table (RangeLossFromTable).
   auto deposit = [&](double range, double strength) {
-    const double power = strength * RangeLossFromTable(range);
-    const double start = range / g.bin_size_m;
-    const double end = start + pulse_bins;
-    for (auto k = static_cast<std::size_t>(start); k < bins && static_cast<double>(k) < end; ++k) {
-      const double overlap =
-          std::min(static_cast<double>(k + 1), end) - std::max(static_cast<double>(k), start);
-      out.echo_power[k] += power * overlap;
-    }
+    const double start = range * bins_per_m;
+    scratch.spreader.Add(start, start + pulse_bins, strength * RangeLossFromTable(range));
   };
   // The one-way pattern at a direction in the beam frame, or 0 outside the half-space ahead.
   const Eigen::Matrix3d R_beam_world = R_world_beam.transpose();
@@ -181,81 +251,18 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
     const double epsilon = std::asin(std::clamp(u.z(), -1.0, 1.0));
     return std::exp(-0.5 * (k_h * theta * theta + k_v * epsilon * epsilon));
   };
-  const Eigen::Vector3d sonar = T_world_sonar.translation();
-  const double spreading_db = a.spreading_db_per_decade;
-  // Multipath of a ray with two-way pattern weight `pattern` whose first hit is `first`: the ray
-  // goes on in the mirror direction with the specular fraction of its energy, up to max_bounces
-  // times. At each later hit P_k, after a path of length L from the sonar, two returns:
-  //  - back along the same path (through the same mirrors both ways): range L, weight
-  //    pattern · s² · ρ cosⁿ, where s is the product of the specular fractions so far;
-  //  - straight back to the sonar if P_k is in view (an occlusion ray) and in the receive lobe:
-  //    range R = (L + d)/2 with d = |P_k - sonar|, weight 2 · √pattern · p(P_k) · s · ρ (cos_i
-  //    cos_s)^(n/2) · (R/d)^(S/10); p is the one-way pattern towards P_k, the factor 2 counts
-  //    the reverse path (sonar → P_k → mirrors → sonar), equal by reciprocity, and (R/d)^(S/10)
-  //    turns the monostatic spreading at R into the last leg's own.
-  auto multipath = [&](const Eigen::Vector3f& first_direction, const Hit& first, double pattern) {
-    Eigen::Vector3f direction = first_direction;
-    Hit hit = first;
-    Eigen::Vector3f from = origin;
-    double path = hit.distance;
-    double specular = 1.0;
-    for (int bounce = 1; bounce <= a.max_bounces; ++bounce) {
-      specular *= materials_by_mesh_[hit.mesh].specular;
-      if (specular <= 0.0 || path >= 2.0 * max_range) return;
-      from += hit.distance * direction;
-      direction = (direction - 2.0f * direction.dot(hit.normal) * hit.normal).normalized();
-      ++out.traced_rays;
-      const auto next = tracer_.Intersect(from + 1e-4f * direction, direction,
-                                          static_cast<float>(2.0 * max_range - path));
-      if (!next) return;
-      hit = *next;
-      path += hit.distance;
-      const Material& m = materials_by_mesh_[hit.mesh];
-      const double cos_in = std::abs(hit.normal.dot(direction));
-      if (path <= max_range) {
-        deposit(path, pattern * specular * specular * m.reflectivity *
-                          CosPower(cos_in, m.backscatter_exponent));
-      }
-      const Eigen::Vector3f at = from + hit.distance * direction;
-      const Eigen::Vector3d back = sonar - at.cast<double>();
-      const double d = back.norm();
-      const double range = 0.5 * (path + d);
-      if (range > max_range || d < g.bin_size_m) continue;
-      const double receive = one_way_pattern(-back / d);
-      const double weight = 2.0 * std::sqrt(pattern) * receive * specular * m.reflectivity;
-      if (weight < kNegligibleWeight) continue;
-      const Eigen::Vector3f to_sonar = (back / d).cast<float>();
-      ++out.traced_rays;
-      if (tracer_.Occluded(at + 1e-4f * to_sonar, to_sonar, static_cast<float>(d) - 2e-4f)) {
-        continue;
-      }
-      const double cos_out = std::abs(hit.normal.dot(to_sonar));
-      deposit(range, weight * CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) *
-                         std::pow(range / d, spreading_db / 10.0));
-    }
-  };
-  // The aperture's rays, stratified and jittered (two draws per ray, in this order), their
-  // two-way pattern weights, then their first hits, traced as one coherent bundle.
+
+  // The aperture's rays and their first hits, traced as one coherent bundle.
   const auto rays = static_cast<std::size_t>(a.rays_horizontal) * a.rays_vertical;
-  std::vector<Eigen::Vector3f> directions(rays);
-  std::vector<double> patterns(rays);
-  double weight_sum = 0.0;
-  for (int i = 0, r = 0; i < a.rays_horizontal; ++i) {
-    for (int j = 0; j < a.rays_vertical; ++j, ++r) {
-      const double theta = ((i + echo_rng.Uniform()) / a.rays_horizontal - 0.5) * width_h;
-      const double epsilon = ((j + echo_rng.Uniform()) / a.rays_vertical - 0.5) * width_v;
-      const double pattern = std::exp(-k_h * theta * theta - k_v * epsilon * epsilon);
-      weight_sum += pattern;
-      patterns[static_cast<std::size_t>(r)] = pattern;
-      const SinCos h = SmallAngleSinCos(theta);
-      const SinCos v = SmallAngleSinCos(epsilon);
-      directions[static_cast<std::size_t>(r)] =
-          (R_world_beam * Eigen::Vector3d(h.cos * v.cos, h.sin * v.cos, v.sin)).cast<float>();
-    }
-  }
-  std::vector<std::optional<Hit>> hits(rays);
+  std::vector<Eigen::Vector3f>& directions = scratch.directions;
+  std::vector<double>& patterns = scratch.patterns;
+  const double weight_sum = DrawRays(R_world_beam, echo_rng, directions, patterns);
+  std::vector<std::optional<Hit>>& hits = scratch.hits;
+  hits.resize(rays);
   tracer_.IntersectBundle(origin, directions, static_cast<float>(max_range), hits);
   out.traced_rays += rays;
+  std::vector<MirrorPath>& paths = scratch.paths;
+  paths.clear();
   for (std::size_t r = 0; r < rays; ++r) {
     const auto& hit = hits[r];
     if (!hit) continue;
@@ -271,9 +278,78 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
     deposit(range, pattern * material.reflectivity *
                        CosPower(cos_incidence, material.backscatter_exponent));
     if (a.max_bounces > 0 && material.specular > 0.0) {
-      multipath(direction, *hit, pattern);
+      paths.push_back({origin, direction, *hit, hit->distance, 1.0, pattern});
     }
   }
+
+  // Multipath, one bounce at a time for all the beam's rays (each bounce's mirrored rays one
+  // stream, their occlusion rays another): a ray with two-way pattern weight `pattern` goes on
+  // in the mirror direction with the specular fraction of its energy, up to max_bounces times.
+  // At each later hit P_k, after a path of length L from the sonar, two returns:
+  //  - back along the same path (through the same mirrors both ways): range L, weight
+  //    pattern · s² · ρ cosⁿ, where s is the product of the specular fractions so far;
+  //  - straight back to the sonar if P_k is in view (an occlusion ray) and in the receive lobe:
+  //    range R = (L + d)/2 with d = |P_k - sonar|, weight 2 · √pattern · p(P_k) · s · ρ (cos_i
+  //    cos_s)^(n/2) · (R/d)^(S/10); p is the one-way pattern towards P_k, the factor 2 counts
+  //    the reverse path (sonar → P_k → mirrors → sonar), equal by reciprocity, and (R/d)^(S/10)
+  //    turns the monostatic spreading at R into the last leg's own.
+  const Eigen::Vector3d sonar = T_world_sonar.translation();
+  const double spreading_db = a.spreading_db_per_decade;
+  std::vector<MirrorPath>& next_paths = scratch.next_paths;
+  std::vector<Ray>& stream = scratch.rays;
+  std::vector<StraightReturn>& returns = scratch.returns;
+  for (int bounce = 1; bounce <= a.max_bounces && !paths.empty(); ++bounce) {
+    next_paths.clear();
+    stream.clear();
+    for (MirrorPath p : paths) {
+      p.specular *= materials_by_mesh_[p.hit.mesh].specular;
+      if (p.specular <= 0.0 || p.path >= 2.0 * max_range) continue;
+      p.from += p.hit.distance * p.direction;
+      p.direction =
+          (p.direction - 2.0f * p.direction.dot(p.hit.normal) * p.hit.normal).normalized();
+      stream.push_back({p.from + 1e-4f * p.direction, p.direction,
+                        static_cast<float>(2.0 * max_range - p.path)});
+      next_paths.push_back(p);
+    }
+    hits.resize(stream.size());
+    tracer_.IntersectStream(stream, hits);
+    out.traced_rays += stream.size();
+
+    paths.clear();
+    stream.clear();
+    returns.clear();
+    for (std::size_t q = 0; q < next_paths.size(); ++q) {
+      if (!hits[q]) continue;
+      MirrorPath& p = paths.emplace_back(next_paths[q]);
+      p.hit = *hits[q];
+      p.path += p.hit.distance;
+      const Material& m = materials_by_mesh_[p.hit.mesh];
+      const double cos_in = std::abs(p.hit.normal.dot(p.direction));
+      if (p.path <= max_range) {
+        deposit(p.path, p.pattern * p.specular * p.specular * m.reflectivity *
+                            CosPower(cos_in, m.backscatter_exponent));
+      }
+      const Eigen::Vector3f at = p.from + p.hit.distance * p.direction;
+      const Eigen::Vector3d back = sonar - at.cast<double>();
+      const double d = back.norm();
+      const double range = 0.5 * (p.path + d);
+      if (range > max_range || d < g.bin_size_m) continue;
+      const double receive = one_way_pattern(-back / d);
+      const double weight = 2.0 * std::sqrt(p.pattern) * receive * p.specular * m.reflectivity;
+      if (weight < kNegligibleWeight) continue;
+      const Eigen::Vector3f to_sonar = (back / d).cast<float>();
+      const double cos_out = std::abs(p.hit.normal.dot(to_sonar));
+      stream.push_back({at + 1e-4f * to_sonar, to_sonar, static_cast<float>(d) - 2e-4f});
+      returns.push_back({range, weight * CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) *
+                                    std::pow(range / d, spreading_db / 10.0)});
+    }
+    tracer_.OccludedStream(stream, scratch.occluded);
+    out.traced_rays += stream.size();
+    for (std::size_t q = 0; q < returns.size(); ++q) {
+      if (!scratch.occluded[q]) deposit(returns[q].range, returns[q].weight);
+    }
+  }
+  scratch.spreader.AddTo(out.echo_power);
   for (double& p : out.echo_power) p /= weight_sum;
 
   if (const auto axis =

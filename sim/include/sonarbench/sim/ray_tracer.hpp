@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "sonarbench/sim/mesh.hpp"
 
@@ -19,6 +20,13 @@ struct Hit {
   Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();
   /// Index of the mesh hit, in the order the meshes were given.
   std::uint32_t mesh = 0;
+};
+
+/// A ray segment: from `origin` along `direction` (unit) for up to `max_distance` [m].
+struct Ray {
+  Eigen::Vector3f origin;
+  Eigen::Vector3f direction;
+  float max_distance = 0.0f;
 };
 
 /// An Embree scene over a set of triangle meshes. Thread-safe for queries once constructed.
@@ -42,6 +50,15 @@ class RayTracer {
   /// nothing. The same hits as Intersect() ray by ray, to within Embree's float rounding.
   void IntersectBundle(const Eigen::Vector3f& origin, std::span<const Eigen::Vector3f> directions,
                        float max_distance, std::span<std::optional<Hit>> hits) const;
+
+  /// The first hits of rays from anywhere in any direction (the mirrored rays of one bounce of
+  /// a beam's multipath), traced as one incoherent stream (rtcIntersect1M): `hits[i]` is
+  /// `rays[i]`'s, as Intersect() would find it.
+  void IntersectStream(std::span<const Ray> rays, std::span<std::optional<Hit>> hits) const;
+
+  /// Whether any surface lies along each of `rays` (rtcOccluded1M, one incoherent stream):
+  /// `occluded[i]` is Occluded() of `rays[i]`.
+  void OccludedStream(std::span<const Ray> rays, std::vector<bool>& occluded) const;
 
   /// Whether any surface lies along `direction` (unit) from `origin` within `max_distance` [m].
   [[nodiscard]] bool Occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,

@@ -1,0 +1,67 @@
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <span>
+#include <vector>
+
+namespace sonarbench::sim {
+
+/// Sums echoes that each last a pulse length over a beam's range bins. An echo is a box: power
+/// `power` per bin over [start, end) (in bins), of which bin k receives `power` times the part
+/// of [k, k + 1) the box covers. Each box costs two edge updates, whatever its length; the bins
+/// are formed once at the end.
+///
+/// Bin k's sum is the power of the boxes open through all of it plus, for each edge inside it,
+/// ±power times the part of the bin after the edge. Edges are kept per bin: the power of the
+/// boxes they open (+) or close (-), their partial contributions, and their count, so that the
+/// running power is set to exactly 0 wherever no box is open (no rounding residue after an echo).
+class PulseSpreader {
+ public:
+  explicit PulseSpreader(std::size_t bins = 0) { Reset(bins); }
+
+  /// Empties the spreader and sizes it for `bins` bins.
+  void Reset(std::size_t bins) {
+    opened_.assign(bins, 0.0);
+    partial_.assign(bins, 0.0);
+    open_count_.assign(bins, 0);
+  }
+
+  /// Adds `power` per bin over [start, end) bins (start ≤ end; parts beyond the last bin, or
+  /// before bin 0, are dropped).
+  void Add(double start, double end, double power) {
+    Edge(start, power, 1);
+    Edge(end, -power, -1);
+  }
+
+  /// Adds every bin's sum to `out` (one value per bin) and empties the spreader.
+  void AddTo(std::span<double> out) {
+    double running = 0.0;
+    int open = 0;
+    for (std::size_t k = 0; k < out.size() && k < opened_.size(); ++k) {
+      out[k] += std::max(0.0, (open > 0 ? running : 0.0) + partial_[k]);
+      running += opened_[k];
+      open += open_count_[k];
+      if (open == 0) running = 0.0;
+      opened_[k] = 0.0;
+      partial_[k] = 0.0;
+      open_count_[k] = 0;
+    }
+  }
+
+ private:
+  void Edge(double at, double power, int count) {
+    at = std::max(at, 0.0);
+    if (!(at < static_cast<double>(opened_.size()))) return;
+    const auto k = static_cast<std::size_t>(at);
+    opened_[k] += power;
+    partial_[k] += power * (static_cast<double>(k + 1) - at);
+    open_count_[k] += count;
+  }
+
+  std::vector<double> opened_;
+  std::vector<double> partial_;
+  std::vector<int> open_count_;
+};
+
+}  // namespace sonarbench::sim
