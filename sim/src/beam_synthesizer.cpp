@@ -47,20 +47,22 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
     ad_bucket_steps_[b - ad_first_bucket_] = static_cast<std::uint8_t>(q);
   }
 
-  range_step_m_ = sensor_.geometry.bin_size_m / 16.0;
+  const double range_step_m = sensor_.geometry.bin_size_m / 16.0;
   range_steps_per_m_ = 16.0 / sensor_.geometry.bin_size_m;
   const auto steps =
-      static_cast<std::size_t>(std::ceil(sensor_.geometry.MaxRangeM() / range_step_m_));
+      static_cast<std::size_t>(std::ceil(sensor_.geometry.MaxRangeM() / range_step_m));
   range_loss_.resize(steps + 2);
   for (std::size_t k = 0; k < range_loss_.size(); ++k) {
-    range_loss_[k] = RangeLoss(static_cast<double>(k) * range_step_m_);
+    range_loss_[k] = RangeLoss(static_cast<double>(k) * range_step_m);
   }
 
   // Slot a of stratum i sits at (i + (a + ½)/slots)/strata of the aperture (scaled by the
-  // aperture scale), centred on the axis; its pattern factor is exp(-4 ln2 · angle²/w²), w the
-  // nominal beam width in that direction, so the two factors' product is the two-way pattern.
-  const auto tabulate = [](int strata, double aperture, double beam_width) {
-    const double k = 4.0 * std::log(2.0) / (beam_width * beam_width);
+  // aperture scale), centred on the axis; its pattern factor is exp(-k · angle²), so the two
+  // directions' factors multiply to the two-way pattern.
+  const mapping::SensorGeometry& g = sensor_.geometry;
+  pattern_k_h_ = 4.0 * std::log(2.0) / (g.beam_width_horizontal_rad * g.beam_width_horizontal_rad);
+  pattern_k_v_ = 4.0 * std::log(2.0) / (g.beam_width_vertical_rad * g.beam_width_vertical_rad);
+  const auto tabulate = [](int strata, double aperture, double k) {
     std::vector<JitterSlot> slots;
     for (int i = 0; i < strata; ++i) {
       for (int slot = 0; slot < kJitterSlots; ++slot) {
@@ -70,11 +72,10 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
     }
     return slots;
   };
-  const mapping::SensorGeometry& g = sensor_.geometry;
-  horizontal_slots_ = tabulate(a.rays_horizontal, a.aperture_scale * g.beam_width_horizontal_rad,
-                               g.beam_width_horizontal_rad);
-  vertical_slots_ = tabulate(a.rays_vertical, a.aperture_scale * g.beam_width_vertical_rad,
-                             g.beam_width_vertical_rad);
+  horizontal_slots_ =
+      tabulate(a.rays_horizontal, a.aperture_scale * g.beam_width_horizontal_rad, pattern_k_h_);
+  vertical_slots_ =
+      tabulate(a.rays_vertical, a.aperture_scale * g.beam_width_vertical_rad, pattern_k_v_);
 }
 
 double BeamSynthesizer::RangeLoss(double range_m) const {
@@ -197,7 +198,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const double max_range = g.MaxRangeM();
   Rng rng(seed);
   thread_local Scratch scratch;
-  scratch.spreader.Reset(bins);
+  if (scratch.spreader.Bins() != bins) scratch.spreader.Reset(bins);  // AddTo() leaves it empty
 
   SynthesizedBeam out;
   out.beam.time_s = time_s;
@@ -228,9 +229,6 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
     place_rng.emplace(place);
   }
   Rng& echo_rng = place_rng ? *place_rng : rng;
-  const double k_h =
-      4.0 * std::log(2.0) / (g.beam_width_horizontal_rad * g.beam_width_horizontal_rad);
-  const double k_v = 4.0 * std::log(2.0) / (g.beam_width_vertical_rad * g.beam_width_vertical_rad);
   const double pulse_bins = a.pulse_length_m / g.bin_size_m;
   const double bins_per_m = 1.0 / g.bin_size_m;
 
@@ -249,7 +247,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
     if (u.x() <= 0.0) return 0.0;
     const double theta = std::atan2(u.y(), u.x());
     const double epsilon = std::asin(std::clamp(u.z(), -1.0, 1.0));
-    return std::exp(-0.5 * (k_h * theta * theta + k_v * epsilon * epsilon));
+    return std::exp(-0.5 * (pattern_k_h_ * theta * theta + pattern_k_v_ * epsilon * epsilon));
   };
 
   // The aperture's rays and their first hits, traced as one coherent bundle.

@@ -112,10 +112,13 @@ class BeamSynthesizer {
   std::vector<std::uint8_t> ad_bucket_steps_;
   std::uint64_t ad_first_bucket_ = 0;
   int ad_bucket_shift_ = 52;
-  /// RangeLoss at multiples of range_step_m_.
+  /// RangeLoss at every 1/16 of a bin (range_steps_per_m_ steps per metre) from 0.
   std::vector<double> range_loss_;
-  double range_step_m_ = 0.0;
   double range_steps_per_m_ = 0.0;
+  /// The two-way pattern's exponents, 4 ln2 / w² for the nominal widths w: b = exp(-k_h θ² -
+  /// k_v ε²).
+  double pattern_k_h_ = 0.0;
+  double pattern_k_v_ = 0.0;
   /// Stratum i's slot a at [i · kJitterSlots + a]: horizontal angles θ, vertical angles ε.
   std::vector<JitterSlot> horizontal_slots_;
   std::vector<JitterSlot> vertical_slots_;

@@ -27,6 +27,8 @@ class PulseSpreader {
     open_count_.assign(bins, 0);
   }
 
+  [[nodiscard]] std::size_t Bins() const { return opened_.size(); }
+
   /// Adds `power` per bin over [start, end) bins (start ≤ end; parts beyond the last bin, or
   /// before bin 0, are dropped).
   void Add(double start, double end, double power) {
