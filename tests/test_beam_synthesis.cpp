@@ -589,6 +589,27 @@ TEST(Simulation, SameSeedSameBytesWhateverTheThreadCount) {
   EXPECT_TRUE(differs_with_seed);
 }
 
+// A scenario's beams drop their echo power; dropping it changes nothing else: the beams equal
+// those synthesised one by one with it kept, and the kept echo power is the beam's.
+TEST(Simulation, BeamsDropTheirEchoPowerAndNothingElse) {
+  Scene scene = LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  scene.sweeps = 1;
+  const auto meshes = BuildSceneMeshes(scene);
+  const RayTracer tracer(meshes);
+  const BeamSynthesizer synthesizer = SceneSynthesizer(scene, tracer, 5);
+  const auto run = SimulateBeams(scene, synthesizer, 5, 2, 40, 60);
+  ASSERT_EQ(run.size(), 20u);
+  for (std::size_t b = 0; b < run.size(); ++b) {
+    const ScheduledBeam s = ScheduleBeam(scene, 40 + b);
+    const SynthesizedBeam kept = synthesizer.Synthesize(
+        s.time_s, s.pose.head_angle_rad, s.pose.T_world_sonar, DeriveSeed(5, 40 + b));
+    EXPECT_TRUE(run[b].echo_power.empty());
+    ASSERT_EQ(kept.echo_power.size(), kept.beam.intensities.size());
+    EXPECT_EQ(run[b].beam.intensities, kept.beam.intensities) << "beam " << 40 + b;
+    EXPECT_EQ(run[b].truth.first_hit_range_m, kept.truth.first_hit_range_m);
+  }
+}
+
 TEST(Simulation, ScheduleSteppsTheHeadAndKeepsTime) {
   const Scene scene = LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   const auto& g = scene.sensor.geometry;

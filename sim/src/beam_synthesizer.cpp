@@ -91,13 +91,14 @@ double BeamSynthesizer::RangeLoss(double range_m) const {
 std::uint8_t BeamSynthesizer::QuantisePower(double power) const {
   // The largest q with ad_thresholds_[q] <= power (the thresholds increase; q = 0 below them):
   // the table gives it at the start of the power's bucket, and the power may pass the next
-  // threshold or two within the bucket. Exact whatever the bucket width; narrow buckets make
-  // the loop rare.
+  // threshold within the bucket (a compare added, not branched on: it is a coin toss). Buckets
+  // of half an AD step hold at most one threshold; the loop keeps it exact for wider ones.
   if (!(power >= ad_thresholds_[1])) return 0;
   if (power >= ad_thresholds_[255]) return 255;
   const std::uint64_t bucket =
       (std::bit_cast<std::uint64_t>(power) >> ad_bucket_shift_) - ad_first_bucket_;
   unsigned q = ad_bucket_steps_[bucket];
+  q += power >= ad_thresholds_[q + 1] ? 1 : 0;
   while (power >= ad_thresholds_[q + 1]) ++q;
   return static_cast<std::uint8_t>(q);
 }
@@ -185,13 +186,14 @@ struct Scratch {
   std::vector<StraightReturn> returns;
   std::vector<bool> occluded;
   PulseSpreader spreader;
+  std::vector<double> echo_power;
 };
 
 }  // namespace
 
 SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad,
                                             const Eigen::Isometry3d& T_world_sonar,
-                                            std::uint64_t seed) const {
+                                            std::uint64_t seed, EchoPower echo_power) const {
   const mapping::SensorGeometry& g = sensor_.geometry;
   const Acoustics& a = sensor_.acoustics;
   const auto bins = static_cast<std::size_t>(g.num_bins);
@@ -206,7 +208,8 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   out.beam.T_world_sonar = T_world_sonar;
   out.truth.T_world_sonar = T_world_sonar;
   out.beam.bin_size_m = g.bin_size_m;
-  out.echo_power.assign(bins, 0.0);
+  std::vector<double>& echo = scratch.echo_power;
+  echo.assign(bins, 0.0);
 
   const Eigen::Matrix3d R_world_beam =
       T_world_sonar.linear() *
@@ -347,8 +350,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       if (!scratch.occluded[q]) deposit(returns[q].range, returns[q].weight);
     }
   }
-  scratch.spreader.AddTo(out.echo_power);
-  for (double& p : out.echo_power) p /= weight_sum;
+  scratch.spreader.AddTo(echo);
 
   if (const auto axis =
           tracer_.Intersect(origin, (R_world_beam * Eigen::Vector3d::UnitX()).cast<float>(),
@@ -360,12 +362,14 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const double noise_power = std::pow(10.0, a.noise_level_db / 10.0);
   const double gain = std::pow(10.0, a.gain_db / 10.0);
   for (std::size_t k = 0; k < bins; ++k) {
-    double signal = gain * out.echo_power[k];
+    echo[k] /= weight_sum;
+    double signal = gain * echo[k];
     if (k < self_reflection_power_.size()) signal += self_reflection_power_[k];
     if (a.speckle) signal *= echo_rng.Exponential();
     const double power = signal + noise_power * rng.Exponential();
     out.beam.intensities[k] = QuantisePower(power);
   }
+  if (echo_power == EchoPower::kKeep) out.echo_power = echo;
   return out;
 }
 

@@ -259,6 +259,7 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   const fs::path root(dir);
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
+  const BeamSynthesizer synthesizer = SceneSynthesizer(scene, tracer, seed);
   const std::size_t beam_count = ScenarioBeamCount(scene);
   const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
   const auto first_sweep = static_cast<std::size_t>(options.shard.index);
@@ -272,7 +273,7 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
       ++summary.sweeps_skipped;
     } else {
       const std::size_t first = s * per_sweep;
-      const auto synthesized = SimulateBeams(scene, tracer, seed, options.threads, first,
+      const auto synthesized = SimulateBeams(scene, synthesizer, seed, options.threads, first,
                                              std::min(beam_count, first + per_sweep));
       const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
       WriteBeams(root / mapping::SweepFile("beams", s, "bin"), beams);

@@ -45,13 +45,16 @@ Eigen::Isometry3d ReportedSonarPose(const Scene& scene, std::size_t index, doubl
   return reported * scene.sensor.geometry.T_vehicle_sonar;
 }
 
-std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const RayTracer& tracer,
-                                           std::uint64_t seed, int threads, std::size_t first,
-                                           std::size_t last) {
+BeamSynthesizer SceneSynthesizer(const Scene& scene, const RayTracer& tracer, std::uint64_t seed) {
   std::vector<Material> materials_by_mesh;
   for (const MeshSpec& mesh : scene.meshes)
     materials_by_mesh.push_back(scene.materials[mesh.material]);
-  const BeamSynthesizer synthesizer(scene.sensor, tracer, std::move(materials_by_mesh), seed);
+  return BeamSynthesizer(scene.sensor, tracer, std::move(materials_by_mesh), seed);
+}
+
+std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const BeamSynthesizer& synthesizer,
+                                           std::uint64_t seed, int threads, std::size_t first,
+                                           std::size_t last) {
   std::vector<SynthesizedBeam> beams(last - first);
   const int n_threads = threads > 0 ? threads : omp_get_max_threads();
 #pragma omp parallel for num_threads(n_threads) schedule(dynamic, 8)
@@ -60,7 +63,7 @@ std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const RayTracer& 
     const ScheduledBeam s = ScheduleBeam(scene, index);
     SynthesizedBeam& out = beams[static_cast<std::size_t>(b)];
     out = synthesizer.Synthesize(s.time_s, s.pose.head_angle_rad, s.pose.T_world_sonar,
-                                 DeriveSeed(seed, index));
+                                 DeriveSeed(seed, index), EchoPower::kDrop);
     out.beam.T_world_sonar = ReportedSonarPose(scene, index, s.time_s, seed);
   }
   return beams;
@@ -72,10 +75,11 @@ std::vector<SynthesizedBeam> SimulateScene(
   const std::size_t count = ScenarioBeamCount(scene);
   const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
   const auto sweeps = static_cast<std::size_t>(scene.sweeps);
+  const BeamSynthesizer synthesizer = SceneSynthesizer(scene, tracer, seed);
   std::vector<SynthesizedBeam> beams;
   beams.reserve(count);
   for (std::size_t sweep = 0; sweep < sweeps; ++sweep) {
-    auto part = SimulateBeams(scene, tracer, seed, threads, sweep * per_sweep,
+    auto part = SimulateBeams(scene, synthesizer, seed, threads, sweep * per_sweep,
                               std::min(count, (sweep + 1) * per_sweep));
     std::move(part.begin(), part.end(), std::back_inserter(beams));
     if (on_sweep) on_sweep(sweep + 1, sweeps);

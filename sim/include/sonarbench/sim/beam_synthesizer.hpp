@@ -28,11 +28,16 @@ struct BeamTruth {
 struct SynthesizedBeam {
   mapping::Beam beam;
   BeamTruth truth;
-  /// Noise-free echo power per bin [linear, relative to a perfect reflector at 1 m].
+  /// Noise-free echo power per bin [linear, relative to a perfect reflector at 1 m]; empty
+  /// unless asked for (EchoPower::kKeep).
   std::vector<double> echo_power;
   /// Rays traced for it: primaries, mirrored rays and occlusion rays (for speed reports).
   std::size_t traced_rays = 0;
 };
+
+/// Whether a synthesised beam carries its noise-free echo power (for tests and studies of the
+/// echo itself). A scenario's beams drop it: 8 bytes per bin that nothing downstream reads.
+enum class EchoPower { kKeep, kDrop };
 
 /// Synthesises MSIS beams by tracing stratified-jittered rays across the beam's aperture.
 ///
@@ -60,10 +65,12 @@ class BeamSynthesizer {
 
   /// One beam at head angle `head_angle_rad` from a sonar at `T_world_sonar`. `seed` drives its
   /// background noise and, unless the acoustics' speckle_correlation_m is set (then the run seed
-  /// and the place do), its ray jitter and speckle.
+  /// and the place do), its ray jitter and speckle. The beam's bytes do not depend on
+  /// `echo_power`.
   [[nodiscard]] SynthesizedBeam Synthesize(double time_s, double head_angle_rad,
                                            const Eigen::Isometry3d& T_world_sonar,
-                                           std::uint64_t seed) const;
+                                           std::uint64_t seed,
+                                           EchoPower echo_power = EchoPower::kKeep) const;
 
   /// A beam's primary rays, for a beam whose frame (x along its axis, z up the fan) is
   /// `R_world_beam`: rays_horizontal × rays_vertical, one per stratum, each at a jitter slot in

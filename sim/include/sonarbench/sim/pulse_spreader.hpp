@@ -21,13 +21,9 @@ class PulseSpreader {
   explicit PulseSpreader(std::size_t bins = 0) { Reset(bins); }
 
   /// Empties the spreader and sizes it for `bins` bins.
-  void Reset(std::size_t bins) {
-    opened_.assign(bins, 0.0);
-    partial_.assign(bins, 0.0);
-    open_count_.assign(bins, 0);
-  }
+  void Reset(std::size_t bins) { edges_.assign(bins, Edges{}); }
 
-  [[nodiscard]] std::size_t Bins() const { return opened_.size(); }
+  [[nodiscard]] std::size_t Bins() const { return edges_.size(); }
 
   /// Adds `power` per bin over [start, end) bins (start ≤ end; parts beyond the last bin, or
   /// before bin 0, are dropped).
@@ -40,30 +36,35 @@ class PulseSpreader {
   void AddTo(std::span<double> out) {
     double running = 0.0;
     int open = 0;
-    for (std::size_t k = 0; k < out.size() && k < opened_.size(); ++k) {
-      out[k] += std::max(0.0, (open > 0 ? running : 0.0) + partial_[k]);
-      running += opened_[k];
-      open += open_count_[k];
+    for (std::size_t k = 0; k < out.size() && k < edges_.size(); ++k) {
+      Edges& e = edges_[k];
+      out[k] += std::max(0.0, (open > 0 ? running : 0.0) + e.partial);
+      running += e.opened;
+      open += e.count;
       if (open == 0) running = 0.0;
-      opened_[k] = 0.0;
-      partial_[k] = 0.0;
-      open_count_[k] = 0;
+      e = Edges{};
     }
   }
 
  private:
   void Edge(double at, double power, int count) {
     at = std::max(at, 0.0);
-    if (!(at < static_cast<double>(opened_.size()))) return;
+    if (!(at < static_cast<double>(edges_.size()))) return;
     const auto k = static_cast<std::size_t>(at);
-    opened_[k] += power;
-    partial_[k] += power * (static_cast<double>(k + 1) - at);
-    open_count_[k] += count;
+    Edges& e = edges_[k];
+    e.opened += power;
+    e.partial += power * (static_cast<double>(k + 1) - at);
+    e.count += count;
   }
 
-  std::vector<double> opened_;
-  std::vector<double> partial_;
-  std::vector<int> open_count_;
+  /// A bin's edges: the power of the boxes they open (+) or close (-), their partial
+  /// contributions to the bin, and their count, side by side for the edge updates.
+  struct Edges {
+    double opened = 0.0;
+    double partial = 0.0;
+    int count = 0;
+  };
+  std::vector<Edges> edges_;
 };
 
 }  // namespace sonarbench::sim

@@ -38,10 +38,18 @@ struct ScheduledBeam {
     const Scene& scene, const RayTracer& tracer, std::uint64_t seed, int threads,
     const std::function<void(std::size_t done, std::size_t total)>& on_sweep = {});
 
-/// Synthesises beams [first, last) of the scene's run, on `threads` threads (0 = all); beam b
-/// draws only from DeriveSeed(seed, b), so any split of a run gives the same beams.
+/// The synthesizer of a scene's run: its sensor, its meshes' materials (mesh i's at i, as
+/// BuildSceneMeshes orders them) and the run seed. Build it once per run: it tables the range
+/// loss, the AD steps and the jitter slots.
+[[nodiscard]] BeamSynthesizer SceneSynthesizer(const Scene& scene, const RayTracer& tracer,
+                                               std::uint64_t seed);
+
+/// Synthesises beams [first, last) of the scene's run with `synthesizer` (SceneSynthesizer of
+/// the same scene and seed), on `threads` threads (0 = all); beam b draws only from
+/// DeriveSeed(seed, b), so any split of a run gives the same beams. Their echo power is dropped
+/// (EchoPower::kDrop).
 [[nodiscard]] std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene,
-                                                         const RayTracer& tracer,
+                                                         const BeamSynthesizer& synthesizer,
                                                          std::uint64_t seed, int threads,
                                                          std::size_t first, std::size_t last);
 
