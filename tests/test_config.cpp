@@ -156,6 +156,23 @@ TEST(SceneFile, BadSonarAcousticsAreNamed) {
        "'sonar_acoustics.speckle_correlation_m'", "'-0.1'"}));
 }
 
+// A material's mirror roughness is read in degrees and kept in radians; out of range is named.
+TEST(SceneFile, SpecularSpreadIsReadInDegrees) {
+  const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  ASSERT_FALSE(scene.materials.empty());
+  EXPECT_NEAR(scene.materials.front().specular_spread_rad, 8.0 * mapping::kDegToRad, 1e-15);
+  test::TempDir dir;
+  const std::string path = (dir.path() / "bad.yaml").string();
+  std::ofstream(path) << "name: x\nsensor_model: "
+                      << test::SourcePath("sensor-models/shad-micron.yaml")
+                      << "\nsweeps: 1\nmaterials:\n"
+                      << "  - {name: rock, reflectivity: 0.5, specular_spread_deg: 45}\n"
+                      << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
+                      << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
+                                   {"bad.yaml:5:", "'materials[0].specular_spread_deg'", "'45'"}));
+}
+
 TEST(SceneFile, MissingFileIsAnInputError) {
   EXPECT_TRUE(ThrowsInputErrorWith([] { (void)sim::LoadScene("/nonexistent/scene.yaml"); },
                                    {"/nonexistent/scene.yaml", "cannot open"}));

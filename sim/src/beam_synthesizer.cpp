@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <vector>
 
@@ -76,6 +77,43 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
       tabulate(a.rays_horizontal, a.aperture_scale * g.beam_width_horizontal_rad, pattern_k_h_);
   vertical_slots_ =
       tabulate(a.rays_vertical, a.aperture_scale * g.beam_width_vertical_rad, pattern_k_v_);
+
+  // A standard 2-D Gaussian offset has a Rayleigh radius, P(radius ≤ ρ) = 1 - exp(-ρ²/2), and a
+  // uniform direction: radius quantiles times evenly spaced directions.
+  spread_offsets_.reserve(kSpreadOffsets);
+  for (int i = 0; i < 64; ++i) {
+    const double radius = std::sqrt(-2.0 * std::log(1.0 - (i + 0.5) / 64.0));
+    for (int j = 0; j < 64; ++j) {
+      const double angle = 2.0 * std::numbers::pi * (j + 0.5) / 64.0;
+      spread_offsets_.emplace_back(static_cast<float>(radius * std::cos(angle)),
+                                   static_cast<float>(radius * std::sin(angle)));
+    }
+  }
+}
+
+Eigen::Vector3f BeamSynthesizer::SpreadMirror(const Eigen::Vector3f& mirror,
+                                              const Eigen::Vector3f& normal,
+                                              const Material& material, Rng& rng) const {
+  if (material.specular_spread_rad <= 0.0) return mirror;
+  static_assert((kSpreadOffsets & (kSpreadOffsets - 1)) == 0, "offsets are picked by a mask");
+  const Eigen::Vector2f& g = spread_offsets_[(rng.Next() >> 32) & (kSpreadOffsets - 1)];
+  // Two unit directions across the mirror direction m, orthonormal with it by construction (Duff
+  // et al., "Building an orthonormal basis, revisited", JCGT 2017: one division, no root), so
+  // m + σ·g has length √(1 + σ²|g|²).
+  const float sign = std::copysign(1.0f, mirror.z());
+  const float a = -1.0f / (sign + mirror.z());
+  const float b = mirror.x() * mirror.y() * a;
+  const Eigen::Vector3f across(1.0f + sign * mirror.x() * mirror.x() * a, sign * b,
+                               -sign * mirror.x());
+  const Eigen::Vector3f across_too(b, sign + mirror.y() * mirror.y() * a, -mirror.y());
+  const auto sigma = static_cast<float>(material.specular_spread_rad);
+  const Eigen::Vector2f tilt = sigma * g;
+  const float unit = 1.0f / std::sqrt(1.0f + tilt.squaredNorm());
+  Eigen::Vector3f spread = (mirror + tilt.x() * across + tilt.y() * across_too) * unit;
+  // A direction into the surface is mirrored back out of it.
+  const float side = spread.dot(normal);
+  if ((side > 0.0f) != (mirror.dot(normal) > 0.0f)) spread -= 2.0f * side * normal;
+  return spread;
 }
 
 double BeamSynthesizer::RangeLoss(double range_m) const {
@@ -303,11 +341,13 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
     next_paths.clear();
     stream.clear();
     for (MirrorPath p : paths) {
-      p.specular *= materials_by_mesh_[p.hit.mesh].specular;
+      const Material& mirror = materials_by_mesh_[p.hit.mesh];
+      p.specular *= mirror.specular;
       if (p.specular <= 0.0 || p.path >= 2.0 * max_range) continue;
       p.from += p.hit.distance * p.direction;
-      p.direction =
-          (p.direction - 2.0f * p.direction.dot(p.hit.normal) * p.hit.normal).normalized();
+      p.direction = SpreadMirror(
+          (p.direction - 2.0f * p.direction.dot(p.hit.normal) * p.hit.normal).normalized(),
+          p.hit.normal, mirror, echo_rng);
       stream.push_back({p.from + 1e-4f * p.direction, p.direction,
                         static_cast<float>(2.0 * max_range - p.path)});
       next_paths.push_back(p);

@@ -142,6 +142,9 @@ Scene LoadScene(const std::string& path) {
     item.Required("reflectivity", m.reflectivity, InRange(0.0, 1.0));
     item.Optional("backscatter_exponent", m.backscatter_exponent, InRange(0.0, 100.0));
     item.Optional("specular", m.specular, InRange(0.0, 1.0));
+    double spread_deg = 0.0;
+    item.Optional("specular_spread_deg", spread_deg, InRange(0.0, 30.0));
+    m.specular_spread_rad = spread_deg * kDegToRad;
     item.RejectUnknownKeys();
     scene.materials.push_back(m);
   }

@@ -98,6 +98,19 @@ class BeamSynthesizer {
   /// Jitter positions per stratum and direction.
   static constexpr int kJitterSlots = 32;
 
+  /// The direction a ray reflected by `material` takes, for the exact mirror direction
+  /// `mirror` (unit) off a surface of normal `normal`: `mirror` itself for a perfect mirror;
+  /// otherwise tilted by atan(σ·g) towards a direction across it, σ the material's
+  /// specular_spread_rad and g a standard 2-D Gaussian offset from kSpreadOffsets tabled ones
+  /// (one draw from `rng`), and kept on the mirror's side of the surface. Unit length.
+  [[nodiscard]] Eigen::Vector3f SpreadMirror(const Eigen::Vector3f& mirror,
+                                             const Eigen::Vector3f& normal,
+                                             const Material& material, Rng& rng) const;
+
+  /// Tabled 2-D Gaussian offsets: 64 radii (the Rayleigh distribution's quantiles at
+  /// (i + ½)/64, up to 3.1 σ) × 64 evenly spaced directions.
+  static constexpr int kSpreadOffsets = 64 * 64;
+
  private:
   /// A ray angle's sine, cosine and one-direction factor of the two-way pattern.
   struct JitterSlot {
@@ -129,6 +142,8 @@ class BeamSynthesizer {
   /// Stratum i's slot a at [i · kJitterSlots + a]: horizontal angles θ, vertical angles ε.
   std::vector<JitterSlot> horizontal_slots_;
   std::vector<JitterSlot> vertical_slots_;
+  /// kSpreadOffsets standard 2-D Gaussian offsets (SpreadMirror).
+  std::vector<Eigen::Vector2f> spread_offsets_;
 };
 
 // Inline: the synthesis calls it for every echo.

@@ -22,6 +22,10 @@ struct Material {
   /// Fraction of the incident energy reflected specularly [0-1]: a ray that hits goes on in the
   /// mirror direction, and what it meets echoes back along the same path (multipath).
   double specular = 0.0;
+  /// How rough a mirror it is: the standard deviation, per axis across the mirror direction, of
+  /// the direction a reflected ray takes [rad] (scene key specular_spread_deg). 0: a perfect
+  /// mirror; a few degrees spread each multipath ghost over bins and head angles.
+  double specular_spread_rad = 0.0;
 };
 
 /// A mesh, as the scene file describes it: procedural, or loaded from a mesh file.
