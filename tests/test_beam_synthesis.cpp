@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <numeric>
 #include <optional>
@@ -329,6 +330,73 @@ TEST(BeamSynthesis, RoughMirrorSpreadsTheGhostSideways) {
   EXPECT_EQ(perfect, 0.0);
   EXPECT_GT(rough, 10.0 * slightly) << slightly << " vs " << rough;
   EXPECT_GT(rough, 0.0);
+}
+
+// Through a rough mirror the echo does not come back along its way out: the way back is tilted
+// afresh, so it reaches the sonar from a direction off the way out and the receive pattern
+// weighs that. The mirror of SpecularBounceEchoesAtTheSummedRange, halfway along the 2 m path
+// to a wide wall (its image): a tilt δ at the mirror moves the image seen from the sonar by
+// δ/2, so the way back arrives c = (δ_out - δ_back)/2 off the way out, c ~ N(0, σ²/2) per
+// axis. With the one-way pattern p(a) = exp(-k a²/2) per axis (k = 4 ln 2 / w², the rays
+// uniform over the nominal width w), the ghost's power against a perfect mirror's is, per
+// axis, ∫ p(a) E[p(a + c)] da / ∫ p(a)² da, with E[p(a + c)] = exp(-k a²/(2(1 + kτ²))) /
+// √(1 + kτ²), τ² = σ²/2; times 1 - σ² for the tilted incidence on the wall (E[cos t] for a
+// tilt t of mean square 2σ²). The synthesis draws δ_out and averages over δ_back in closed
+// form; this checks the unfolding that places the image and the (L - s)/L weighting. Tolerance:
+// the small-angle terms, of order σ² = 2% at 8°, plus four standard errors of the mean over 40
+// pings.
+TEST(BeamSynthesis, RoughMirrorEchoComesBackThroughItsReceivePattern) {
+  const SensorModel sensor = QuietSensor();
+  MeshSpec target;
+  target.type = MeshSpec::Type::kPlane;
+  target.size_m = {40.0, 40.0, 0.0};
+  target.T_world_mesh = mapping::PoseFromXyzRpy({0, 1.0, 0}, {std::numbers::pi / 2, 0, 0});
+  const std::vector<TriangleMesh> meshes{BuildMesh(MirrorTurningXToY(), 0), BuildMesh(target, 0)};
+  const RayTracer tracer(meshes);
+  Material wall;
+  wall.reflectivity = 0.5;
+  const double sigma = 8.0 * kDegToRad;
+  auto ghost = [&](double spread, std::uint64_t seed) {
+    Material glass;
+    glass.reflectivity = 0.0;
+    glass.specular = 1.0;
+    glass.specular_spread_rad = spread;
+    const BeamSynthesizer synthesizer(sensor, tracer, {glass, wall});
+    return TotalPower(synthesizer.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), seed));
+  };
+  constexpr int kPings = 40;
+  std::vector<double> ratio;
+  for (int i = 0; i < kPings; ++i) {
+    const auto seed = static_cast<std::uint64_t>(100 + i);
+    ratio.push_back(ghost(sigma, seed) / ghost(0.0, seed));
+  }
+  const double mean = std::accumulate(ratio.begin(), ratio.end(), 0.0) / kPings;
+  double sum_sq = 0.0;
+  for (double r : ratio) sum_sq += (r - mean) * (r - mean);
+  const double standard_error = std::sqrt(sum_sq / (kPings - 1) / kPings);
+
+  auto per_axis = [&](double width) {
+    const double k = 4.0 * std::log(2.0) / (width * width);
+    const double spread = 1.0 + k * sigma * sigma / 2.0;
+    double through = 0.0;
+    double direct = 0.0;
+    constexpr int kSteps = 10000;
+    for (int j = 0; j < kSteps; ++j) {
+      const double a = width * ((j + 0.5) / kSteps - 0.5);
+      const double p = std::exp(-0.5 * k * a * a);
+      through += p * std::exp(-0.5 * k * a * a / spread) / std::sqrt(spread);
+      direct += p * p;
+    }
+    return through / direct;
+  };
+  const auto& g = sensor.geometry;
+  const double expected = per_axis(g.beam_width_horizontal_rad) *
+                          per_axis(g.beam_width_vertical_rad) * (1.0 - sigma * sigma);
+  std::printf("rough/perfect ghost power %.4f ± %.4f, expected %.4f\n", mean, standard_error,
+              expected);
+  EXPECT_NEAR(mean, expected, 0.02 * expected + 4.0 * standard_error);
+  // Without the fresh way back (the echo retracing its way out) it would be about 1 - σ².
+  EXPECT_LT(mean, 0.8);
 }
 
 // The straight return's occlusion ray: a wall 1 m ahead blocks a segment that reaches it, not

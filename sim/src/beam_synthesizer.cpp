@@ -1,6 +1,7 @@
 #include "sonarbench/sim/beam_synthesizer.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <numbers>
@@ -91,25 +92,26 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
   }
 }
 
+Eigen::Vector3f BeamSynthesizer::Tilt(const Eigen::Vector3f& unit, float sigma, Rng& rng) const {
+  static_assert((kSpreadOffsets & (kSpreadOffsets - 1)) == 0, "offsets are picked by a mask");
+  const Eigen::Vector2f tilt = sigma * spread_offsets_[(rng.Next() >> 32) & (kSpreadOffsets - 1)];
+  // Two unit directions across `unit`, orthonormal with it by construction (Duff et al.,
+  // "Building an orthonormal basis, revisited", JCGT 2017: one division, no root), so
+  // unit + tilt has length √(1 + |tilt|²).
+  const float sign = std::copysign(1.0f, unit.z());
+  const float a = -1.0f / (sign + unit.z());
+  const float b = unit.x() * unit.y() * a;
+  const Eigen::Vector3f across(1.0f + sign * unit.x() * unit.x() * a, sign * b, -sign * unit.x());
+  const Eigen::Vector3f across_too(b, sign + unit.y() * unit.y() * a, -unit.y());
+  const float length = 1.0f / std::sqrt(1.0f + tilt.squaredNorm());
+  return (unit + tilt.x() * across + tilt.y() * across_too) * length;
+}
+
 Eigen::Vector3f BeamSynthesizer::SpreadMirror(const Eigen::Vector3f& mirror,
                                               const Eigen::Vector3f& normal,
                                               const Material& material, Rng& rng) const {
   if (material.specular_spread_rad <= 0.0) return mirror;
-  static_assert((kSpreadOffsets & (kSpreadOffsets - 1)) == 0, "offsets are picked by a mask");
-  const Eigen::Vector2f& g = spread_offsets_[(rng.Next() >> 32) & (kSpreadOffsets - 1)];
-  // Two unit directions across the mirror direction m, orthonormal with it by construction (Duff
-  // et al., "Building an orthonormal basis, revisited", JCGT 2017: one division, no root), so
-  // m + σ·g has length √(1 + σ²|g|²).
-  const float sign = std::copysign(1.0f, mirror.z());
-  const float a = -1.0f / (sign + mirror.z());
-  const float b = mirror.x() * mirror.y() * a;
-  const Eigen::Vector3f across(1.0f + sign * mirror.x() * mirror.x() * a, sign * b,
-                               -sign * mirror.x());
-  const Eigen::Vector3f across_too(b, sign + mirror.y() * mirror.y() * a, -mirror.y());
-  const auto sigma = static_cast<float>(material.specular_spread_rad);
-  const Eigen::Vector2f tilt = sigma * g;
-  const float unit = 1.0f / std::sqrt(1.0f + tilt.squaredNorm());
-  Eigen::Vector3f spread = (mirror + tilt.x() * across + tilt.y() * across_too) * unit;
+  Eigen::Vector3f spread = Tilt(mirror, static_cast<float>(material.specular_spread_rad), rng);
   // A direction into the surface is mirrored back out of it.
   const float side = spread.dot(normal);
   if ((side > 0.0f) != (mirror.dot(normal) > 0.0f)) spread -= 2.0f * side * normal;
@@ -195,7 +197,11 @@ double BeamSynthesizer::DrawRays(const Eigen::Matrix3d& R_world_beam, Rng& rng,
 namespace {
 
 // A mirrored ray of a beam's multipath, between bounces: the hit it last made, from where, along
-// which direction, the path so far and the product of the specular fractions met.
+// which direction, the path so far and the product of the specular fractions met. Unfolded
+// (each reflection undone, so the path is seen from the sonar as a straight line to the image
+// of where it ends): `unfold` maps the current direction back to the sonar's frame and `image`
+// is the last mirror point's image relative to the sonar. `blur` sums, over the rough mirrors
+// met, σ², σ²·s and σ²·s² (s the path length at the mirror): the spread of the way back.
 struct MirrorPath {
   Eigen::Vector3f from;
   Eigen::Vector3f direction;
@@ -203,6 +209,9 @@ struct MirrorPath {
   double path = 0.0;
   double specular = 1.0;
   double pattern = 0.0;
+  Eigen::Matrix3f unfold = Eigen::Matrix3f::Identity();
+  Eigen::Vector3f image = Eigen::Vector3f::Zero();
+  std::array<double, 3> blur{};
 };
 
 // A straight return to the sonar, heard at `range` with strength `weight` unless its occlusion
@@ -317,7 +326,11 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
     deposit(range, pattern * material.reflectivity *
                        CosPower(cos_incidence, material.backscatter_exponent));
     if (a.max_bounces > 0 && material.specular > 0.0) {
-      paths.push_back({origin, direction, *hit, hit->distance, 1.0, pattern});
+      paths.push_back({.from = origin,
+                       .direction = direction,
+                       .hit = *hit,
+                       .path = hit->distance,
+                       .pattern = pattern});
     }
   }
 
@@ -325,13 +338,38 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   // stream, their occlusion rays another): a ray with two-way pattern weight `pattern` goes on
   // in the mirror direction with the specular fraction of its energy, up to max_bounces times.
   // At each later hit P_k, after a path of length L from the sonar, two returns:
-  //  - back along the same path (through the same mirrors both ways): range L, weight
-  //    pattern · s² · ρ cosⁿ, where s is the product of the specular fractions so far;
+  //  - back through the same mirrors: range L, weight pattern · s² · ρ cosⁿ, where s is the
+  //    product of the specular fractions so far and pattern the two-way pattern of the way out
+  //    and back (return_pattern);
   //  - straight back to the sonar if P_k is in view (an occlusion ray) and in the receive lobe:
   //    range R = (L + d)/2 with d = |P_k - sonar|, weight 2 · √pattern · p(P_k) · s · ρ (cos_i
   //    cos_s)^(n/2) · (R/d)^(S/10); p is the one-way pattern towards P_k, the factor 2 counts
   //    the reverse path (sonar → P_k → mirrors → sonar), equal by reciprocity, and (R/d)^(S/10)
   //    turns the monostatic spreading at R into the last leg's own.
+  //
+  // The two-way pattern of the way out and back along a mirror path ending at p's hit. Through
+  // perfect mirrors the echo comes back along the way out: the ray's own two-way pattern.
+  // Through rough ones the way back is a path of its own, each rough mirror tilting it
+  // independently: it arrives from the direction of the end point's image, off by a 2-D
+  // Gaussian angle of variance τ² = Σ σ² (1 - s/L)² per axis (a tilt at path length s moves the
+  // image seen from the sonar by (L - s)/L of it). The receive pattern's mean over that offset,
+  // for the one-way pattern exp(-k θ²/2) per axis, is exp(-k θ² / (2 (1 + k τ²))) / √(1 + k τ²).
+  auto return_pattern = [&](const MirrorPath& p) {
+    if (p.blur[0] <= 0.0) return p.pattern;
+    const Eigen::Vector3d image =
+        R_beam_world * (p.image + p.unfold * (p.hit.distance * p.direction)).cast<double>();
+    if (image.x() <= 0.0) return 0.0;
+    const double inverse = 1.0 / p.path;
+    const double variance =
+        std::max(p.blur[0] - 2.0 * p.blur[1] * inverse + p.blur[2] * inverse * inverse, 0.0);
+    const double theta = std::atan2(image.y(), image.x());
+    const double epsilon = std::asin(std::clamp(image.z() / image.norm(), -1.0, 1.0));
+    const double wide_h = 1.0 + pattern_k_h_ * variance;
+    const double wide_v = 1.0 + pattern_k_v_ * variance;
+    return std::sqrt(p.pattern / (wide_h * wide_v)) *
+           std::exp(-0.5 * (pattern_k_h_ * theta * theta / wide_h +
+                            pattern_k_v_ * epsilon * epsilon / wide_v));
+  };
   const Eigen::Vector3d sonar = T_world_sonar.translation();
   const double spreading_db = a.spreading_db_per_decade;
   std::vector<MirrorPath>& next_paths = scratch.next_paths;
@@ -345,6 +383,14 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       p.specular *= mirror.specular;
       if (p.specular <= 0.0 || p.path >= 2.0 * max_range) continue;
       p.from += p.hit.distance * p.direction;
+      p.image += p.unfold * (p.hit.distance * p.direction);
+      p.unfold -= 2.0f * (p.unfold * p.hit.normal) * p.hit.normal.transpose();
+      if (const double sigma = mirror.specular_spread_rad; sigma > 0.0) {
+        const double variance = sigma * sigma;
+        p.blur[0] += variance;
+        p.blur[1] += variance * p.path;
+        p.blur[2] += variance * p.path * p.path;
+      }
       p.direction = SpreadMirror(
           (p.direction - 2.0f * p.direction.dot(p.hit.normal) * p.hit.normal).normalized(),
           p.hit.normal, mirror, echo_rng);
@@ -367,7 +413,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       const Material& m = materials_by_mesh_[p.hit.mesh];
       const double cos_in = std::abs(p.hit.normal.dot(p.direction));
       if (p.path <= max_range) {
-        deposit(p.path, p.pattern * p.specular * p.specular * m.reflectivity *
+        deposit(p.path, return_pattern(p) * p.specular * p.specular * m.reflectivity *
                             CosPower(cos_in, m.backscatter_exponent));
       }
       const Eigen::Vector3f at = p.from + p.hit.distance * p.direction;

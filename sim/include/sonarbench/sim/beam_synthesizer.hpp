@@ -107,6 +107,10 @@ class BeamSynthesizer {
                                              const Eigen::Vector3f& normal,
                                              const Material& material, Rng& rng) const;
 
+  /// `unit` tilted by atan(σ·g) towards a direction across it, g a standard 2-D Gaussian offset
+  /// from the kSpreadOffsets tabled ones (one draw from `rng`). Unit length.
+  [[nodiscard]] Eigen::Vector3f Tilt(const Eigen::Vector3f& unit, float sigma, Rng& rng) const;
+
   /// Tabled 2-D Gaussian offsets: 64 radii (the Rayleigh distribution's quantiles at
   /// (i + ½)/64, up to 3.1 σ) × 64 evenly spaced directions.
   static constexpr int kSpreadOffsets = 64 * 64;

@@ -24,7 +24,8 @@ struct Material {
   double specular = 0.0;
   /// How rough a mirror it is: the standard deviation, per axis across the mirror direction, of
   /// the direction a reflected ray takes [rad] (scene key specular_spread_deg). 0: a perfect
-  /// mirror; a few degrees spread each multipath ghost over bins and head angles.
+  /// mirror; a few degrees spread each multipath ghost over bins and head angles, and the echo's
+  /// way back is tilted independently of its way out.
   double specular_spread_rad = 0.0;
 };
 
