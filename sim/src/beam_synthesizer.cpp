@@ -18,7 +18,10 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
     : sensor_(sensor),
       tracer_(tracer),
       materials_by_mesh_(std::move(materials_by_mesh)),
-      place_seed_(DeriveSeed(run_seed, 0x706c616365ULL)) {
+      place_seed_(DeriveSeed(run_seed, 0x706c616365ULL)),
+      rough_mirrors_(std::ranges::any_of(materials_by_mesh_, [](const Material& m) {
+        return m.specular > 0.0 && m.specular_spread_rad > 0.0;
+      })) {
   for (const double db : sensor_.acoustics.self_reflection_db) {
     self_reflection_power_.push_back(std::pow(10.0, db / 10.0));
   }
@@ -383,8 +386,10 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       p.specular *= mirror.specular;
       if (p.specular <= 0.0 || p.path >= 2.0 * max_range) continue;
       p.from += p.hit.distance * p.direction;
-      p.image += p.unfold * (p.hit.distance * p.direction);
-      p.unfold -= 2.0f * (p.unfold * p.hit.normal) * p.hit.normal.transpose();
+      if (rough_mirrors_) {
+        p.image += p.unfold * (p.hit.distance * p.direction);
+        p.unfold -= 2.0f * (p.unfold * p.hit.normal) * p.hit.normal.transpose();
+      }
       if (const double sigma = mirror.specular_spread_rad; sigma > 0.0) {
         const double variance = sigma * sigma;
         p.blur[0] += variance;

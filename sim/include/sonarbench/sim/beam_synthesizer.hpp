@@ -107,15 +107,15 @@ class BeamSynthesizer {
                                              const Eigen::Vector3f& normal,
                                              const Material& material, Rng& rng) const;
 
-  /// `unit` tilted by atan(σ·g) towards a direction across it, g a standard 2-D Gaussian offset
-  /// from the kSpreadOffsets tabled ones (one draw from `rng`). Unit length.
-  [[nodiscard]] Eigen::Vector3f Tilt(const Eigen::Vector3f& unit, float sigma, Rng& rng) const;
-
   /// Tabled 2-D Gaussian offsets: 64 radii (the Rayleigh distribution's quantiles at
   /// (i + ½)/64, up to 3.1 σ) × 64 evenly spaced directions.
   static constexpr int kSpreadOffsets = 64 * 64;
 
  private:
+  /// `unit` tilted by atan(σ·g) towards a direction across it, g a standard 2-D Gaussian offset
+  /// from the kSpreadOffsets tabled ones (one draw from `rng`). Unit length.
+  [[nodiscard]] Eigen::Vector3f Tilt(const Eigen::Vector3f& unit, float sigma, Rng& rng) const;
+
   /// A ray angle's sine, cosine and one-direction factor of the two-way pattern.
   struct JitterSlot {
     double sin = 0.0;
@@ -127,6 +127,9 @@ class BeamSynthesizer {
   std::vector<Material> materials_by_mesh_;
   /// Seeds the echoes' randomness per place when the acoustics' speckle_correlation_m is set.
   std::uint64_t place_seed_ = 0;
+  /// Whether any material is a rough mirror: only then do mirror paths track their image (the
+  /// way back's direction).
+  bool rough_mirrors_ = false;
   /// The self-reflection profile as linear power per bin.
   std::vector<double> self_reflection_power_;
   /// Power at which each AD step begins: step q for power ≥ ad_thresholds_[q] (index 0 unused).
