@@ -293,14 +293,20 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
     const double start = range * bins_per_m;
     scratch.spreader.Add(start, start + pulse_bins, strength * RangeLossFromTable(range));
   };
-  // The one-way pattern at a direction in the beam frame, or 0 outside the half-space ahead.
+  // The one-way pattern towards a world direction (unit), or 0 outside the half-space ahead;
+  // with `blur` > 0 its mean over a 2-D Gaussian offset of that variance per axis [rad²]: for
+  // exp(-k θ²/2) per axis, exp(-k θ² / (2 (1 + k τ²))) / √(1 + k τ²).
   const Eigen::Matrix3d R_beam_world = R_world_beam.transpose();
-  auto one_way_pattern = [&](const Eigen::Vector3d& towards) {
+  auto one_way_pattern = [&](const Eigen::Vector3d& towards, double blur = 0.0) {
     const Eigen::Vector3d u = R_beam_world * towards;
     if (u.x() <= 0.0) return 0.0;
     const double theta = std::atan2(u.y(), u.x());
     const double epsilon = std::asin(std::clamp(u.z(), -1.0, 1.0));
-    return std::exp(-0.5 * (pattern_k_h_ * theta * theta + pattern_k_v_ * epsilon * epsilon));
+    const double wide_h = 1.0 + pattern_k_h_ * blur;
+    const double wide_v = 1.0 + pattern_k_v_ * blur;
+    return std::exp(-0.5 * (pattern_k_h_ * theta * theta / wide_h +
+                            pattern_k_v_ * epsilon * epsilon / wide_v)) /
+           std::sqrt(wide_h * wide_v);
   };
 
   // The aperture's rays and their first hits, traced as one coherent bundle.
@@ -354,24 +360,15 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   // perfect mirrors the echo comes back along the way out: the ray's own two-way pattern.
   // Through rough ones the way back is a path of its own, each rough mirror tilting it
   // independently: it arrives from the direction of the end point's image, off by a 2-D
-  // Gaussian angle of variance τ² = Σ σ² (1 - s/L)² per axis (a tilt at path length s moves the
-  // image seen from the sonar by (L - s)/L of it). The receive pattern's mean over that offset,
-  // for the one-way pattern exp(-k θ²/2) per axis, is exp(-k θ² / (2 (1 + k τ²))) / √(1 + k τ²).
+  // Gaussian angle of variance Σ σ² (1 - s/L)² per axis (a tilt at path length s moves the
+  // image seen from the sonar by (L - s)/L of it), and the receive pattern is averaged over it.
   auto return_pattern = [&](const MirrorPath& p) {
     if (p.blur[0] <= 0.0) return p.pattern;
-    const Eigen::Vector3d image =
-        R_beam_world * (p.image + p.unfold * (p.hit.distance * p.direction)).cast<double>();
-    if (image.x() <= 0.0) return 0.0;
+    const Eigen::Vector3f image = p.image + p.unfold * (p.hit.distance * p.direction);
     const double inverse = 1.0 / p.path;
-    const double variance =
+    const double blur =
         std::max(p.blur[0] - 2.0 * p.blur[1] * inverse + p.blur[2] * inverse * inverse, 0.0);
-    const double theta = std::atan2(image.y(), image.x());
-    const double epsilon = std::asin(std::clamp(image.z() / image.norm(), -1.0, 1.0));
-    const double wide_h = 1.0 + pattern_k_h_ * variance;
-    const double wide_v = 1.0 + pattern_k_v_ * variance;
-    return std::sqrt(p.pattern / (wide_h * wide_v)) *
-           std::exp(-0.5 * (pattern_k_h_ * theta * theta / wide_h +
-                            pattern_k_v_ * epsilon * epsilon / wide_v));
+    return std::sqrt(p.pattern) * one_way_pattern(image.cast<double>().normalized(), blur);
   };
   const Eigen::Vector3d sonar = T_world_sonar.translation();
   const double spreading_db = a.spreading_db_per_decade;
