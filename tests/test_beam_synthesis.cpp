@@ -147,6 +147,41 @@ TEST(BeamSynthesis, EchoFollowsSpreadingAndAbsorptionWithRange) {
   EXPECT_NEAR(10.0 * std::log10(far / near), expected_db, 0.01);
 }
 
+// Reverberation: a wall at normal incidence echoes over a few bins; the tail that echo feeds
+// starts in the bin after each echo bin, falls by exp(-bin / length) per bin once the echo has
+// passed (10·log10(e) / length dB per metre), and holds R = 10^(reverberation_db/10) of the
+// echo's power in all: with the wall at 0.5 m and a 0.2 m length the beam's end (5 m) cuts
+// exp(-22) of it. The rays are the same in both pings (same seed), so the echo is too.
+TEST(BeamSynthesis, ReverberationTailDecaysAtItsLengthAndHoldsItsShare) {
+  SensorModel dry = QuietSensor();
+  SensorModel wet = dry;
+  wet.acoustics.reverberation_length_m = 0.2;
+  wet.acoustics.reverberation_db = -3.0;
+  const SynthesizedBeam echo = Ping(dry, Wall(0.5, 0.0));
+  const SynthesizedBeam heard = Ping(wet, Wall(0.5, 0.0));
+  const std::vector<double>& p = echo.echo_power;
+  ASSERT_EQ(heard.echo_power.size(), p.size());
+  const auto first = static_cast<std::size_t>(
+      std::find_if(p.begin(), p.end(), [](double x) { return x > 0.0; }) - p.begin());
+  const auto last = static_cast<std::size_t>(
+      p.rend() - std::find_if(p.rbegin(), p.rend(), [](double x) { return x > 0.0; }) - 1);
+  ASSERT_LT(last + 10, p.size());
+  std::vector<double> tail(p.size());
+  for (std::size_t k = 0; k < p.size(); ++k) tail[k] = heard.echo_power[k] - p[k];
+  // Nothing before the echo's second bin.
+  for (std::size_t k = 0; k <= first; ++k) EXPECT_EQ(tail[k], 0.0) << "bin " << k;
+  EXPECT_GT(tail[first + 1], 0.0);
+  // Past the echo, a pure exponential in range.
+  const double bin = dry.geometry.bin_size_m;
+  const double per_bin = std::exp(-bin / 0.2);
+  for (std::size_t k = last + 2; k < last + 200; ++k) {
+    EXPECT_NEAR(tail[k] / tail[k - 1], per_bin, 1e-9) << "bin " << k;
+  }
+  const double total_echo = std::accumulate(p.begin(), p.end(), 0.0);
+  const double total_tail = std::accumulate(tail.begin(), tail.end(), 0.0);
+  EXPECT_NEAR(total_tail / total_echo, std::pow(10.0, -0.3), 1e-6);
+}
+
 // Multipath: a mirror that scatters nothing back (reflectivity 0, specular 1) at 45° one metre
 // ahead turns the beam towards a plane one metre to the side. The mirror's image of that plane
 // lies two metres ahead, so the ghost's echo starts in bin floor(2.0 / bin) exactly as a wall at

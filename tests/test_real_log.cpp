@@ -267,6 +267,36 @@ TEST(Fidelity, SelfComparisonAgreesAndShiftsAreMeasuredInBins) {
               1e-9);
 }
 
+// The wall's echo strength: each beam's strongest intensity beyond the wall's minimum range,
+// 100 + (beam mod 100) here, so the 400 beams hold each of 100..199 four times and the sorted
+// values at 40, 200 and 360 are 110, 150 and 190. Brighter echoes before that range (the
+// self-reflection's 230) do not count.
+TEST(Fidelity, WallPeaksArePercentilesOfEachBeamsStrongestEcho) {
+  const mapping::SensorGeometry sensor;
+  const std::vector<mapping::Beam> beams = TwoSweeps(sensor, [](int b, int k) -> std::uint8_t {
+    if (k < 40) return 230;
+    return k == 170 ? static_cast<std::uint8_t>(100 + b % 100) : 10;
+  });
+  const auto report = sim::CompareWithLog(beams, beams, sensor, 1.6);
+  EXPECT_EQ(report.sim_wall_peak, (std::array<double, 3>{110.0, 150.0, 190.0}));
+  EXPECT_EQ(report.real_wall_peak, report.sim_wall_peak);
+  // Aligned on the wall (bin 170), the profile is 10 everywhere but at offset 0, the peaks'
+  // mean 149.5 (its offsets reach back to bin 130, clear of the first 40 bins' 230).
+  ASSERT_EQ(report.sim_wall_profile.size(), 161u);
+  for (std::size_t i = 0; i < report.sim_wall_profile.size(); ++i) {
+    const double expected = i == 40 ? 149.5 : 10.0;
+    EXPECT_DOUBLE_EQ(report.sim_wall_profile[i], expected) << "offset " << i - 40.0;
+  }
+  EXPECT_EQ(report.wall_tail_mean_abs_difference, 0.0);
+  // A real log 5 brighter everywhere past the wall's first 16 bins differs by 5 in the tail.
+  std::vector<mapping::Beam> brighter = beams;
+  for (auto& beam : brighter) {
+    for (std::size_t k = 170 + 16; k < beam.intensities.size(); ++k) beam.intensities[k] += 5;
+  }
+  EXPECT_DOUBLE_EQ(sim::CompareWithLog(beams, brighter, sensor, 1.6).wall_tail_mean_abs_difference,
+                   5.0);
+}
+
 // The sweep-to-sweep spread: two identical sweeps spread 0; a second sweep brighter by d in
 // every bin spreads d/√2 in every cell (the sample standard deviation of {v, v + d}).
 TEST(Fidelity, SweepSpreadIsTheStandardDeviationAcrossSweepsPerAngleAndBin) {

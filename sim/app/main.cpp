@@ -187,6 +187,12 @@ int Fidelity(const FidelityArgs& args) {
             << " (past self-reflection)\n"
             << "wall range: median difference " << report.median_wall_difference_bins
             << " bins over " << report.wall_angles_compared << " head angles\n"
+            << "wall echo intensity, 10th/50th/90th percentile over beams: sim "
+            << report.sim_wall_peak[0] << "/" << report.sim_wall_peak[1] << "/"
+            << report.sim_wall_peak[2] << ", real " << report.real_wall_peak[0] << "/"
+            << report.real_wall_peak[1] << "/" << report.real_wall_peak[2]
+            << "; behind it (16-120 bins), mean |difference| "
+            << report.wall_tail_mean_abs_difference << "\n"
             << "intensity histograms: intersection " << report.histogram_intersection << "\n"
             << "sweep-to-sweep spread per head angle and bin: sim " << report.sim_sweep_spread
             << ", real " << report.real_sweep_spread << "\n"

@@ -146,6 +146,19 @@ std::uint8_t BeamSynthesizer::QuantisePower(double power) const {
   return static_cast<std::uint8_t>(q);
 }
 
+void BeamSynthesizer::AddReverberation(std::vector<double>& echo_power) const {
+  const Acoustics& a = sensor_.acoustics;
+  if (a.reverberation_length_m <= 0.0) return;
+  const double keep = std::exp(-sensor_.geometry.bin_size_m / a.reverberation_length_m);
+  const double feed = std::pow(10.0, a.reverberation_db / 10.0) * (1.0 - keep);
+  double tail = 0.0;
+  for (double& power : echo_power) {
+    const double echo = power;
+    power += tail;
+    tail = keep * tail + feed * echo;
+  }
+}
+
 namespace {
 
 // Bistatic returns weaker than this (relative to a perfect reflector filling the beam) are not
@@ -449,8 +462,9 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   out.beam.intensities.resize(bins);
   const double noise_power = std::pow(10.0, a.noise_level_db / 10.0);
   const double gain = std::pow(10.0, a.gain_db / 10.0);
+  for (double& power : echo) power /= weight_sum;
+  AddReverberation(echo);
   for (std::size_t k = 0; k < bins; ++k) {
-    echo[k] /= weight_sum;
     double signal = gain * echo[k];
     if (k < self_reflection_power_.size()) signal += self_reflection_power_[k];
     if (a.speckle) signal *= echo_rng.Exponential();

@@ -36,18 +36,63 @@ std::size_t StepIndex(const mapping::Beam& beam, const mapping::SensorGeometry& 
   return static_cast<std::size_t>(((step % steps) + steps) % steps);
 }
 
+// The first bin at or beyond `min_range_m` and the strongest bin from there on, if any.
+std::optional<std::size_t> StrongestBin(const mapping::Beam& beam, double min_range_m) {
+  const auto first = static_cast<std::size_t>(std::ceil(min_range_m / beam.bin_size_m));
+  if (first >= beam.intensities.size()) return std::nullopt;
+  const auto strongest =
+      std::max_element(beam.intensities.begin() + static_cast<long>(first), beam.intensities.end());
+  return static_cast<std::size_t>(strongest - beam.intensities.begin());
+}
+
+// The 10th, 50th and 90th percentiles (the values at ⌊q·n⌋ of the sorted n) of each beam's
+// strongest intensity beyond `min_range_m`.
+std::array<double, 3> WallPeaks(std::span<const mapping::Beam> beams, double min_range_m) {
+  std::vector<double> peaks;
+  for (const auto& beam : beams) {
+    if (const auto bin = StrongestBin(beam, min_range_m)) peaks.push_back(beam.intensities[*bin]);
+  }
+  std::array<double, 3> out{};
+  if (peaks.empty()) return out;
+  std::sort(peaks.begin(), peaks.end());
+  const std::array<double, 3> quantiles = {0.1, 0.5, 0.9};
+  for (std::size_t i = 0; i < 3; ++i) {
+    out[i] = peaks[static_cast<std::size_t>(quantiles[i] * static_cast<double>(peaks.size()))];
+  }
+  return out;
+}
+
+// FidelityReport::sim_wall_profile for `beams`.
+std::vector<double> WallProfile(std::span<const mapping::Beam> beams, double min_range_m,
+                                std::size_t first_usable) {
+  constexpr int kBefore = FidelityReport::kWallProfileBefore;
+  const auto size = static_cast<std::size_t>(kBefore + FidelityReport::kWallProfileAfter + 1);
+  std::vector<double> sum(size, 0.0);
+  std::vector<double> count(size, 0.0);
+  for (const auto& beam : beams) {
+    const auto bin = StrongestBin(beam, min_range_m);
+    if (!bin) continue;
+    for (std::size_t i = 0; i < size; ++i) {
+      const auto k = static_cast<long>(*bin) + static_cast<long>(i) - kBefore;
+      if (k < static_cast<long>(first_usable) || k >= static_cast<long>(beam.intensities.size()))
+        continue;
+      sum[i] += beam.intensities[static_cast<std::size_t>(k)];
+      count[i] += 1.0;
+    }
+  }
+  for (std::size_t i = 0; i < size; ++i) sum[i] = count[i] > 0.0 ? sum[i] / count[i] : 0.0;
+  return sum;
+}
+
 std::vector<std::optional<double>> WallRanges(std::span<const mapping::Beam> beams,
                                               const mapping::SensorGeometry& sensor,
                                               double min_range_m) {
   const int steps = sensor.BeamsPerSweep();
   std::vector<std::vector<double>> per_angle(static_cast<std::size_t>(steps));
   for (const auto& beam : beams) {
-    const auto first = static_cast<std::size_t>(std::ceil(min_range_m / beam.bin_size_m));
-    if (first >= beam.intensities.size()) continue;
-    const auto strongest = std::max_element(beam.intensities.begin() + static_cast<long>(first),
-                                            beam.intensities.end());
-    per_angle[StepIndex(beam, sensor)].push_back(
-        beam.BinCentreRange(static_cast<std::size_t>(strongest - beam.intensities.begin())));
+    if (const auto bin = StrongestBin(beam, min_range_m)) {
+      per_angle[StepIndex(beam, sensor)].push_back(beam.BinCentreRange(*bin));
+    }
   }
   std::vector<std::optional<double>> out(per_angle.size());
   for (std::size_t a = 0; a < per_angle.size(); ++a) {
@@ -150,6 +195,18 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   r.profile_mean_abs_difference = first < bins ? abs_sum / static_cast<double>(bins - first) : 0.0;
   r.sim_wall_m = WallRanges(sim, sensor, wall_min_range_m);
   r.real_wall_m = WallRanges(real, sensor, wall_min_range_m);
+  r.sim_wall_profile = WallProfile(sim, wall_min_range_m, first);
+  r.real_wall_profile = WallProfile(real, wall_min_range_m, first);
+  double tail_sum = 0.0;
+  const auto tail_start =
+      static_cast<std::size_t>(FidelityReport::kWallProfileBefore + FidelityReport::kWallTailStart);
+  for (std::size_t i = tail_start; i < r.sim_wall_profile.size(); ++i) {
+    tail_sum += std::abs(r.sim_wall_profile[i] - r.real_wall_profile[i]);
+  }
+  r.wall_tail_mean_abs_difference =
+      tail_sum / static_cast<double>(r.sim_wall_profile.size() - tail_start);
+  r.sim_wall_peak = WallPeaks(sim, wall_min_range_m);
+  r.real_wall_peak = WallPeaks(real, wall_min_range_m);
   std::vector<double> differences;
   for (std::size_t a = 0; a < r.sim_wall_m.size(); ++a) {
     if (r.sim_wall_m[a] && r.real_wall_m[a]) {
@@ -196,6 +253,13 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
           << (r.real_wall_m[a] ? std::to_string(*r.real_wall_m[a]) : "") << "\n";
   }
   WriteText((dir / "wall_range.csv").string(), walls.str());
+  std::ostringstream wall_profile;
+  wall_profile << "offset_bins,sim_mean,real_mean\n";
+  for (std::size_t i = 0; i < r.sim_wall_profile.size(); ++i) {
+    wall_profile << static_cast<long>(i) - FidelityReport::kWallProfileBefore << ","
+                 << r.sim_wall_profile[i] << "," << r.real_wall_profile[i] << "\n";
+  }
+  WriteText((dir / "wall_profile.csv").string(), wall_profile.str());
   std::ostringstream hist;
   hist << "intensity,sim_fraction,real_fraction\n";
   for (std::size_t v = 0; v < 256; ++v) {
@@ -230,12 +294,15 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"profile_mean_abs_difference_usable_bins", r.profile_mean_abs_difference},
                  {"median_wall_range_difference_bins", r.median_wall_difference_bins},
                  {"wall_angles_compared", r.wall_angles_compared},
+                 {"wall_peak_intensity_p10_p50_p90_sim", r.sim_wall_peak},
+                 {"wall_tail_mean_abs_difference", r.wall_tail_mean_abs_difference},
+                 {"wall_peak_intensity_p10_p50_p90_real", r.real_wall_peak},
                  {"histogram_intersection", r.histogram_intersection},
                  {"sweep_spread_sim", r.sim_sweep_spread},
                  {"sweep_spread_real", r.real_sweep_spread},
                  {"outputs",
-                  {"profile.csv", "profile.png", "wall_range.csv", "histogram.csv", "polar.png",
-                   "fan.png"}}});
+                  {"profile.csv", "profile.png", "wall_range.csv", "wall_profile.csv",
+                   "histogram.csv", "polar.png", "fan.png"}}});
   WriteJson((dir / "fidelity.json").string(), report);
 }
 

@@ -55,7 +55,8 @@ enum class EchoPower { kKeep, kDrop };
 /// are the material's reflectivity and backscatter exponent, S the spreading loss per decade, α
 /// the two-way absorption and G the time-varied gain. Speckle multiplies each bin's power by an
 /// exponential draw of mean 1; background noise and the self-reflection profile add power; the
-/// level in dB is mapped to 0..255 by the AD window.
+/// level in dB is mapped to 0..255 by the AD window. In a closed place (a tank) each bin's
+/// echo also feeds a reverberation tail heard after it (AddReverberation), before speckle.
 ///
 /// Thread-safe: Synthesize() is const and draws only from a generator seeded by its argument.
 class BeamSynthesizer {
@@ -94,6 +95,13 @@ class BeamSynthesizer {
   /// bins out (relative error under 1e-4 for |S - G| ≤ 20 dB per decade, where an AD step is
   /// 3.7%); exact nearer and beyond the table.
   [[nodiscard]] double RangeLossFromTable(double range_m) const;
+
+  /// Adds the place's reverberation to a beam's noise-free echo power per bin (in place): bin k
+  /// gains Σ_{j<k} P_j · R · (1 - q) · q^(k-1-j), with q = exp(-bin / reverberation_length_m)
+  /// and R = 10^(reverberation_db/10), so the echo in bin j feeds a tail that starts in the next
+  /// bin, falls by q per bin and holds R · P_j in all (before the beam's end cuts it). Echoes
+  /// feed it, the tail does not. Nothing changes when reverberation_length_m is 0.
+  void AddReverberation(std::vector<double>& echo_power) const;
 
   /// Jitter positions per stratum and direction.
   static constexpr int kJitterSlots = 32;

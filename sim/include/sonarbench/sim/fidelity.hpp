@@ -27,6 +27,23 @@ struct FidelityReport {
   /// the strongest echo beyond `wall_min_range_m` (the wall, in a tank).
   std::vector<std::optional<double>> sim_wall_m;
   std::vector<std::optional<double>> real_wall_m;
+  /// The strongest echo's intensity beyond `wall_min_range_m`, per beam: its 10th, 50th and
+  /// 90th percentiles over all beams (how bright the walls are; the mean profile alone cannot
+  /// tell saturated walls with dark gaps from moderate walls with a tail).
+  std::array<double, 3> sim_wall_peak{};
+  std::array<double, 3> real_wall_peak{};
+  /// The mean intensity around each beam's strongest echo beyond `wall_min_range_m`, aligned
+  /// on it: entry i is the mean, over the beams that reach it, of the bin at offset
+  /// i - kWallProfileBefore from the strongest bin (the wall's echo, its width and the tail
+  /// behind it, which the profile against range blurs over the tank's walls' ranges).
+  std::vector<double> sim_wall_profile;
+  std::vector<double> real_wall_profile;
+  static constexpr int kWallProfileBefore = 40;
+  static constexpr int kWallProfileAfter = 120;
+  /// Mean |sim - real| of the two wall-aligned profiles from kWallTailStart bins behind the
+  /// strongest echo to the end: the tail behind the walls (reverberation, ghosts) alone.
+  double wall_tail_mean_abs_difference = 0.0;
+  static constexpr int kWallTailStart = 16;
   /// Median over head angles of |sim - real| wall range, in bins; and how many angles had both.
   double median_wall_difference_bins = 0.0;
   std::size_t wall_angles_compared = 0;
@@ -52,7 +69,8 @@ struct FidelityReport {
 /// Pearson correlation of two equally long series (0 if either is constant).
 [[nodiscard]] double PearsonCorrelation(std::span<const double> a, std::span<const double> b);
 
-/// Writes fidelity.json, profile.csv, wall_range.csv, histogram.csv, profile.png (the two mean
+/// Writes fidelity.json, profile.csv, wall_range.csv, wall_profile.csv, histogram.csv,
+/// profile.png (the two mean
 /// profiles), and polar and fan images of each run's first sweep side by side (sim left, real
 /// right) into `out_dir`.
 void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& report,

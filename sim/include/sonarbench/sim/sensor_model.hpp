@@ -42,6 +42,13 @@ struct Acoustics {
   /// so a static sonar hears the same echoes sweep after sweep, as the real tank log does, and
   /// only the background noise varies; a moving one decorrelates cell by cell.
   double speckle_correlation_m = 0.0;
+  /// The reverberation of a closed place (a tank): every echo feeds a diffuse tail heard after
+  /// it, decaying exponentially with range, e-folding over `reverberation_length_m` [m] (0: no
+  /// tail, the default), holding in all `reverberation_db` [dB] of the echo's power. A
+  /// phenomenological stand-in for the diffuse paths the ray tracer does not follow (see
+  /// BeamSynthesizer).
+  double reverberation_length_m = 0.0;
+  double reverberation_db = -20.0;
   /// Level mapped to intensity 0, and the span [dB] mapped onto 0..255 (the Micron's ADLow/ADSpan).
   double ad_low_db = -40.0;
   double ad_span_db = 40.0;
