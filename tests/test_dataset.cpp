@@ -241,9 +241,14 @@ TEST_F(TankDataset, ADamagedFileIsNamed) {
   const auto out = dir.path() / "ds";
   (void)sim::SimulateDataset(*scene_, out.string(), {});
   {
+    // Flip every bit of one byte (writing a fixed value leaves the file as it was whenever the
+    // byte already held it).
     std::fstream f(out / "beams/sweep_0002.bin", std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(100);
+    const int byte = f.get();
+    ASSERT_NE(byte, std::char_traits<char>::eof());
     f.seekp(100);
-    f.put('\x01');
+    f.put(static_cast<char>(~byte));
   }
   EXPECT_NE(test::InputErrorOf([&] {
               (void)mapping::ReadDataset(out.string());

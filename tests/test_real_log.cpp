@@ -297,6 +297,20 @@ TEST(Fidelity, WallPeaksArePercentilesOfEachBeamsStrongestEcho) {
                    5.0);
 }
 
+// The texture along range: intensities alternating 50, 150 bin by bin are perfectly
+// anti-correlated at odd lags and correlated at even ones (the far half, bins 213-398 of the
+// default geometry, holds an even count, so each beam's mean is exactly 100).
+TEST(Fidelity, RangeCorrelationIsTheAutocorrelationAlongEachBeam) {
+  const mapping::SensorGeometry sensor;
+  const std::vector<mapping::Beam> beams =
+      TwoSweeps(sensor, [](int, int k) -> std::uint8_t { return k % 2 == 0 ? 50 : 150; });
+  const auto report = sim::CompareWithLog(beams, beams, sensor, 1.6);
+  ASSERT_EQ(report.sim_range_correlation.size(), 9u);
+  for (std::size_t m = 0; m < report.sim_range_correlation.size(); ++m) {
+    EXPECT_NEAR(report.sim_range_correlation[m], m % 2 == 0 ? 1.0 : -1.0, 1e-12) << "lag " << m;
+  }
+}
+
 // The sweep-to-sweep spread: two identical sweeps spread 0; a second sweep brighter by d in
 // every bin spreads d/√2 in every cell (the sample standard deviation of {v, v + d}).
 TEST(Fidelity, SweepSpreadIsTheStandardDeviationAcrossSweepsPerAngleAndBin) {

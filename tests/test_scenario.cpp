@@ -20,11 +20,13 @@ namespace {
 using mapping::kDegToRad;
 
 // The default tank scenario, run once for the whole suite (≈ 15 s on 2 cores); ctest runs this
-// executable as one test so that the run is shared. Multipath is switched off here, so that
-// "nothing echoes from beyond a wall" holds exactly; BeamSynthesis tests multipath on its own.
-// The scene's floor is fitted as faint as the real log's and its threshold (160) set against the
-// ghosts, so it maps little floor. These tests are about where echoes land, so the floor here is
-// brighter (reflectivity 0.2, cos^0.5: 7.3 times the fitted floor's echo where the fan meets it)
+// executable as one test so that the run is shared. Multipath and the tank's reverberation are
+// switched off here, so that "nothing echoes from beyond a wall" holds exactly; BeamSynthesis
+// tests both on their own. The scene's floor is fitted as faint as the real log's and its
+// threshold (110) set against the reverberation, so it maps little floor. These tests are about
+// where echoes land, so the walls here are bright (reflectivity 0.5, where the fitted 0.012
+// matches the real log's moderate wall echoes), the floor brighter (0.2, cos^0.5: 12 times the
+// fitted floor's 0.03 cos¹ where the fan meets it, at 72.5° incidence)
 // and, with no ghosts to reject, the threshold 90: the floor's echo is a run of its own before
 // the wall's in nearly every beam. (A floor as bright as the walls merges with their echo into
 // one run at the floor's range: with the threshold 60, 34-75 of a wall's 88-90 columns mapped.)
@@ -32,10 +34,12 @@ class TankScenario : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     scene_ = new Scene(LoadScene(test::SourcePath("scenes/cras-tank.yaml")));
+    MaterialNamed("tank_wall").reflectivity = 0.5;
     Material& floor = MaterialNamed("tank_floor");
     floor.reflectivity = 0.2;
     floor.backscatter_exponent = 0.5;
     for (Material& m : scene_->materials) m.specular = 0.0;
+    scene_->sensor.acoustics.reverberation_length_m = 0.0;
     scene_->mapping.detection.threshold = 90;
     result_ = new ScenarioResult(RunScenario(*scene_, RunOptions{}));
     cells_ = new MapCells(CollectMapCells(result_->mapper->tree()));

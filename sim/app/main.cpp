@@ -194,6 +194,10 @@ int Fidelity(const FidelityArgs& args) {
             << "; behind it (16-120 bins), mean |difference| "
             << report.wall_tail_mean_abs_difference << "\n"
             << "intensity histograms: intersection " << report.histogram_intersection << "\n"
+            << "range correlation at 1/2/3 bins (far half): sim " << report.sim_range_correlation[1]
+            << "/" << report.sim_range_correlation[2] << "/" << report.sim_range_correlation[3]
+            << ", real " << report.real_range_correlation[1] << "/"
+            << report.real_range_correlation[2] << "/" << report.real_range_correlation[3] << "\n"
             << "sweep-to-sweep spread per head angle and bin: sim " << report.sim_sweep_spread
             << ", real " << report.real_sweep_spread << "\n"
             << "wrote " << args.out << "/fidelity.json\n";

@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <optional>
 #include <vector>
@@ -22,6 +23,8 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
       rough_mirrors_(std::ranges::any_of(materials_by_mesh_, [](const Material& m) {
         return m.specular > 0.0 && m.specular_spread_rad > 0.0;
       })) {
+  speckle_window_ = static_cast<int>(
+      std::max(1L, std::lround(sensor_.acoustics.pulse_length_m / sensor_.geometry.bin_size_m)));
   for (const double db : sensor_.acoustics.self_reflection_db) {
     self_reflection_power_.push_back(std::pow(10.0, db / 10.0));
   }
@@ -146,6 +149,40 @@ std::uint8_t BeamSynthesizer::QuantisePower(double power) const {
   return static_cast<std::uint8_t>(q);
 }
 
+void BeamSynthesizer::CorrelatedSpeckle(std::span<double> factors, int window, Rng& rng) {
+  if (window <= 1) {
+    for (double& f : factors) f = rng.Exponential();
+    return;
+  }
+  static const std::array<std::complex<double>, kSpecklePhases> phases = [] {
+    std::array<std::complex<double>, kSpecklePhases> table;
+    for (int i = 0; i < kSpecklePhases; ++i) {
+      table[static_cast<std::size_t>(i)] =
+          std::polar(1.0, 2.0 * std::numbers::pi * i / kSpecklePhases);
+    }
+    return table;
+  }();
+  static_assert(kSpecklePhases == 1 << 10, "a phase is the top 10 bits of a draw");
+  const auto draw = [&rng] {
+    const double amplitude = std::sqrt(rng.Exponential());
+    return amplitude * phases[static_cast<std::size_t>(rng.Next() >> 54)];
+  };
+  // The window's phasors in a ring, their sum kept running.
+  thread_local std::vector<std::complex<double>> ring;
+  const auto size = static_cast<std::size_t>(window);
+  ring.resize(size);
+  std::complex<double> sum = 0.0;
+  for (std::size_t j = 0; j + 1 < size; ++j) sum += ring[j] = draw();
+  const double scale = 1.0 / window;
+  for (std::size_t k = 0; k < factors.size(); ++k) {
+    std::complex<double>& slot = ring[(k + size - 1) % size];
+    slot = draw();
+    sum += slot;
+    factors[k] = std::norm(sum) * scale;
+    sum -= ring[k % size];
+  }
+}
+
 void BeamSynthesizer::AddReverberation(std::vector<double>& echo_power) const {
   const Acoustics& a = sensor_.acoustics;
   if (a.reverberation_length_m <= 0.0) return;
@@ -250,6 +287,7 @@ struct Scratch {
   std::vector<bool> occluded;
   PulseSpreader spreader;
   std::vector<double> echo_power;
+  std::vector<double> speckle;
 };
 
 }  // namespace
@@ -463,11 +501,16 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const double noise_power = std::pow(10.0, a.noise_level_db / 10.0);
   const double gain = std::pow(10.0, a.gain_db / 10.0);
   for (double& power : echo) power /= weight_sum;
+  std::vector<double>& speckle = scratch.speckle;
+  if (a.speckle) {
+    speckle.resize(bins);
+    CorrelatedSpeckle(speckle, speckle_window_, echo_rng);
+  }
   AddReverberation(echo);
   for (std::size_t k = 0; k < bins; ++k) {
     double signal = gain * echo[k];
     if (k < self_reflection_power_.size()) signal += self_reflection_power_[k];
-    if (a.speckle) signal *= echo_rng.Exponential();
+    if (a.speckle) signal *= speckle[k];
     const double power = signal + noise_power * rng.Exponential();
     out.beam.intensities[k] = QuantisePower(power);
   }

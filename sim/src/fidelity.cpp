@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <numeric>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -82,6 +83,32 @@ std::vector<double> WallProfile(std::span<const mapping::Beam> beams, double min
   }
   for (std::size_t i = 0; i < size; ++i) sum[i] = count[i] > 0.0 ? sum[i] / count[i] : 0.0;
   return sum;
+}
+
+// FidelityReport::sim_range_correlation for `beams`, over bins [first, bins).
+std::vector<double> RangeCorrelation(std::span<const mapping::Beam> beams, std::size_t first,
+                                     std::size_t bins) {
+  const auto lags = static_cast<std::size_t>(FidelityReport::kTextureLags);
+  std::vector<double> covariance(lags + 1, 0.0);
+  std::vector<double> centred;
+  for (const auto& beam : beams) {
+    const std::size_t end = std::min(bins, beam.intensities.size());
+    if (end <= first + lags) continue;
+    centred.assign(beam.intensities.begin() + static_cast<long>(first),
+                   beam.intensities.begin() + static_cast<long>(end));
+    const double mean =
+        std::accumulate(centred.begin(), centred.end(), 0.0) / static_cast<double>(centred.size());
+    for (double& v : centred) v -= mean;
+    for (std::size_t m = 0; m <= lags; ++m) {
+      double sum = 0.0;
+      for (std::size_t k = 0; k + m < centred.size(); ++k) sum += centred[k] * centred[k + m];
+      covariance[m] += sum / static_cast<double>(centred.size() - m);
+    }
+  }
+  if (covariance[0] > 0.0) {
+    for (std::size_t m = lags + 1; m-- > 0;) covariance[m] /= covariance[0];
+  }
+  return covariance;
 }
 
 std::vector<std::optional<double>> WallRanges(std::span<const mapping::Beam> beams,
@@ -222,6 +249,9 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   }
   r.sim_sweep_spread = SweepSpread(sim, sensor);
   r.real_sweep_spread = SweepSpread(real, sensor);
+  const std::size_t far_half = (first + bins) / 2;
+  r.sim_range_correlation = RangeCorrelation(sim, far_half, bins);
+  r.real_range_correlation = RangeCorrelation(real, far_half, bins);
   r.sim_histogram = Histogram(sim, first);
   r.real_histogram = Histogram(real, first);
   for (std::size_t v = 0; v < 256; ++v) {
@@ -298,6 +328,8 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"wall_tail_mean_abs_difference", r.wall_tail_mean_abs_difference},
                  {"wall_peak_intensity_p10_p50_p90_real", r.real_wall_peak},
                  {"histogram_intersection", r.histogram_intersection},
+                 {"range_correlation_by_lag_sim", r.sim_range_correlation},
+                 {"range_correlation_by_lag_real", r.real_range_correlation},
                  {"sweep_spread_sim", r.sim_sweep_spread},
                  {"sweep_spread_real", r.real_sweep_spread},
                  {"outputs",

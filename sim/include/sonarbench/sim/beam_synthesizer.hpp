@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "sonarbench/mapping/beam.hpp"
@@ -54,7 +55,8 @@ enum class EchoPower { kKeep, kDrop };
 /// to every bin that the pulse [r, r + L) overlaps, in proportion to the overlap, where ρ and n
 /// are the material's reflectivity and backscatter exponent, S the spreading loss per decade, α
 /// the two-way absorption and G the time-varied gain. Speckle multiplies each bin's power by an
-/// exponential draw of mean 1; background noise and the self-reflection profile add power; the
+/// exponential draw of mean 1, correlated over the pulse length (CorrelatedSpeckle); background
+/// noise and the self-reflection profile add power; the
 /// level in dB is mapped to 0..255 by the AD window. In a closed place (a tank) each bin's
 /// echo also feeds a reverberation tail heard after it (AddReverberation), before speckle.
 ///
@@ -103,6 +105,18 @@ class BeamSynthesizer {
   /// feed it, the tail does not. Nothing changes when reverberation_length_m is 0.
   void AddReverberation(std::vector<double>& echo_power) const;
 
+  /// Speckle factors for consecutive range bins: factor k is |Σ g_j|² / L over the L bins
+  /// j = k - L + 1 .. k, the g_j independent circular complex Gaussians of unit power (an
+  /// amplitude √E, E exponential, and one of kSpecklePhases evenly spaced phases). A bin's echo
+  /// is the coherent sum of the scatterers the pulse covers, so each factor is exponential of
+  /// mean 1 (Rayleigh amplitude) and the factors of bins m apart share L - m of their
+  /// scatterers: their correlation is (1 - m/L)² for m < L, 0 beyond. L = 1 draws one
+  /// exponential per bin. `window` (L) ≥ 1; the first factor's window is drawn in full.
+  static void CorrelatedSpeckle(std::span<double> factors, int window, Rng& rng);
+
+  /// Phases of the speckle's complex Gaussians.
+  static constexpr int kSpecklePhases = 1024;
+
   /// Jitter positions per stratum and direction.
   static constexpr int kJitterSlots = 32;
 
@@ -140,6 +154,8 @@ class BeamSynthesizer {
   bool rough_mirrors_ = false;
   /// The self-reflection profile as linear power per bin.
   std::vector<double> self_reflection_power_;
+  /// The speckle's correlation window: the pulse length in bins, rounded, at least 1.
+  int speckle_window_ = 1;
   /// Power at which each AD step begins: step q for power ≥ ad_thresholds_[q] (index 0 unused).
   std::array<double, 256> ad_thresholds_{};
   /// Per bucket of powers (the top bits of the double, from the bucket of ad_thresholds_[1]

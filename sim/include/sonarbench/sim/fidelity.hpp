@@ -52,6 +52,13 @@ struct FidelityReport {
   /// or more sweeps). A static sonar's echoes and speckle repeat; only noise varies.
   double sim_sweep_spread = 0.0;
   double real_sweep_spread = 0.0;
+  /// The texture along range: entry m (m = 0 .. kTextureLags) is the correlation of intensities
+  /// m bins apart within a beam, over the far half of the usable bins (each beam's mean taken
+  /// out; covariances and variances summed over beams). Speckle that changes over the pulse
+  /// length keeps it high for a few bins; structure (walls, bands) holds it up beyond.
+  std::vector<double> sim_range_correlation;
+  std::vector<double> real_range_correlation;
+  static constexpr int kTextureLags = 8;
   /// Intensity histograms (fractions of all usable bins), and their intersection Σ min(p, q):
   /// 1 for identical distributions, 0 for disjoint ones.
   std::array<double, 256> sim_histogram{};
