@@ -812,6 +812,78 @@ TEST(BeamSynthesis, SpeckleIsExponentialAndCorrelatedOverThePulse) {
   for (double v : single) EXPECT_EQ(v, b.Exponential());
 }
 
+// Speckle shared between beams through their azimuth sectors (a static sonar's scatterers are
+// the place's; the Micron's beams, 3° wide and 1.8° apart, share most of theirs):
+//  - the sector weights are the square roots of the pattern's shares: squares summing to 1,
+//    symmetric, and the neighbouring beams' amplitude correlation ρ = Σ w_d w_{d+1} within 0.03
+//    of the continuous Gaussian pattern's exp(-Δ²/8σ²) = 0.779 (the sectors are a head step
+//    wide: the coarseness costs 0.024);
+//  - one sector of weight 1 is CorrelatedSpeckle's sequence for that sector's seed;
+//  - a beam's factors are exponential of mean 1 (KS on factors a window apart, as above);
+//  - two beams one sector apart correlate by ρ², bin for bin (64 independent pairs of
+//    sequences; the mean within 5 standard errors plus 4/n, a false alarm under 1e-5).
+TEST(BeamSynthesis, NeighbouringBeamsShareTheirSectorsSpeckle) {
+  const SensorModel micron = QuietSensor();
+  const std::vector<TriangleMesh> none;
+  const RayTracer tracer(none);
+  const BeamSynthesizer synthesizer(micron, tracer, {Material{}});
+  const std::vector<double>& w = synthesizer.SectorWeights();
+  ASSERT_EQ(w.size(), 2u * BeamSynthesizer::kSectorReach + 1);
+  double squares = 0.0;
+  double rho = 0.0;
+  for (std::size_t d = 0; d < w.size(); ++d) {
+    squares += w[d] * w[d];
+    EXPECT_NEAR(w[d], w[w.size() - 1 - d], 1e-12);
+    if (d + 1 < w.size()) rho += w[d] * w[d + 1];
+  }
+  EXPECT_NEAR(squares, 1.0, 1e-12);
+  const mapping::SensorGeometry& g = micron.geometry;
+  const double sigma = g.beam_width_horizontal_rad / std::sqrt(8.0 * std::log(2.0));
+  EXPECT_NEAR(rho, std::exp(-g.step_angle_rad * g.step_angle_rad / (8.0 * sigma * sigma)), 0.03);
+
+  constexpr int kWindow = 4;
+  std::vector<double> direct(500);
+  std::vector<double> sector(500);
+  Rng rng(99);
+  BeamSynthesizer::CorrelatedSpeckle(direct, kWindow, rng);
+  const std::array<double, 1> one = {1.0};
+  const std::array<std::uint64_t, 1> seed = {99};
+  BeamSynthesizer::SectorSpeckle(sector, kWindow, one, seed);
+  EXPECT_EQ(direct, sector);
+
+  constexpr int kPairs = 64;
+  constexpr std::size_t kLength = 16384;
+  std::vector<double> a(kLength);
+  std::vector<double> b(kLength);
+  std::vector<double> correlations;
+  std::vector<double> independent;
+  for (int pair = 0; pair < kPairs; ++pair) {
+    // Sectors 0 .. 2R+1 of the place; beam A hears 0 .. 2R, beam B, one step on, 1 .. 2R+1.
+    std::vector<std::uint64_t> seeds;
+    for (std::size_t d = 0; d < w.size() + 1; ++d) seeds.push_back(DeriveSeed(1000 + pair, d));
+    BeamSynthesizer::SectorSpeckle(a, kWindow, w, std::span(seeds).first(w.size()));
+    BeamSynthesizer::SectorSpeckle(b, kWindow, w, std::span(seeds).subspan(1));
+    for (std::size_t k = 0; k < kLength; k += 4 * kWindow) independent.push_back(a[k]);
+    const double ma = std::accumulate(a.begin(), a.end(), 0.0) / kLength;
+    const double mb = std::accumulate(b.begin(), b.end(), 0.0) / kLength;
+    double ab = 0.0, aa = 0.0, bb = 0.0;
+    for (std::size_t k = 0; k < kLength; ++k) {
+      ab += (a[k] - ma) * (b[k] - mb);
+      aa += (a[k] - ma) * (a[k] - ma);
+      bb += (b[k] - mb) * (b[k] - mb);
+    }
+    correlations.push_back(ab / std::sqrt(aa * bb));
+  }
+  const auto n = static_cast<double>(independent.size());
+  EXPECT_LT(KsDistance(independent, [](double v) { return 1.0 - std::exp(-v); }),
+            1.949 / std::sqrt(n) + 1.0 / BeamSynthesizer::kSpecklePhases);
+  const double mean = std::accumulate(correlations.begin(), correlations.end(), 0.0) / kPairs;
+  double sd = 0.0;
+  for (double c : correlations) sd += (c - mean) * (c - mean);
+  sd = std::sqrt(sd / (kPairs - 1));
+  EXPECT_NEAR(mean, rho * rho, 5.0 * sd / std::sqrt(kPairs) + 4.0 / kLength);
+}
+
 TEST(BeamSynthesis, NoiseFloorMatchesItsConfiguredDistribution) {
   SensorModel sensor = QuietSensor();
   sensor.acoustics.noise_level_db = -43.0;

@@ -311,6 +311,20 @@ TEST(Fidelity, RangeCorrelationIsTheAutocorrelationAlongEachBeam) {
   }
 }
 
+// The texture across beams: beam b's far-half bins alternate 50, 150, shifted by one bin on odd
+// beams, so beams an odd number of head steps apart are perfectly anti-correlated and even ones
+// correlated; a beam of the other sweep that is not m steps on is never paired.
+TEST(Fidelity, BeamCorrelationPairsBeamsByHeadStep) {
+  const mapping::SensorGeometry sensor;
+  const std::vector<mapping::Beam> beams =
+      TwoSweeps(sensor, [](int b, int k) -> std::uint8_t { return (k + b) % 2 == 0 ? 50 : 150; });
+  const auto report = sim::CompareWithLog(beams, beams, sensor, 1.6);
+  ASSERT_EQ(report.sim_beam_correlation.size(), 4u);
+  for (std::size_t m = 0; m < report.sim_beam_correlation.size(); ++m) {
+    EXPECT_NEAR(report.sim_beam_correlation[m], m % 2 == 0 ? 1.0 : -1.0, 1e-12) << "step " << m;
+  }
+}
+
 // The sweep-to-sweep spread: two identical sweeps spread 0; a second sweep brighter by d in
 // every bin spreads d/√2 in every cell (the sample standard deviation of {v, v + d}).
 TEST(Fidelity, SweepSpreadIsTheStandardDeviationAcrossSweepsPerAngleAndBin) {

@@ -198,6 +198,10 @@ int Fidelity(const FidelityArgs& args) {
             << "/" << report.sim_range_correlation[2] << "/" << report.sim_range_correlation[3]
             << ", real " << report.real_range_correlation[1] << "/"
             << report.real_range_correlation[2] << "/" << report.real_range_correlation[3] << "\n"
+            << "beam-to-beam correlation at 1/2/3 head steps (far half): sim "
+            << report.sim_beam_correlation[1] << "/" << report.sim_beam_correlation[2] << "/"
+            << report.sim_beam_correlation[3] << ", real " << report.real_beam_correlation[1] << "/"
+            << report.real_beam_correlation[2] << "/" << report.real_beam_correlation[3] << "\n"
             << "sweep-to-sweep spread per head angle and bin: sim " << report.sim_sweep_spread
             << ", real " << report.real_sweep_spread << "\n"
             << "wrote " << args.out << "/fidelity.json\n";

@@ -25,6 +25,22 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
       })) {
   speckle_window_ = static_cast<int>(
       std::max(1L, std::lround(sensor_.acoustics.pulse_length_m / sensor_.geometry.bin_size_m)));
+  // Sector d's share of the two-way horizontal pattern exp(-θ²/2σ²), σ = w_h / √(8 ln 2): the
+  // normal distribution's mass over [(d - ½) Δ, (d + ½) Δ], Δ the head step.
+  {
+    const mapping::SensorGeometry& g = sensor_.geometry;
+    const double sigma = g.beam_width_horizontal_rad / std::sqrt(8.0 * std::log(2.0));
+    const auto cdf = [&](double x) { return 0.5 * std::erfc(-x / (sigma * std::sqrt(2.0))); };
+    sector_weights_.assign(2 * kSectorReach + 1, 0.0);
+    double total = 0.0;
+    for (int d = -kSectorReach; d <= kSectorReach; ++d) {
+      const double share = cdf((d + 0.5) * g.step_angle_rad) - cdf((d - 0.5) * g.step_angle_rad);
+      if (share < 1e-3) continue;
+      sector_weights_[static_cast<std::size_t>(d + kSectorReach)] = share;
+      total += share;
+    }
+    for (double& w : sector_weights_) w = std::sqrt(w / total);
+  }
   for (const double db : sensor_.acoustics.self_reflection_db) {
     self_reflection_power_.push_back(std::pow(10.0, db / 10.0));
   }
@@ -149,38 +165,86 @@ std::uint8_t BeamSynthesizer::QuantisePower(double power) const {
   return static_cast<std::uint8_t>(q);
 }
 
+namespace {
+
+// A circular complex Gaussian of unit power: an amplitude √E, E exponential, and one of
+// BeamSynthesizer::kSpecklePhases evenly spaced phases from the top bits of a second draw.
+std::complex<double> DrawPhasor(Rng& rng) {
+  static const std::array<std::complex<double>, BeamSynthesizer::kSpecklePhases> phases = [] {
+    std::array<std::complex<double>, BeamSynthesizer::kSpecklePhases> table;
+    for (int i = 0; i < BeamSynthesizer::kSpecklePhases; ++i) {
+      table[static_cast<std::size_t>(i)] =
+          std::polar(1.0, 2.0 * std::numbers::pi * i / BeamSynthesizer::kSpecklePhases);
+    }
+    return table;
+  }();
+  static_assert(BeamSynthesizer::kSpecklePhases == 1 << 10, "a phase is a draw's top 10 bits");
+  const double amplitude = std::sqrt(rng.Exponential());
+  return amplitude * phases[static_cast<std::size_t>(rng.Next() >> 54)];
+}
+
+// factors[k] = |Σ_{j=k..k+L-1} amplitudes[j]|² / L, for amplitudes.size() = factors.size() + L - 1.
+void WindowPower(std::span<const std::complex<double>> amplitudes, std::size_t window,
+                 std::span<double> factors) {
+  std::complex<double> sum = 0.0;
+  for (std::size_t j = 0; j + 1 < window; ++j) sum += amplitudes[j];
+  const double scale = 1.0 / static_cast<double>(window);
+  for (std::size_t k = 0; k < factors.size(); ++k) {
+    sum += amplitudes[k + window - 1];
+    factors[k] = std::norm(sum) * scale;
+    sum -= amplitudes[k];
+  }
+}
+
+}  // namespace
+
 void BeamSynthesizer::CorrelatedSpeckle(std::span<double> factors, int window, Rng& rng) {
   if (window <= 1) {
     for (double& f : factors) f = rng.Exponential();
     return;
   }
-  static const std::array<std::complex<double>, kSpecklePhases> phases = [] {
-    std::array<std::complex<double>, kSpecklePhases> table;
-    for (int i = 0; i < kSpecklePhases; ++i) {
-      table[static_cast<std::size_t>(i)] =
-          std::polar(1.0, 2.0 * std::numbers::pi * i / kSpecklePhases);
-    }
-    return table;
-  }();
-  static_assert(kSpecklePhases == 1 << 10, "a phase is the top 10 bits of a draw");
-  const auto draw = [&rng] {
-    const double amplitude = std::sqrt(rng.Exponential());
-    return amplitude * phases[static_cast<std::size_t>(rng.Next() >> 54)];
-  };
-  // The window's phasors in a ring, their sum kept running.
-  thread_local std::vector<std::complex<double>> ring;
   const auto size = static_cast<std::size_t>(window);
-  ring.resize(size);
-  std::complex<double> sum = 0.0;
-  for (std::size_t j = 0; j + 1 < size; ++j) sum += ring[j] = draw();
-  const double scale = 1.0 / window;
-  for (std::size_t k = 0; k < factors.size(); ++k) {
-    std::complex<double>& slot = ring[(k + size - 1) % size];
-    slot = draw();
-    sum += slot;
-    factors[k] = std::norm(sum) * scale;
-    sum -= ring[k % size];
+  thread_local std::vector<std::complex<double>> amplitudes;
+  amplitudes.resize(factors.size() + size - 1);
+  for (auto& a : amplitudes) a = DrawPhasor(rng);
+  WindowPower(amplitudes, size, factors);
+}
+
+void BeamSynthesizer::SectorSpeckle(std::span<double> factors, int window,
+                                    std::span<const double> amplitude_weights,
+                                    std::span<const std::uint64_t> sector_seeds) {
+  const auto size = static_cast<std::size_t>(std::max(window, 1));
+  const std::size_t length = factors.size() + size - 1;
+  // A sector's phasors, kept per thread for the next beams: a static sonar's neighbouring beams
+  // share all but one of their sectors. Keyed by seed and length, so what a beam gets does not
+  // depend on which beams the thread did before.
+  struct Sector {
+    std::uint64_t seed = 0;
+    std::vector<std::complex<double>> phasors;
+  };
+  thread_local std::array<Sector, 2 * kSectorReach + 2> cache;
+  thread_local std::size_t next_slot = 0;
+  const auto phasors_of = [&](std::uint64_t seed) -> const std::vector<std::complex<double>>& {
+    for (const Sector& sector : cache) {
+      if (sector.seed == seed && sector.phasors.size() == length) return sector.phasors;
+    }
+    Sector& sector = cache[next_slot];
+    next_slot = (next_slot + 1) % cache.size();
+    sector.seed = seed;
+    sector.phasors.resize(length);
+    Rng rng(seed);
+    for (auto& z : sector.phasors) z = DrawPhasor(rng);
+    return sector.phasors;
+  };
+  thread_local std::vector<std::complex<double>> amplitudes;
+  amplitudes.assign(length, 0.0);
+  for (std::size_t d = 0; d < amplitude_weights.size(); ++d) {
+    const double w = amplitude_weights[d];
+    if (w == 0.0) continue;
+    const std::vector<std::complex<double>>& z = phasors_of(sector_seeds[d]);
+    for (std::size_t j = 0; j < length; ++j) amplitudes[j] += w * z[j];
   }
+  WindowPower(amplitudes, size, factors);
 }
 
 void BeamSynthesizer::AddReverberation(std::vector<double>& echo_power) const {
@@ -318,19 +382,31 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const Eigen::Vector3f origin = T_world_sonar.translation().cast<float>();
   // The echo's own randomness (ray jitter, speckle) is the ping's, or, with a correlation
   // length, the place's: the same for every ping from the same azimuth, tilt and position cell.
+  // The place's speckle is its scatterers': each head-step-wide azimuth sector has its own,
+  // which every beam whose pattern covers it hears (SectorSpeckle).
   std::optional<Rng> place_rng;
+  std::array<std::uint64_t, 2 * kSectorReach + 1> sector_seeds{};
   if (a.speckle_correlation_m > 0.0) {
-    const auto step = [&](double angle) {
-      return static_cast<std::uint64_t>(std::llround(angle / g.step_angle_rad));
-    };
+    const double step = g.step_angle_rad;
+    const long long turn = std::llround(2.0 * std::numbers::pi / step);
     const Eigen::Vector3d axis = R_world_beam.col(0);
-    std::uint64_t place = DeriveSeed(place_seed_, step(std::atan2(axis.y(), axis.x())));
-    place = DeriveSeed(place, step(std::asin(std::clamp(axis.z(), -1.0, 1.0))));
-    for (int i = 0; i < 3; ++i) {
-      const double cell = std::floor(T_world_sonar.translation()[i] / a.speckle_correlation_m);
-      place = DeriveSeed(place, static_cast<std::uint64_t>(static_cast<std::int64_t>(cell)));
+    const long long azimuth = std::llround(std::atan2(axis.y(), axis.x()) / step);
+    const long long tilt = std::llround(std::asin(std::clamp(axis.z(), -1.0, 1.0)) / step);
+    const auto place_of = [&](long long sector) {
+      std::uint64_t place =
+          DeriveSeed(place_seed_, static_cast<std::uint64_t>(((sector % turn) + turn) % turn));
+      place = DeriveSeed(place, static_cast<std::uint64_t>(tilt));
+      for (int i = 0; i < 3; ++i) {
+        const double cell = std::floor(T_world_sonar.translation()[i] / a.speckle_correlation_m);
+        place = DeriveSeed(place, static_cast<std::uint64_t>(static_cast<std::int64_t>(cell)));
+      }
+      return place;
+    };
+    place_rng.emplace(place_of(azimuth));
+    for (int d = -kSectorReach; d <= kSectorReach; ++d) {
+      sector_seeds[static_cast<std::size_t>(d + kSectorReach)] =
+          DeriveSeed(place_of(azimuth + d), 0x737065636bULL);  // "speck"
     }
-    place_rng.emplace(place);
   }
   Rng& echo_rng = place_rng ? *place_rng : rng;
   const double pulse_bins = a.pulse_length_m / g.bin_size_m;
@@ -504,7 +580,11 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   std::vector<double>& speckle = scratch.speckle;
   if (a.speckle) {
     speckle.resize(bins);
-    CorrelatedSpeckle(speckle, speckle_window_, echo_rng);
+    if (place_rng) {
+      SectorSpeckle(speckle, speckle_window_, sector_weights_, sector_seeds);
+    } else {
+      CorrelatedSpeckle(speckle, speckle_window_, echo_rng);
+    }
   }
   AddReverberation(echo);
   for (std::size_t k = 0; k < bins; ++k) {

@@ -111,6 +111,46 @@ std::vector<double> RangeCorrelation(std::span<const mapping::Beam> beams, std::
   return covariance;
 }
 
+// FidelityReport::sim_beam_correlation for `beams`, over bins [first, bins).
+std::vector<double> BeamCorrelation(std::span<const mapping::Beam> beams,
+                                    const mapping::SensorGeometry& sensor, std::size_t first,
+                                    std::size_t bins) {
+  const auto lags = static_cast<std::size_t>(FidelityReport::kBeamLags);
+  const auto steps = static_cast<std::size_t>(sensor.BeamsPerSweep());
+  std::vector<double> out(lags + 1, 0.0);
+  out[0] = 1.0;
+  const auto centred = [&](const mapping::Beam& beam, std::vector<double>& v) {
+    v.clear();
+    for (std::size_t k = first; k < std::min(bins, beam.intensities.size()); ++k)
+      v.push_back(beam.intensities[k]);
+    if (v.empty()) return;
+    const double mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+    for (double& x : v) x -= mean;
+  };
+  std::vector<double> a;
+  std::vector<double> b;
+  for (std::size_t m = 1; m <= lags; ++m) {
+    double covariance = 0.0;
+    double spread = 0.0;
+    for (std::size_t i = 0; i + m < beams.size(); ++i) {
+      if ((StepIndex(beams[i], sensor) + m) % steps != StepIndex(beams[i + m], sensor)) continue;
+      centred(beams[i], a);
+      centred(beams[i + m], b);
+      const std::size_t n = std::min(a.size(), b.size());
+      double ab = 0.0, aa = 0.0, bb = 0.0;
+      for (std::size_t k = 0; k < n; ++k) {
+        ab += a[k] * b[k];
+        aa += a[k] * a[k];
+        bb += b[k] * b[k];
+      }
+      covariance += ab;
+      spread += std::sqrt(aa * bb);
+    }
+    out[m] = spread > 0.0 ? covariance / spread : 0.0;
+  }
+  return out;
+}
+
 std::vector<std::optional<double>> WallRanges(std::span<const mapping::Beam> beams,
                                               const mapping::SensorGeometry& sensor,
                                               double min_range_m) {
@@ -252,6 +292,8 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   const std::size_t far_half = (first + bins) / 2;
   r.sim_range_correlation = RangeCorrelation(sim, far_half, bins);
   r.real_range_correlation = RangeCorrelation(real, far_half, bins);
+  r.sim_beam_correlation = BeamCorrelation(sim, sensor, far_half, bins);
+  r.real_beam_correlation = BeamCorrelation(real, sensor, far_half, bins);
   r.sim_histogram = Histogram(sim, first);
   r.real_histogram = Histogram(real, first);
   for (std::size_t v = 0; v < 256; ++v) {
@@ -330,6 +372,8 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"histogram_intersection", r.histogram_intersection},
                  {"range_correlation_by_lag_sim", r.sim_range_correlation},
                  {"range_correlation_by_lag_real", r.real_range_correlation},
+                 {"beam_correlation_by_step_sim", r.sim_beam_correlation},
+                 {"beam_correlation_by_step_real", r.real_beam_correlation},
                  {"sweep_spread_sim", r.sim_sweep_spread},
                  {"sweep_spread_real", r.real_sweep_spread},
                  {"outputs",

@@ -55,10 +55,11 @@ enum class EchoPower { kKeep, kDrop };
 /// to every bin that the pulse [r, r + L) overlaps, in proportion to the overlap, where ρ and n
 /// are the material's reflectivity and backscatter exponent, S the spreading loss per decade, α
 /// the two-way absorption and G the time-varied gain. Speckle multiplies each bin's power by an
-/// exponential draw of mean 1, correlated over the pulse length (CorrelatedSpeckle); background
-/// noise and the self-reflection profile add power; the
-/// level in dB is mapped to 0..255 by the AD window. In a closed place (a tank) each bin's
-/// echo also feeds a reverberation tail heard after it (AddReverberation), before speckle.
+/// exponential draw of mean 1, correlated over the pulse length (CorrelatedSpeckle) and, when
+/// the speckle is the place's, shared by overlapping beams (SectorSpeckle); background noise and
+/// the self-reflection profile add power; the level in dB is mapped to 0..255 by the AD window. In
+/// a closed place (a tank) each bin's echo also feeds a reverberation tail heard after it
+/// (AddReverberation), before speckle.
 ///
 /// Thread-safe: Synthesize() is const and draws only from a generator seeded by its argument.
 class BeamSynthesizer {
@@ -114,6 +115,25 @@ class BeamSynthesizer {
   /// exponential per bin. `window` (L) ≥ 1; the first factor's window is drawn in full.
   static void CorrelatedSpeckle(std::span<double> factors, int window, Rng& rng);
 
+  /// The same for a beam whose scatterers lie in several azimuth sectors, each sector's own
+  /// complex Gaussians drawn, bin by bin, by Rng(sector_seeds[d]) as CorrelatedSpeckle draws
+  /// them (n + L - 1 of them, the first L - 1 before bin 0): bin j's amplitude is
+  /// Σ_d amplitude_weights[d] · g_j(d), and the factors are |Σ over the window|² / L as above.
+  /// With Σ_d weights² = 1 each factor is exponential of mean 1; two beams that share sectors
+  /// (a static sonar's neighbouring beams: the sectors are the world's, keyed by head step)
+  /// correlate by (Σ_d w_d w'_d)² bin for bin. One sector of weight 1 gives exactly
+  /// CorrelatedSpeckle's factors for Rng(sector_seeds[0]) when L > 1.
+  static void SectorSpeckle(std::span<double> factors, int window,
+                            std::span<const double> amplitude_weights,
+                            std::span<const std::uint64_t> sector_seeds);
+
+  /// Amplitude weights of the head-step-wide azimuth sectors around a beam's own (index
+  /// kSectorReach is the beam's; d steps off it, kSectorReach + d): the square roots of the
+  /// two-way horizontal pattern's share of power in each sector, sectors carrying under 1e-3 of
+  /// it dropped, so that the squares sum to 1.
+  [[nodiscard]] const std::vector<double>& SectorWeights() const { return sector_weights_; }
+  static constexpr int kSectorReach = 4;
+
   /// Phases of the speckle's complex Gaussians.
   static constexpr int kSpecklePhases = 1024;
 
@@ -156,6 +176,8 @@ class BeamSynthesizer {
   std::vector<double> self_reflection_power_;
   /// The speckle's correlation window: the pulse length in bins, rounded, at least 1.
   int speckle_window_ = 1;
+  /// SectorWeights().
+  std::vector<double> sector_weights_;
   /// Power at which each AD step begins: step q for power ≥ ad_thresholds_[q] (index 0 unused).
   std::array<double, 256> ad_thresholds_{};
   /// Per bucket of powers (the top bits of the double, from the bucket of ad_thresholds_[1]

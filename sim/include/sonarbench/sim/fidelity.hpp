@@ -59,6 +59,13 @@ struct FidelityReport {
   std::vector<double> sim_range_correlation;
   std::vector<double> real_range_correlation;
   static constexpr int kTextureLags = 8;
+  /// The texture across beams: entry m (m = 0 .. kBeamLags) is the correlation of the same bins
+  /// (the far half) of beams m head steps apart, m beams apart in time order (each beam's mean
+  /// taken out; covariances and the geometric mean of the variances summed over pairs).
+  /// Overlapping beams share scatterers, so their speckle correlates.
+  std::vector<double> sim_beam_correlation;
+  std::vector<double> real_beam_correlation;
+  static constexpr int kBeamLags = 3;
   /// Intensity histograms (fractions of all usable bins), and their intersection Σ min(p, q):
   /// 1 for identical distributions, 0 for disjoint ones.
   std::array<double, 256> sim_histogram{};

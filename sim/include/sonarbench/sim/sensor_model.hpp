@@ -40,7 +40,8 @@ struct Acoustics {
   /// jitter and speckle afresh. Positive: both come from a stream seeded by the run seed, the
   /// beam's world azimuth and tilt in head steps and the sonar's position in cells of this size,
   /// so a static sonar hears the same echoes sweep after sweep, as the real tank log does, and
-  /// only the background noise varies; a moving one decorrelates cell by cell.
+  /// only the background noise varies; a moving one decorrelates cell by cell. The speckle is
+  /// then drawn per head-step azimuth sector and shared by the beams whose pattern covers it.
   double speckle_correlation_m = 0.0;
   /// The reverberation of a closed place (a tank): every echo feeds a diffuse tail heard after
   /// it, decaying exponentially with range, e-folding over `reverberation_length_m` [m] (0: no
