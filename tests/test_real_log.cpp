@@ -280,6 +280,12 @@ TEST(Fidelity, WallPeaksArePercentilesOfEachBeamsStrongestEcho) {
   const auto report = sim::CompareWithLog(beams, beams, sensor, 1.6);
   EXPECT_EQ(report.sim_wall_peak, (std::array<double, 3>{110.0, 150.0, 190.0}));
   EXPECT_EQ(report.real_wall_peak, report.sim_wall_peak);
+  // Per head angle, the median over its two sweeps' beams b and b + 200: 100 + b mod 100 both.
+  ASSERT_EQ(report.sim_wall_peak_by_angle.size(), 200u);
+  for (std::size_t a = 0; a < 200; ++a) {
+    ASSERT_TRUE(report.sim_wall_peak_by_angle[a].has_value());
+    EXPECT_EQ(*report.sim_wall_peak_by_angle[a], 100.0 + static_cast<double>(a % 100));
+  }
   // Aligned on the wall (bin 170), the profile is 10 everywhere but at offset 0, the peaks'
   // mean 149.5 (its offsets reach back to bin 130, clear of the first 40 bins' 230).
   ASSERT_EQ(report.sim_wall_profile.size(), 161u);

@@ -151,14 +151,16 @@ std::vector<double> BeamCorrelation(std::span<const mapping::Beam> beams,
   return out;
 }
 
-std::vector<std::optional<double>> WallRanges(std::span<const mapping::Beam> beams,
-                                              const mapping::SensorGeometry& sensor,
-                                              double min_range_m) {
+// Per head-angle step, the median over sweeps of value(beam, strongest bin beyond min_range_m).
+template <typename Value>
+std::vector<std::optional<double>> PerAngleMedian(std::span<const mapping::Beam> beams,
+                                                  const mapping::SensorGeometry& sensor,
+                                                  double min_range_m, Value value) {
   const int steps = sensor.BeamsPerSweep();
   std::vector<std::vector<double>> per_angle(static_cast<std::size_t>(steps));
   for (const auto& beam : beams) {
     if (const auto bin = StrongestBin(beam, min_range_m)) {
-      per_angle[StepIndex(beam, sensor)].push_back(beam.BinCentreRange(*bin));
+      per_angle[StepIndex(beam, sensor)].push_back(value(beam, *bin));
     }
   }
   std::vector<std::optional<double>> out(per_angle.size());
@@ -169,6 +171,22 @@ std::vector<std::optional<double>> WallRanges(std::span<const mapping::Beam> bea
     out[a] = v[v.size() / 2];
   }
   return out;
+}
+
+std::vector<std::optional<double>> WallRanges(std::span<const mapping::Beam> beams,
+                                              const mapping::SensorGeometry& sensor,
+                                              double min_range_m) {
+  return PerAngleMedian(beams, sensor, min_range_m, [](const mapping::Beam& beam, std::size_t bin) {
+    return beam.BinCentreRange(bin);
+  });
+}
+
+std::vector<std::optional<double>> WallPeaksByAngle(std::span<const mapping::Beam> beams,
+                                                    const mapping::SensorGeometry& sensor,
+                                                    double min_range_m) {
+  return PerAngleMedian(beams, sensor, min_range_m, [](const mapping::Beam& beam, std::size_t bin) {
+    return static_cast<double>(beam.intensities[bin]);
+  });
 }
 
 double SweepSpread(std::span<const mapping::Beam> beams, const mapping::SensorGeometry& sensor) {
@@ -262,6 +280,8 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   r.profile_mean_abs_difference = first < bins ? abs_sum / static_cast<double>(bins - first) : 0.0;
   r.sim_wall_m = WallRanges(sim, sensor, wall_min_range_m);
   r.real_wall_m = WallRanges(real, sensor, wall_min_range_m);
+  r.sim_wall_peak_by_angle = WallPeaksByAngle(sim, sensor, wall_min_range_m);
+  r.real_wall_peak_by_angle = WallPeaksByAngle(real, sensor, wall_min_range_m);
   r.sim_wall_profile = WallProfile(sim, wall_min_range_m, first);
   r.real_wall_profile = WallProfile(real, wall_min_range_m, first);
   double tail_sum = 0.0;
@@ -318,11 +338,14 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
   }
   WriteText((dir / "profile.csv").string(), profile.str());
   std::ostringstream walls;
-  walls << "head_angle_deg,sim_wall_m,real_wall_m\n";
+  walls << "head_angle_deg,sim_wall_m,real_wall_m,sim_wall_intensity,real_wall_intensity\n";
+  const auto field = [](const std::optional<double>& v) {
+    return v ? std::to_string(*v) : std::string();
+  };
   for (std::size_t a = 0; a < r.sim_wall_m.size(); ++a) {
-    walls << a * sensor.step_angle_rad * 180.0 / std::numbers::pi << ","
-          << (r.sim_wall_m[a] ? std::to_string(*r.sim_wall_m[a]) : "") << ","
-          << (r.real_wall_m[a] ? std::to_string(*r.real_wall_m[a]) : "") << "\n";
+    walls << a * sensor.step_angle_rad * 180.0 / std::numbers::pi << "," << field(r.sim_wall_m[a])
+          << "," << field(r.real_wall_m[a]) << "," << field(r.sim_wall_peak_by_angle[a]) << ","
+          << field(r.real_wall_peak_by_angle[a]) << "\n";
   }
   WriteText((dir / "wall_range.csv").string(), walls.str());
   std::ostringstream wall_profile;

@@ -27,6 +27,9 @@ struct FidelityReport {
   /// the strongest echo beyond `wall_min_range_m` (the wall, in a tank).
   std::vector<std::optional<double>> sim_wall_m;
   std::vector<std::optional<double>> real_wall_m;
+  /// The same for the strongest echo's intensity (how bright each wall is, angle by angle).
+  std::vector<std::optional<double>> sim_wall_peak_by_angle;
+  std::vector<std::optional<double>> real_wall_peak_by_angle;
   /// The strongest echo's intensity beyond `wall_min_range_m`, per beam: its 10th, 50th and
   /// 90th percentiles over all beams (how bright the walls are; the mean profile alone cannot
   /// tell saturated walls with dark gaps from moderate walls with a tail).
