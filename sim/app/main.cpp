@@ -424,10 +424,12 @@ int main(int argc, char** argv) {
   CLI::App* fidelity_cmd = app.add_subcommand(
       "fidelity",
       "Compare a simulated scene with a real log of the same place: mean intensity against range "
-      "(correlation), the strongest echo's range per head angle (median difference in bins), "
-      "intensity histograms (intersection), and the first sweeps side by side (sim left, real "
-      "right). Writes fidelity.json, profile.csv/.png, wall_range.csv, histogram.csv, polar.png "
-      "and fan.png into --out.");
+      "(correlation), the strongest echo's range per head angle (median difference in bins) and "
+      "its intensity (percentiles), the profile around it (the tail behind the walls), "
+      "intensity histograms (intersection), the texture along range and across beams "
+      "(correlations), and the first sweeps side by side (sim left, real right). Writes "
+      "fidelity.json, profile.csv/.png, wall_range.csv, wall_profile.csv, histogram.csv, "
+      "polar.png and fan.png into --out.");
   fidelity_cmd->add_option("scene", fidelity.scene, "Scene YAML file")
       ->required()
       ->check(CLI::ExistingFile);
