@@ -392,14 +392,17 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
     const Eigen::Vector3d axis = R_world_beam.col(0);
     const long long azimuth = std::llround(std::atan2(axis.y(), axis.x()) / step);
     const long long tilt = std::llround(std::asin(std::clamp(axis.z(), -1.0, 1.0)) / step);
+    std::array<std::uint64_t, 3> cells{};
+    for (int i = 0; i < 3; ++i) {
+      const double cell = std::floor(T_world_sonar.translation()[i] / a.speckle_correlation_m);
+      cells[static_cast<std::size_t>(i)] =
+          static_cast<std::uint64_t>(static_cast<std::int64_t>(cell));
+    }
     const auto place_of = [&](long long sector) {
       std::uint64_t place =
           DeriveSeed(place_seed_, static_cast<std::uint64_t>(((sector % turn) + turn) % turn));
       place = DeriveSeed(place, static_cast<std::uint64_t>(tilt));
-      for (int i = 0; i < 3; ++i) {
-        const double cell = std::floor(T_world_sonar.translation()[i] / a.speckle_correlation_m);
-        place = DeriveSeed(place, static_cast<std::uint64_t>(static_cast<std::int64_t>(cell)));
-      }
+      for (const std::uint64_t cell : cells) place = DeriveSeed(place, cell);
       return place;
     };
     place_rng.emplace(place_of(azimuth));

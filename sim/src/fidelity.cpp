@@ -85,24 +85,32 @@ std::vector<double> WallProfile(std::span<const mapping::Beam> beams, double min
   return sum;
 }
 
-// FidelityReport::sim_range_correlation for `beams`, over bins [first, bins).
-std::vector<double> RangeCorrelation(std::span<const mapping::Beam> beams, std::size_t first,
-                                     std::size_t bins) {
+// Each beam's bins [first, bins) (fewer for a short beam), less the beam's mean over them.
+std::vector<std::vector<double>> CentredRows(std::span<const mapping::Beam> beams,
+                                             std::size_t first, std::size_t bins) {
+  std::vector<std::vector<double>> rows(beams.size());
+  for (std::size_t i = 0; i < beams.size(); ++i) {
+    const auto& v = beams[i].intensities;
+    const std::size_t end = std::min(bins, v.size());
+    if (end <= first) continue;
+    rows[i].assign(v.begin() + static_cast<long>(first), v.begin() + static_cast<long>(end));
+    const double mean =
+        std::accumulate(rows[i].begin(), rows[i].end(), 0.0) / static_cast<double>(end - first);
+    for (double& x : rows[i]) x -= mean;
+  }
+  return rows;
+}
+
+// FidelityReport::sim_range_correlation from the beams' centred rows.
+std::vector<double> RangeCorrelation(const std::vector<std::vector<double>>& rows) {
   const auto lags = static_cast<std::size_t>(FidelityReport::kTextureLags);
   std::vector<double> covariance(lags + 1, 0.0);
-  std::vector<double> centred;
-  for (const auto& beam : beams) {
-    const std::size_t end = std::min(bins, beam.intensities.size());
-    if (end <= first + lags) continue;
-    centred.assign(beam.intensities.begin() + static_cast<long>(first),
-                   beam.intensities.begin() + static_cast<long>(end));
-    const double mean =
-        std::accumulate(centred.begin(), centred.end(), 0.0) / static_cast<double>(centred.size());
-    for (double& v : centred) v -= mean;
+  for (const auto& row : rows) {
+    if (row.size() <= lags) continue;
     for (std::size_t m = 0; m <= lags; ++m) {
       double sum = 0.0;
-      for (std::size_t k = 0; k + m < centred.size(); ++k) sum += centred[k] * centred[k + m];
-      covariance[m] += sum / static_cast<double>(centred.size() - m);
+      for (std::size_t k = 0; k + m < row.size(); ++k) sum += row[k] * row[k + m];
+      covariance[m] += sum / static_cast<double>(row.size() - m);
     }
   }
   if (covariance[0] > 0.0) {
@@ -111,34 +119,23 @@ std::vector<double> RangeCorrelation(std::span<const mapping::Beam> beams, std::
   return covariance;
 }
 
-// FidelityReport::sim_beam_correlation for `beams`, over bins [first, bins).
+// FidelityReport::sim_beam_correlation from the beams' centred rows.
 std::vector<double> BeamCorrelation(std::span<const mapping::Beam> beams,
-                                    const mapping::SensorGeometry& sensor, std::size_t first,
-                                    std::size_t bins) {
+                                    const std::vector<std::vector<double>>& rows,
+                                    const mapping::SensorGeometry& sensor) {
   const auto lags = static_cast<std::size_t>(FidelityReport::kBeamLags);
   const auto steps = static_cast<std::size_t>(sensor.BeamsPerSweep());
   std::vector<double> out(lags + 1, 0.0);
   out[0] = 1.0;
-  const auto centred = [&](const mapping::Beam& beam, std::vector<double>& v) {
-    v.clear();
-    for (std::size_t k = first; k < std::min(bins, beam.intensities.size()); ++k)
-      v.push_back(beam.intensities[k]);
-    if (v.empty()) return;
-    const double mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-    for (double& x : v) x -= mean;
-  };
-  std::vector<double> a;
-  std::vector<double> b;
   for (std::size_t m = 1; m <= lags; ++m) {
     double covariance = 0.0;
     double spread = 0.0;
     for (std::size_t i = 0; i + m < beams.size(); ++i) {
       if ((StepIndex(beams[i], sensor) + m) % steps != StepIndex(beams[i + m], sensor)) continue;
-      centred(beams[i], a);
-      centred(beams[i + m], b);
-      const std::size_t n = std::min(a.size(), b.size());
+      const std::vector<double>& a = rows[i];
+      const std::vector<double>& b = rows[i + m];
       double ab = 0.0, aa = 0.0, bb = 0.0;
-      for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t k = 0; k < std::min(a.size(), b.size()); ++k) {
         ab += a[k] * b[k];
         aa += a[k] * a[k];
         bb += b[k] * b[k];
@@ -310,10 +307,12 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   r.sim_sweep_spread = SweepSpread(sim, sensor);
   r.real_sweep_spread = SweepSpread(real, sensor);
   const std::size_t far_half = (first + bins) / 2;
-  r.sim_range_correlation = RangeCorrelation(sim, far_half, bins);
-  r.real_range_correlation = RangeCorrelation(real, far_half, bins);
-  r.sim_beam_correlation = BeamCorrelation(sim, sensor, far_half, bins);
-  r.real_beam_correlation = BeamCorrelation(real, sensor, far_half, bins);
+  const auto sim_rows = CentredRows(sim, far_half, bins);
+  const auto real_rows = CentredRows(real, far_half, bins);
+  r.sim_range_correlation = RangeCorrelation(sim_rows);
+  r.real_range_correlation = RangeCorrelation(real_rows);
+  r.sim_beam_correlation = BeamCorrelation(sim, sim_rows, sensor);
+  r.real_beam_correlation = BeamCorrelation(real, real_rows, sensor);
   r.sim_histogram = Histogram(sim, first);
   r.real_histogram = Histogram(real, first);
   for (std::size_t v = 0; v < 256; ++v) {
