@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
+#include <string>
 
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
@@ -192,6 +194,30 @@ TEST(SceneFile, ReverberationIsTheScenes) {
                       << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
   EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
                                    {"bad.yaml:5:", "'sonar_acoustics.reverberation_db'", "'30'"}));
+}
+
+// The scenes built on the fitted tank (the two that must fail, and the crate) restate its
+// acoustics, materials and detection rather than include them: they must stay in step with
+// scenes/cras-tank.yaml, or they no longer test what their comments say. The two must-fail
+// scenes also keep the tank's criteria, only expecting them to fail.
+TEST(SceneFile, TankScenesShareTheFittedTank) {
+  const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  for (const char* name : {"scenes/cras-tank-sparse-rays.yaml", "scenes/cras-tank-nav-drift.yaml",
+                           "scenes/tank-crate.yaml"}) {
+    SCOPED_TRACE(name);
+    const sim::Scene scene = sim::LoadScene(test::SourcePath(name));
+    EXPECT_EQ(scene.sensor.acoustics, tank.sensor.acoustics);
+    EXPECT_EQ(scene.mapping.detection, tank.mapping.detection);
+    for (const sim::Material& material : tank.materials) {
+      const auto same = std::ranges::find(scene.materials, material.name, &sim::Material::name);
+      ASSERT_NE(same, scene.materials.end()) << material.name;
+      EXPECT_EQ(*same, material);
+    }
+    if (std::string(name).starts_with("scenes/cras-tank-")) {
+      EXPECT_TRUE(scene.criteria.expect_fail);
+      EXPECT_EQ(scene.criteria.metrics, tank.criteria.metrics);
+    }
+  }
 }
 
 TEST(SceneFile, MissingFileIsAnInputError) {

@@ -32,6 +32,8 @@ struct DetectionConfig {
   double canny_blur_sigma = 1.4;
   /// kAutoCanny: thresholds are (1 ∓ sigma) · median of the blurred image's usable bins.
   double auto_canny_sigma = 0.33;
+
+  bool operator==(const DetectionConfig&) const = default;
 };
 
 /// The key set the mapper collects cells in; the map does not depend on it.

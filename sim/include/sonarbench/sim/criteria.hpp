@@ -23,6 +23,8 @@ struct Criterion {
   std::optional<double> acceptable_min;
   std::optional<double> acceptable_max;
   bool optional = false;
+
+  bool operator==(const Criterion&) const = default;
 };
 
 /// A scene's criteria. With `expect_fail`, the scenario passes only when at least one required

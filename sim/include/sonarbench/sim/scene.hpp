@@ -27,6 +27,8 @@ struct Material {
   /// mirror; a few degrees spread each multipath ghost over bins and head angles, and the echo's
   /// way back is tilted independently of its way out.
   double specular_spread_rad = 0.0;
+
+  bool operator==(const Material&) const = default;
 };
 
 /// A mesh, as the scene file describes it: procedural, or loaded from a mesh file.

@@ -56,6 +56,8 @@ struct Acoustics {
   /// Mean self-reflection (vehicle body and transducer ringing) power per bin from bin 0, at the
   /// receiver output [dB]; bins past the end of the list get none.
   std::vector<double> self_reflection_db;
+
+  bool operator==(const Acoustics&) const = default;
 };
 
 /// A sensor model file: `geometry` for the mapper, `acoustics` for the simulator.
