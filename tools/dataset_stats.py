@@ -1,0 +1,79 @@
+#!/usr/bin/env python3
+"""Intensity statistics of a sonarbench dataset (docs/dataset-format.md), for comparing a
+simulated run with a real log bin by bin where `sonarbench fidelity` gives only summaries.
+
+    python3 tools/dataset_stats.py DIR [DIR ...]
+
+DIR is what `sonarbench simulate SCENE --out DIR` or `sonarbench import LOG.mat --out DIR`
+wrote. For each, per range band: the mean intensity, the share of bins at 0 and at 150 or
+more; and the ringing tail: each beam's largest 5-bin moving average over bins 30-63
+(0.38-0.79 m, past the self-reflection the mapper drops), as percentiles over beams and the
+share of beams whose tail reaches 60. Standard library only.
+"""
+import glob
+import os
+import struct
+import sys
+
+BANDS_M = [(0.4, 1.5), (1.5, 2.0), (2.0, 2.5), (2.5, 3.0), (3.0, 4.0), (4.0, 5.0)]
+TAIL_BINS = (30, 64)  # centres of the 5-bin windows
+
+
+def load_beams(directory):
+    """(bin_size_m, intensities) of every beam, sweep by sweep."""
+    files = sorted(glob.glob(os.path.join(directory, "beams", "sweep_*.bin")))
+    if not files:
+        sys.exit(f"{directory}: no beams/sweep_*.bin (not a sonarbench dataset?)")
+    beams = []
+    for path in files:
+        with open(path, "rb") as f:
+            data = f.read()
+        if data[:8] != b"SBBEAMS1":
+            sys.exit(f"{path}: expected the magic SBBEAMS1")
+        (count,) = struct.unpack_from("<I", data, 8)
+        offset = 12
+        for beam in range(count):
+            if offset + 28 > len(data):
+                sys.exit(f"{path}: beam {beam} truncated")
+            _, _, bin_size, bins = struct.unpack_from("<dddI", data, offset)
+            offset += 28
+            if offset + bins > len(data):
+                sys.exit(f"{path}: beam {beam} truncated")
+            beams.append((bin_size, data[offset:offset + bins]))
+            offset += bins
+    return beams
+
+
+def percentile(sorted_values, q):
+    return sorted_values[min(len(sorted_values) - 1, int(q * len(sorted_values)))]
+
+
+def report(directory):
+    beams = load_beams(directory)
+    print(f"{directory}: {len(beams)} beams")
+    for low, high in BANDS_M:
+        values = [v for size, b in beams for k, v in enumerate(b) if low <= k * size < high]
+        if not values:
+            continue
+        n = len(values)
+        print(f"  {low:.1f}-{high:.1f} m: mean {sum(values) / n:.1f}, "
+              f"at 0 {100 * sum(v == 0 for v in values) / n:.1f}%, "
+              f"at 150 or more {100 * sum(v >= 150 for v in values) / n:.2f}%")
+    tails = []
+    for _, b in beams:
+        if len(b) < TAIL_BINS[1] + 2:
+            continue
+        tails.append(max(sum(b[i - 2:i + 3]) / 5 for i in range(*TAIL_BINS)))
+    if tails:
+        tails.sort()
+        print("  ringing tail (largest 5-bin mean over bins 30-63): "
+              f"median {percentile(tails, 0.5):.0f}, p90 {percentile(tails, 0.9):.0f}, "
+              f"p99 {percentile(tails, 0.99):.0f}, max {tails[-1]:.0f}; "
+              f"{100 * sum(t >= 60 for t in tails) / len(tails):.1f}% of beams reach 60")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 2:
+        sys.exit(__doc__)
+    for d in sys.argv[1:]:
+        report(d)
