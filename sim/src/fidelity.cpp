@@ -37,21 +37,34 @@ std::size_t StepIndex(const mapping::Beam& beam, const mapping::SensorGeometry& 
   return static_cast<std::size_t>(((step % steps) + steps) % steps);
 }
 
-// The first bin at or beyond `min_range_m` and the strongest bin from there on, if any.
-std::optional<std::size_t> StrongestBin(const mapping::Beam& beam, double min_range_m) {
-  const auto first = static_cast<std::size_t>(std::ceil(min_range_m / beam.bin_size_m));
-  if (first >= beam.intensities.size()) return std::nullopt;
-  const auto strongest =
-      std::max_element(beam.intensities.begin() + static_cast<long>(first), beam.intensities.end());
-  return static_cast<std::size_t>(strongest - beam.intensities.begin());
+// Per beam, its strongest bin at or beyond `min_range_m` (the wall, in a tank), if it has one.
+using StrongestBins = std::vector<std::optional<std::size_t>>;
+StrongestBins FindStrongestBins(std::span<const mapping::Beam> beams, double min_range_m) {
+  StrongestBins out(beams.size());
+  for (std::size_t i = 0; i < beams.size(); ++i) {
+    const auto& v = beams[i].intensities;
+    const auto first = static_cast<std::size_t>(std::ceil(min_range_m / beams[i].bin_size_m));
+    if (first >= v.size()) continue;
+    out[i] = static_cast<std::size_t>(
+        std::max_element(v.begin() + static_cast<long>(first), v.end()) - v.begin());
+  }
+  return out;
+}
+
+// Mean |a - b| over two equally long series (0 for empty ones).
+double MeanAbsDifference(std::span<const double> a, std::span<const double> b) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) sum += std::abs(a[i] - b[i]);
+  return a.empty() ? 0.0 : sum / static_cast<double>(a.size());
 }
 
 // The 10th, 50th and 90th percentiles (the values at ⌊q·n⌋ of the sorted n) of each beam's
 // strongest intensity beyond `min_range_m`.
-std::array<double, 3> WallPeaks(std::span<const mapping::Beam> beams, double min_range_m) {
+std::array<double, 3> WallPeaks(std::span<const mapping::Beam> beams,
+                                const StrongestBins& strongest) {
   std::vector<double> peaks;
-  for (const auto& beam : beams) {
-    if (const auto bin = StrongestBin(beam, min_range_m)) peaks.push_back(beam.intensities[*bin]);
+  for (std::size_t i = 0; i < beams.size(); ++i) {
+    if (strongest[i]) peaks.push_back(beams[i].intensities[*strongest[i]]);
   }
   std::array<double, 3> out{};
   if (peaks.empty()) return out;
@@ -64,17 +77,17 @@ std::array<double, 3> WallPeaks(std::span<const mapping::Beam> beams, double min
 }
 
 // FidelityReport::sim_wall_profile for `beams`.
-std::vector<double> WallProfile(std::span<const mapping::Beam> beams, double min_range_m,
-                                std::size_t first_usable) {
+std::vector<double> WallProfile(std::span<const mapping::Beam> beams,
+                                const StrongestBins& strongest, std::size_t first_usable) {
   constexpr int kBefore = FidelityReport::kWallProfileBefore;
   const auto size = static_cast<std::size_t>(kBefore + FidelityReport::kWallProfileAfter + 1);
   std::vector<double> sum(size, 0.0);
   std::vector<double> count(size, 0.0);
-  for (const auto& beam : beams) {
-    const auto bin = StrongestBin(beam, min_range_m);
-    if (!bin) continue;
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    if (!strongest[b]) continue;
+    const auto& beam = beams[b];
     for (std::size_t i = 0; i < size; ++i) {
-      const auto k = static_cast<long>(*bin) + static_cast<long>(i) - kBefore;
+      const auto k = static_cast<long>(*strongest[b]) + static_cast<long>(i) - kBefore;
       if (k < static_cast<long>(first_usable) || k >= static_cast<long>(beam.intensities.size()))
         continue;
       sum[i] += beam.intensities[static_cast<std::size_t>(k)];
@@ -148,16 +161,17 @@ std::vector<double> BeamCorrelation(std::span<const mapping::Beam> beams,
   return out;
 }
 
-// Per head-angle step, the median over sweeps of value(beam, strongest bin beyond min_range_m).
+// Per head-angle step, the median over sweeps of value(beam, its strongest bin).
 template <typename Value>
 std::vector<std::optional<double>> PerAngleMedian(std::span<const mapping::Beam> beams,
+                                                  const StrongestBins& strongest,
                                                   const mapping::SensorGeometry& sensor,
-                                                  double min_range_m, Value value) {
+                                                  Value value) {
   const int steps = sensor.BeamsPerSweep();
   std::vector<std::vector<double>> per_angle(static_cast<std::size_t>(steps));
-  for (const auto& beam : beams) {
-    if (const auto bin = StrongestBin(beam, min_range_m)) {
-      per_angle[StepIndex(beam, sensor)].push_back(value(beam, *bin));
+  for (std::size_t i = 0; i < beams.size(); ++i) {
+    if (strongest[i]) {
+      per_angle[StepIndex(beams[i], sensor)].push_back(value(beams[i], *strongest[i]));
     }
   }
   std::vector<std::optional<double>> out(per_angle.size());
@@ -171,17 +185,17 @@ std::vector<std::optional<double>> PerAngleMedian(std::span<const mapping::Beam>
 }
 
 std::vector<std::optional<double>> WallRanges(std::span<const mapping::Beam> beams,
-                                              const mapping::SensorGeometry& sensor,
-                                              double min_range_m) {
-  return PerAngleMedian(beams, sensor, min_range_m, [](const mapping::Beam& beam, std::size_t bin) {
+                                              const StrongestBins& strongest,
+                                              const mapping::SensorGeometry& sensor) {
+  return PerAngleMedian(beams, strongest, sensor, [](const mapping::Beam& beam, std::size_t bin) {
     return beam.BinCentreRange(bin);
   });
 }
 
 std::vector<std::optional<double>> WallPeaksByAngle(std::span<const mapping::Beam> beams,
-                                                    const mapping::SensorGeometry& sensor,
-                                                    double min_range_m) {
-  return PerAngleMedian(beams, sensor, min_range_m, [](const mapping::Beam& beam, std::size_t bin) {
+                                                    const StrongestBins& strongest,
+                                                    const mapping::SensorGeometry& sensor) {
+  return PerAngleMedian(beams, strongest, sensor, [](const mapping::Beam& beam, std::size_t bin) {
     return static_cast<double>(beam.intensities[bin]);
   });
 }
@@ -270,27 +284,26 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   r.real_mean = MeanProfile(real, bins);
   r.profile_correlation_all = PearsonCorrelation(r.sim_mean, r.real_mean);
   const auto first = static_cast<std::size_t>(sensor.FirstUsableBin());
-  r.profile_correlation_usable = PearsonCorrelation(std::span(r.sim_mean).subspan(first),
-                                                    std::span(r.real_mean).subspan(first));
-  double abs_sum = 0.0;
-  for (std::size_t k = first; k < bins; ++k) abs_sum += std::abs(r.sim_mean[k] - r.real_mean[k]);
-  r.profile_mean_abs_difference = first < bins ? abs_sum / static_cast<double>(bins - first) : 0.0;
-  r.sim_wall_m = WallRanges(sim, sensor, wall_min_range_m);
-  r.real_wall_m = WallRanges(real, sensor, wall_min_range_m);
-  r.sim_wall_peak_by_angle = WallPeaksByAngle(sim, sensor, wall_min_range_m);
-  r.real_wall_peak_by_angle = WallPeaksByAngle(real, sensor, wall_min_range_m);
-  r.sim_wall_profile = WallProfile(sim, wall_min_range_m, first);
-  r.real_wall_profile = WallProfile(real, wall_min_range_m, first);
-  double tail_sum = 0.0;
+  const std::size_t usable = std::min(first, bins);  // all bins may lie in the self-reflection
+  r.profile_correlation_usable = PearsonCorrelation(std::span(r.sim_mean).subspan(usable),
+                                                    std::span(r.real_mean).subspan(usable));
+  r.profile_mean_abs_difference = MeanAbsDifference(std::span(r.sim_mean).subspan(usable),
+                                                    std::span(r.real_mean).subspan(usable));
+  const StrongestBins sim_strongest = FindStrongestBins(sim, wall_min_range_m);
+  const StrongestBins real_strongest = FindStrongestBins(real, wall_min_range_m);
+  r.sim_wall_m = WallRanges(sim, sim_strongest, sensor);
+  r.real_wall_m = WallRanges(real, real_strongest, sensor);
+  r.sim_wall_peak_by_angle = WallPeaksByAngle(sim, sim_strongest, sensor);
+  r.real_wall_peak_by_angle = WallPeaksByAngle(real, real_strongest, sensor);
+  r.sim_wall_profile = WallProfile(sim, sim_strongest, first);
+  r.real_wall_profile = WallProfile(real, real_strongest, first);
   const auto tail_start =
       static_cast<std::size_t>(FidelityReport::kWallProfileBefore + FidelityReport::kWallTailStart);
-  for (std::size_t i = tail_start; i < r.sim_wall_profile.size(); ++i) {
-    tail_sum += std::abs(r.sim_wall_profile[i] - r.real_wall_profile[i]);
-  }
   r.wall_tail_mean_abs_difference =
-      tail_sum / static_cast<double>(r.sim_wall_profile.size() - tail_start);
-  r.sim_wall_peak = WallPeaks(sim, wall_min_range_m);
-  r.real_wall_peak = WallPeaks(real, wall_min_range_m);
+      MeanAbsDifference(std::span(r.sim_wall_profile).subspan(tail_start),
+                        std::span(r.real_wall_profile).subspan(tail_start));
+  r.sim_wall_peak = WallPeaks(sim, sim_strongest);
+  r.real_wall_peak = WallPeaks(real, real_strongest);
   std::vector<double> differences;
   for (std::size_t a = 0; a < r.sim_wall_m.size(); ++a) {
     if (r.sim_wall_m[a] && r.real_wall_m[a]) {
