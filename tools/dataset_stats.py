@@ -6,11 +6,14 @@ simulated run with a real log bin by bin where `sonarbench fidelity` gives only 
 
 DIR is what `sonarbench simulate SCENE --out DIR` or `sonarbench import LOG.mat --out DIR`
 wrote. For each, per range band: the mean intensity, the share of bins at 0 and at 150 or
-more; and the ringing tail: each beam's largest 5-bin moving average over bins 30-63
+more, and the sweep-to-sweep spread (per head angle, to 0.1°, and bin, the standard deviation
+over the beams at that angle, averaged over the band's cells seen twice or more: a static
+sonar's echoes repeat, noise does not); and the ringing tail: each beam's largest 5-bin moving average over bins 30-63
 (0.38-0.79 m, past the self-reflection the mapper drops), as percentiles over beams and the
 share of beams whose tail reaches 60. Standard library only.
 """
 import glob
+import math
 import os
 import struct
 import sys
@@ -19,8 +22,9 @@ BANDS_M = [(0.4, 1.5), (1.5, 2.0), (2.0, 2.5), (2.5, 3.0), (3.0, 4.0), (4.0, 5.0
 TAIL_BINS = (30, 64)  # centres of the 5-bin windows
 
 
-def load_beams(directory):
-    """(bin_size_m, intensities) of every beam, sweep by sweep."""
+def load_beams(directory, with_angles=False):
+    """(bin_size_m, intensities) of every beam, sweep by sweep; with_angles: (head_angle_rad,
+    bin_size_m, intensities)."""
     files = sorted(glob.glob(os.path.join(directory, "beams", "sweep_*.bin")))
     if not files:
         sys.exit(f"{directory}: no beams/sweep_*.bin (not a sonarbench dataset?)")
@@ -35,11 +39,12 @@ def load_beams(directory):
         for beam in range(count):
             if offset + 28 > len(data):
                 sys.exit(f"{path}: beam {beam} truncated")
-            _, _, bin_size, bins = struct.unpack_from("<dddI", data, offset)
+            _, angle, bin_size, bins = struct.unpack_from("<dddI", data, offset)
             offset += 28
             if offset + bins > len(data):
                 sys.exit(f"{path}: beam {beam} truncated")
-            beams.append((bin_size, data[offset:offset + bins]))
+            intensities = data[offset:offset + bins]
+            beams.append((angle, bin_size, intensities) if with_angles else (bin_size, intensities))
             offset += bins
     return beams
 
@@ -48,17 +53,43 @@ def percentile(sorted_values, q):
     return sorted_values[min(len(sorted_values) - 1, int(q * len(sorted_values)))]
 
 
+def sweep_spreads(beams):
+    """Per bin: [sum of the standard deviations over head angles, their count]."""
+    by_angle = {}
+    for angle, size, b in beams:
+        by_angle.setdefault(round(math.degrees(angle) % 360.0, 1) % 360.0, []).append((size, b))
+    spreads = {}
+    for group in by_angle.values():
+        if len(group) < 2:
+            continue
+        size = group[0][0]
+        for k in range(min(len(b) for _, b in group)):
+            values = [b[k] for _, b in group]
+            mean = sum(values) / len(values)
+            sd = math.sqrt(sum((v - mean) ** 2 for v in values) / (len(values) - 1))
+            cell = spreads.setdefault((size, k), [0.0, 0])
+            cell[0] += sd
+            cell[1] += 1
+    return spreads
+
+
 def report(directory):
-    beams = load_beams(directory)
+    with_angles = load_beams(directory, with_angles=True)
+    beams = [(size, b) for _, size, b in with_angles]
+    spreads = sweep_spreads(with_angles)
     print(f"{directory}: {len(beams)} beams")
     for low, high in BANDS_M:
         values = [v for size, b in beams for k, v in enumerate(b) if low <= k * size < high]
         if not values:
             continue
         n = len(values)
-        print(f"  {low:.1f}-{high:.1f} m: mean {sum(values) / n:.1f}, "
-              f"at 0 {100 * sum(v == 0 for v in values) / n:.1f}%, "
-              f"at 150 or more {100 * sum(v >= 150 for v in values) / n:.2f}%")
+        line = (f"  {low:.1f}-{high:.1f} m: mean {sum(values) / n:.1f}, "
+                f"at 0 {100 * sum(v == 0 for v in values) / n:.1f}%, "
+                f"at 150 or more {100 * sum(v >= 150 for v in values) / n:.2f}%")
+        cells = [c for (size, k), c in spreads.items() if low <= k * size < high]
+        if cells:
+            line += (f", sweep-to-sweep spread {sum(c[0] for c in cells) / sum(c[1] for c in cells):.1f}")
+        print(line)
     tails = []
     for _, b in beams:
         if len(b) < TAIL_BINS[1] + 2:

@@ -1,9 +1,13 @@
 // Google Benchmark of beam synthesis against raw Embree (issue 3's speed goals), one sweep of the
-// default tank scenario:
+// default tank scenario (/tank: 14 triangles, 8 rough reflections per ray) and of the seabed
+// survey (/seabed: an 11.5 k-triangle height field, no multipath), each row for both but
+// BM_SynthesisNoMultipath (the tank's only: the seabed has none):
 //   BM_RawEmbree        the synthesis's primary rays, generated beforehand, intersected only:
 //                       one rtcIntersect1 per ray
 //   BM_RawEmbreeBundle  the same, each beam's rays as one coherent stream (rtcIntersect1M), the
 //                       query the synthesis makes
+//   BM_SynthesisNoMultipath  the tank's synthesis with no material specular: one ray traced
+//                       per primary, the raw rows' rays exactly (the goal's comparison)
 //   BM_Synthesis/1, /2  the whole synthesis (hits, backscatter, the scene's multipath: mirrored and
 //                       occlusion rays, range spreading, noise, quantisation) on 1 and 2 threads
 // Per-run set-up is outside every timing, as a run does it once: the BVH (the raw rows' too) and
@@ -12,8 +16,10 @@
 // for the synthesis, the real-time factor: the real sonar's time for the sweep over ours.
 #include <benchmark/benchmark.h>
 
-#include <numbers>
+#include <map>
+#include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "sonarbench/sim/beam_synthesizer.hpp"
@@ -24,20 +30,26 @@
 namespace sonarbench::sim {
 namespace {
 
-struct Tank {
-  Scene scene = [] {
-    Scene s = LoadScene(SONARBENCH_SOURCE_DIR "/scenes/cras-tank.yaml");
-    s.sweeps = 1;
-    return s;
-  }();
-  std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
-  RayTracer tracer{meshes};
-  /// The same scene without multipath: no material reflects specularly.
-  Scene no_multipath = [this] {
-    Scene s = scene;
-    for (Material& m : s.materials) m.specular = 0.0;
-    return s;
-  }();
+// A scene as the bench runs it: one sweep, its meshes' BVH, and the same scene without multipath
+// (no material reflects specularly).
+struct BenchScene {
+  explicit BenchScene(const std::string& file)
+      : scene([&] {
+          Scene s = LoadScene(std::string(SONARBENCH_SOURCE_DIR "/scenes/") + file);
+          s.sweeps = 1;
+          return s;
+        }()),
+        meshes(BuildSceneMeshes(scene)),
+        tracer(meshes),
+        no_multipath([this] {
+          Scene s = scene;
+          for (Material& m : s.materials) m.specular = 0.0;
+          return s;
+        }()) {}
+  Scene scene;
+  std::vector<TriangleMesh> meshes;
+  RayTracer tracer;
+  Scene no_multipath;
 };
 
 constexpr std::uint64_t kSeed = 1;
@@ -48,17 +60,6 @@ std::vector<SynthesizedBeam> SimulateSweep(const Scene& scene, const BeamSynthes
   return SimulateBeams(scene, synthesizer, kSeed, threads, 0, ScenarioBeamCount(scene));
 }
 
-Tank& TheTank() {
-  static Tank tank;
-  return tank;
-}
-
-double PrimaryRaysPerSweep(const Scene& scene) {
-  const Acoustics& a = scene.sensor.acoustics;
-  return static_cast<double>(a.rays_horizontal) * a.rays_vertical *
-         scene.sensor.geometry.BeamsPerSweep();
-}
-
 // One sweep's primary rays, drawn as the synthesis draws them (BeamSynthesizer::DrawRays: the
 // same strata and jitter slots, from the benchmark's own seeds), generated once, outside any
 // timing.
@@ -67,82 +68,100 @@ struct SweepRays {
   std::vector<std::vector<Eigen::Vector3f>> directions;  // per beam, per ray
 };
 
-const SweepRays& TheSweepRays() {
-  static const SweepRays rays = [] {
-    const Tank& tank = TheTank();
-    const BeamSynthesizer synthesizer(tank.scene.sensor, tank.tracer,
-                                      std::vector<Material>(tank.meshes.size()));
-    SweepRays out;
-    std::vector<double> patterns;
-    for (int b = 0; b < tank.scene.sensor.geometry.BeamsPerSweep(); ++b) {
-      const ScheduledBeam s = ScheduleBeam(tank.scene, static_cast<std::size_t>(b));
-      const Eigen::Matrix3d R =
-          s.pose.T_world_sonar.linear() *
-          Eigen::AngleAxisd(s.pose.head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      out.origins.push_back(s.pose.T_world_sonar.translation().cast<float>());
-      Rng rng(DeriveSeed(kSeed, static_cast<std::uint64_t>(b)));
-      synthesizer.DrawRays(R, rng, out.directions.emplace_back(), patterns);
-    }
-    return out;
-  }();
-  return rays;
+SweepRays DrawSweepRays(const BenchScene& bench) {
+  const BeamSynthesizer synthesizer(bench.scene.sensor, bench.tracer,
+                                    std::vector<Material>(bench.meshes.size()));
+  SweepRays out;
+  std::vector<double> patterns;
+  for (int b = 0; b < bench.scene.sensor.geometry.BeamsPerSweep(); ++b) {
+    const ScheduledBeam s = ScheduleBeam(bench.scene, static_cast<std::size_t>(b));
+    const Eigen::Matrix3d R =
+        s.pose.T_world_sonar.linear() *
+        Eigen::AngleAxisd(s.pose.head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    out.origins.push_back(s.pose.T_world_sonar.translation().cast<float>());
+    Rng rng(DeriveSeed(kSeed, static_cast<std::uint64_t>(b)));
+    synthesizer.DrawRays(R, rng, out.directions.emplace_back(), patterns);
+  }
+  return out;
+}
+
+// The scene and its sweep's rays, built on first use and kept for every row.
+struct Setup {
+  BenchScene bench;
+  SweepRays rays;
+};
+
+const Setup& TheSetup(const std::string& file) {
+  static std::map<std::string, std::unique_ptr<Setup>> setups;
+  std::unique_ptr<Setup>& setup = setups[file];
+  if (!setup) {
+    setup = std::make_unique<Setup>(Setup{BenchScene(file), {}});
+    setup->rays = DrawSweepRays(setup->bench);
+  }
+  return *setup;
+}
+
+double PrimaryRaysPerSweep(const Scene& scene) {
+  const Acoustics& a = scene.sensor.acoustics;
+  return static_cast<double>(a.rays_horizontal) * a.rays_vertical *
+         scene.sensor.geometry.BeamsPerSweep();
 }
 
 // Raw Embree, one rtcIntersect1 per ray (RayTracer::Intersect), of the precomputed rays.
-void BM_RawEmbree(benchmark::State& state) {
-  Tank& tank = TheTank();
-  const SweepRays& rays = TheSweepRays();
-  const auto max_range = static_cast<float>(tank.scene.sensor.geometry.MaxRangeM());
+void BM_RawEmbree(benchmark::State& state, const std::string& file) {
+  const Setup& setup = TheSetup(file);
+  const SweepRays& rays = setup.rays;
+  const auto max_range = static_cast<float>(setup.bench.scene.sensor.geometry.MaxRangeM());
   for (auto _ : state) {
     std::size_t hits = 0;
     for (std::size_t b = 0; b < rays.origins.size(); ++b) {
       for (const Eigen::Vector3f& d : rays.directions[b]) {
-        hits += tank.tracer.Intersect(rays.origins[b], d, max_range).has_value() ? 1 : 0;
+        hits += setup.bench.tracer.Intersect(rays.origins[b], d, max_range).has_value() ? 1 : 0;
       }
     }
     benchmark::DoNotOptimize(hits);
   }
   state.counters["rays/s"] = benchmark::Counter(
-      PrimaryRaysPerSweep(tank.scene) * state.iterations(), benchmark::Counter::kIsRate);
+      PrimaryRaysPerSweep(setup.bench.scene) * state.iterations(), benchmark::Counter::kIsRate);
 }
 
 // Raw Embree, each beam's rays as one coherent stream (RayTracer::IntersectBundle, the query
 // the synthesis makes), of the precomputed rays.
-void BM_RawEmbreeBundle(benchmark::State& state) {
-  Tank& tank = TheTank();
-  const SweepRays& rays = TheSweepRays();
-  const auto max_range = static_cast<float>(tank.scene.sensor.geometry.MaxRangeM());
+void BM_RawEmbreeBundle(benchmark::State& state, const std::string& file) {
+  const Setup& setup = TheSetup(file);
+  const SweepRays& rays = setup.rays;
+  const auto max_range = static_cast<float>(setup.bench.scene.sensor.geometry.MaxRangeM());
   std::vector<std::optional<Hit>> hits;
   for (auto _ : state) {
     std::size_t hit_count = 0;
     for (std::size_t b = 0; b < rays.origins.size(); ++b) {
       hits.resize(rays.directions[b].size());
-      tank.tracer.IntersectBundle(rays.origins[b], rays.directions[b], max_range, hits);
+      setup.bench.tracer.IntersectBundle(rays.origins[b], rays.directions[b], max_range, hits);
       for (const auto& hit : hits) hit_count += hit.has_value() ? 1 : 0;
     }
     benchmark::DoNotOptimize(hit_count);
   }
   state.counters["rays/s"] = benchmark::Counter(
-      PrimaryRaysPerSweep(tank.scene) * state.iterations(), benchmark::Counter::kIsRate);
+      PrimaryRaysPerSweep(setup.bench.scene) * state.iterations(), benchmark::Counter::kIsRate);
 }
 
-void BM_Synthesis(benchmark::State& state) {
-  Tank& tank = TheTank();
+void BM_Synthesis(benchmark::State& state, const std::string& file) {
+  const BenchScene& bench = TheSetup(file).bench;
   const auto threads = static_cast<int>(state.range(0));
-  const BeamSynthesizer synthesizer = SceneSynthesizer(tank.scene, tank.tracer, kSeed);
+  const BeamSynthesizer synthesizer = SceneSynthesizer(bench.scene, bench.tracer, kSeed);
   double traced = 0.0;
   for (auto _ : state) {
-    auto beams = SimulateSweep(tank.scene, synthesizer, threads);
+    auto beams = SimulateSweep(bench.scene, synthesizer, threads);
     for (const SynthesizedBeam& beam : beams) traced += static_cast<double>(beam.traced_rays);
     benchmark::DoNotOptimize(beams);
   }
-  const auto& g = tank.scene.sensor.geometry;
+  const auto& g = bench.scene.sensor.geometry;
   state.counters["rays/s"] = benchmark::Counter(
-      PrimaryRaysPerSweep(tank.scene) * state.iterations(), benchmark::Counter::kIsRate);
+      PrimaryRaysPerSweep(bench.scene) * state.iterations(), benchmark::Counter::kIsRate);
   // Every ray traced (mirrored and occlusion rays too), per second and per primary ray.
   state.counters["traced_rays/s"] = benchmark::Counter(traced, benchmark::Counter::kIsRate);
   state.counters["traced_per_primary"] =
-      traced / (PrimaryRaysPerSweep(tank.scene) * static_cast<double>(state.iterations()));
+      traced / (PrimaryRaysPerSweep(bench.scene) * static_cast<double>(state.iterations()));
   // Real time of a sweep over the (wall-clock) time per sweep: the counter is a rate of sweeps,
   // scaled by the sonar's seconds per sweep.
   state.counters["real_time_factor"] = benchmark::Counter(
@@ -150,21 +169,41 @@ void BM_Synthesis(benchmark::State& state) {
 }
 
 // The same without multipath: one ray per primary, the raw benchmark's rays exactly.
-void BM_SynthesisNoMultipath(benchmark::State& state) {
-  Tank& tank = TheTank();
-  const BeamSynthesizer synthesizer = SceneSynthesizer(tank.no_multipath, tank.tracer, kSeed);
+void BM_SynthesisNoMultipath(benchmark::State& state, const std::string& file) {
+  const BenchScene& bench = TheSetup(file).bench;
+  const BeamSynthesizer synthesizer = SceneSynthesizer(bench.no_multipath, bench.tracer, kSeed);
   for (auto _ : state) {
-    auto beams = SimulateSweep(tank.no_multipath, synthesizer, 1);
+    auto beams = SimulateSweep(bench.no_multipath, synthesizer, 1);
     benchmark::DoNotOptimize(beams);
   }
   state.counters["rays/s"] = benchmark::Counter(
-      PrimaryRaysPerSweep(tank.no_multipath) * state.iterations(), benchmark::Counter::kIsRate);
+      PrimaryRaysPerSweep(bench.no_multipath) * state.iterations(), benchmark::Counter::kIsRate);
 }
 
-BENCHMARK(BM_RawEmbree)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_RawEmbreeBundle)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_SynthesisNoMultipath)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Synthesis)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+// The tank: 14 triangles, 8 rough reflections per ray, the default scenario.
+const std::string kTank = "cras-tank.yaml";
+// The seabed survey: a 30 m × 12 m height field at 25 cm (11.5 k triangles), no multipath.
+const std::string kSeabed = "seabed.yaml";
+
+BENCHMARK_CAPTURE(BM_RawEmbree, tank, kTank)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RawEmbreeBundle, tank, kTank)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_SynthesisNoMultipath, tank, kTank)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Synthesis, tank, kTank)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_RawEmbree, seabed, kSeabed)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_RawEmbreeBundle, seabed, kSeabed)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Synthesis, seabed, kSeabed)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace sonarbench::sim
