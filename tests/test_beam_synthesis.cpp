@@ -182,6 +182,96 @@ TEST(BeamSynthesis, ReverberationTailDecaysAtItsLengthAndHoldsItsShare) {
   EXPECT_NEAR(total_tail / total_echo, std::pow(10.0, -0.3), 1e-6);
 }
 
+// The second trip, exactly: one first-trip echo in bin i (power P, pulse-spread) and one
+// impulse in bin j (power Q) give T · g(m) · (P / g(i)) · (Q / g(j)) / 2 to each of bins
+// m = i + j and i + j + 1, g(k) = ((k + ½) bins)^(G/10) the time-varied gain, T the level;
+// nothing elsewhere, nothing for a pair whose sum is past the last bin, nothing at -100 dB.
+TEST(BeamSynthesis, SecondTripIsTheTripsProductAtTheSummedRange) {
+  SensorModel sensor = QuietSensor();
+  sensor.acoustics.second_trip_db = 3.0;
+  const RayTracer tracer(Wall(1.0, 0.0));
+  const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
+  const auto bins = static_cast<std::size_t>(sensor.geometry.num_bins);
+  const double bin = sensor.geometry.bin_size_m;
+  const auto g = [&](std::size_t k) { return std::pow((k + 0.5) * bin, 20.0 / 10.0); };
+  std::vector<double> echo(bins, 0.0);
+  std::vector<double> impulse(bins, 0.0);
+  echo[50] = 0.25;
+  impulse[60] = 0.125;
+  std::vector<double> heard = echo;
+  synthesizer.AddSecondTrip(heard, impulse);
+  const double half = 0.5 * std::pow(10.0, 0.3) * (0.25 / g(50)) * (0.125 / g(60));
+  for (std::size_t k = 0; k < bins; ++k) {
+    double expected = echo[k];
+    if (k == 110 || k == 111) expected += half * g(k);
+    EXPECT_NEAR(heard[k], expected, 1e-12 * std::max(expected, 1e-30)) << "bin " << k;
+  }
+  // Past the last bin: nothing.
+  std::vector<double> far(bins, 0.0);
+  std::vector<double> far_impulse(bins, 0.0);
+  far[bins - 100] = 1.0;
+  far_impulse[100] = 1.0;
+  std::vector<double> far_heard = far;
+  synthesizer.AddSecondTrip(far_heard, far_impulse);
+  EXPECT_EQ(far_heard, far);
+  // At -100 dB (the default): nothing at all.
+  const BeamSynthesizer none(QuietSensor(), tracer, {Material{}});
+  std::vector<double> unchanged = echo;
+  none.AddSecondTrip(unchanged, impulse);
+  EXPECT_EQ(unchanged, echo);
+}
+
+// A wall at normal incidence 1 m ahead, through the whole synthesis: with no time-varied gain
+// (and spreading to match) the second trip is the two trips' convolution, so it starts where
+// the first trip's echo and impulse start summed (within two bins of twice the wall's range), its
+// centre of mass is theirs summed, and it holds T times their powers' product.
+TEST(BeamSynthesis, WallRingsAgainAtTwiceItsRange) {
+  SensorModel flat = QuietSensor();
+  flat.acoustics.spreading_db_per_decade = 0.0;
+  flat.acoustics.tvg_db_per_decade = 0.0;
+  SensorModel ringing = flat;
+  ringing.acoustics.second_trip_db = -3.0;
+  const std::vector<TriangleMesh> wall = Wall(1.0, 0.0);
+  const SynthesizedBeam once = Ping(flat, wall);
+  const SynthesizedBeam twice = Ping(ringing, wall);
+  const std::vector<double>& p = once.echo_power;
+  ASSERT_EQ(twice.echo_power.size(), p.size());
+  std::vector<double> second(p.size());
+  for (std::size_t k = 0; k < p.size(); ++k) second[k] = twice.echo_power[k] - p[k];
+  const auto first_of = [](const std::vector<double>& v) {
+    return static_cast<std::size_t>(
+        std::find_if(v.begin(), v.end(), [](double x) { return x > 1e-15; }) - v.begin());
+  };
+  const auto centre_of = [](const std::vector<double>& v) {
+    double mass = 0.0;
+    double moment = 0.0;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      mass += v[k];
+      moment += (k + 0.5) * v[k];
+    }
+    return moment / mass;
+  };
+  // The first trip's impulse response: the same rays' echoes, each over one bin, which a pulse
+  // one bin long gives.
+  SensorModel short_pulse = flat;
+  short_pulse.acoustics.pulse_length_m = flat.geometry.bin_size_m;
+  const std::vector<double>& h = Ping(short_pulse, wall).echo_power;
+  const std::size_t wall_bin = first_of(p);
+  EXPECT_EQ(wall_bin, static_cast<std::size_t>(1.0 / flat.geometry.bin_size_m));
+  EXPECT_EQ(first_of(h), wall_bin);
+  EXPECT_EQ(first_of(second), 2 * wall_bin);
+  // Each trip's echo is known only to its bin, taken as spread evenly over it: the sum of two
+  // ranges, each within a bin, starts up to two bins before twice the wall's bin.
+  const auto twice_wall = static_cast<std::size_t>(2.0 / flat.geometry.bin_size_m);
+  EXPECT_GE(first_of(second) + 2, twice_wall);
+  EXPECT_LE(first_of(second), twice_wall);
+  EXPECT_NEAR(centre_of(second), centre_of(p) + centre_of(h), 1e-9);
+  const double total_p = std::accumulate(p.begin(), p.end(), 0.0);
+  const double total_h = std::accumulate(h.begin(), h.end(), 0.0);
+  const double total_second = std::accumulate(second.begin(), second.end(), 0.0);
+  EXPECT_NEAR(total_second / (total_p * total_h), std::pow(10.0, -0.3), 1e-9);
+}
+
 // Multipath: a mirror that scatters nothing back (reflectivity 0, specular 1) at 45° one metre
 // ahead turns the beam towards a plane one metre to the side. The mirror's image of that plane
 // lies two metres ahead, so the ghost's echo starts in bin floor(2.0 / bin) exactly as a wall at

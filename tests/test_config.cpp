@@ -175,25 +175,31 @@ TEST(SceneFile, SpecularSpreadIsReadInDegrees) {
                                    {"bad.yaml:5:", "'materials[0].specular_spread_deg'", "'45'"}));
 }
 
-// The tank's reverberation is a property of the place: its scene sets it over the sensor
-// model's (none), and a level outside -100..20 dB is refused, naming the key and line.
+// The tank's reverberation and second trip are the scene's (the sensor model has neither),
+// and a level outside -100..20 dB is refused, naming the key and line.
 TEST(SceneFile, ReverberationIsTheScenes) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
   EXPECT_EQ(micron.acoustics.reverberation_length_m, 0.0);
+  EXPECT_EQ(micron.acoustics.second_trip_db, -100.0);
   const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   EXPECT_EQ(tank.sensor.acoustics.reverberation_length_m, 0.9);
   EXPECT_EQ(tank.sensor.acoustics.reverberation_db, -2.0);
-  test::TempDir dir;
-  const std::string path = (dir.path() / "bad.yaml").string();
-  std::ofstream(path) << "name: x\nsensor_model: "
-                      << test::SourcePath("sensor-models/shad-micron.yaml")
-                      << "\nsweeps: 1\nsonar_acoustics:\n"
-                      << "  reverberation_db: 30\n"
-                      << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0]}\n"
-                      << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
-  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
-                                   {"bad.yaml:5:", "'sonar_acoustics.reverberation_db'", "'30'"}));
+  EXPECT_EQ(tank.sensor.acoustics.second_trip_db, 7.0);
+  for (const char* key : {"reverberation_db", "second_trip_db"}) {
+    test::TempDir dir;
+    const std::string path = (dir.path() / "bad.yaml").string();
+    std::ofstream(path) << "name: x\nsensor_model: "
+                        << test::SourcePath("sensor-models/shad-micron.yaml")
+                        << "\nsweeps: 1\nsonar_acoustics:\n"
+                        << "  " << key << ": 30\n"
+                        << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0]}\n"
+                        << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+    EXPECT_TRUE(
+        ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
+                             {"bad.yaml:5:", "'sonar_acoustics." + std::string(key) + "'", "'30'"}))
+        << key;
+  }
 }
 
 // The scenes built on the fitted tank (the two that must fail, and the crate) restate its

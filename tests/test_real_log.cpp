@@ -303,6 +303,43 @@ TEST(Fidelity, WallPeaksArePercentilesOfEachBeamsStrongestEcho) {
                    5.0);
 }
 
+// The second trip: beams whose strongest echo (200) is at bin 120 + b mod 10, on a background
+// falling with range (120 - ⌊k/4⌋), and in the "real" copy a ring around twice the wall's bin:
+// +3 at offsets -6..-2, 0, 2 and 4 (8 bins, 24 in all). The flanks are the same in both, so
+// the excesses differ by the ring's 24 exactly, and the flanks' line leaves the background
+// within its flooring (near 0). Beams whose window leaves the beam are skipped: every 20th
+// beam's wall at bin 185 puts twice it past the last bin.
+TEST(Fidelity, SecondTripExcessIsTheRingAboveItsFlanksLine) {
+  const mapping::SensorGeometry sensor;
+  const auto background = [](int k) { return static_cast<std::uint8_t>(120 - k / 4); };
+  const std::vector<int> ring_offsets = {-6, -5, -4, -3, -2, 0, 2, 4};
+  const auto beams_with = [&](int ring) {
+    return TwoSweeps(sensor, [&](int b, int k) -> std::uint8_t {
+      const int wall = b % 20 == 19 ? 185 : 120 + b % 10;
+      if (k == wall) return 200;
+      std::uint8_t v = background(k);
+      for (const int o : ring_offsets) {
+        if (k == 2 * wall + o) v = static_cast<std::uint8_t>(v + ring);
+      }
+      return v;
+    });
+  };
+  const std::vector<mapping::Beam> flat = beams_with(0);
+  const std::vector<mapping::Beam> ringing = beams_with(3);
+  const auto report = sim::CompareWithLog(flat, ringing, sensor, 1.0);
+  // background(k) = 120 - floor(k / 4) is a line only to within its flooring: the flanks' fit
+  // leaves at most 1 per bin over the ring's 41 bins, about its mean 0.
+  EXPECT_NEAR(report.sim_second_trip_excess, 0.0, 2.0);
+  EXPECT_NEAR(report.real_second_trip_excess - report.sim_second_trip_excess, 24.0, 1e-9);
+  EXPECT_EQ(report.sim_second_trip_beams, 2u * 200u * 19u / 20u);
+  EXPECT_EQ(report.real_second_trip_beams, report.sim_second_trip_beams);
+  ASSERT_EQ(report.real_second_trip_profile.size(), 81u);
+  EXPECT_NEAR(report.real_second_trip_profile[40 - 6] - report.sim_second_trip_profile[40 - 6], 3.0,
+              1e-9);
+  EXPECT_NEAR(report.real_second_trip_profile[40 - 1] - report.sim_second_trip_profile[40 - 1], 0.0,
+              1e-9);
+}
+
 // The texture along range: intensities alternating 50, 150 bin by bin are perfectly
 // anti-correlated at odd lags and correlated at even ones (the far half, bins 213-398 of the
 // default geometry, holds an even count, so each beam's mean is exactly 100).

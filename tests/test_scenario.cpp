@@ -20,10 +20,10 @@ namespace {
 using mapping::kDegToRad;
 
 // The default tank scenario, run once for the whole suite (≈ 15 s on 2 cores); ctest runs this
-// executable as one test so that the run is shared. Multipath and the tank's reverberation are
-// switched off here, so that "nothing echoes from beyond a wall" holds exactly; BeamSynthesis
-// tests both on their own. The scene's floor is fitted as faint as the real log's and its
-// threshold (110) set against the reverberation, so it maps little floor. These tests are about
+// executable as one test so that the run is shared. Multipath, the tank's reverberation and its
+// second trip are switched off here, so that "nothing echoes from beyond a wall" holds exactly;
+// BeamSynthesis tests both on their own. The scene's floor is fitted as faint as the real log's and
+// its threshold (110) set against the reverberation, so it maps little floor. These tests are about
 // where echoes land, so the walls here are bright (reflectivity 0.5, where the fitted 0.012
 // matches the real log's moderate wall echoes), the floor brighter (0.2, cos^0.5: 12 times the
 // fitted floor's 0.03 cos¹ where the fan meets it, at 72.5° incidence)
@@ -40,6 +40,7 @@ class TankScenario : public ::testing::Test {
     floor.backscatter_exponent = 0.5;
     for (Material& m : scene_->materials) m.specular = 0.0;
     scene_->sensor.acoustics.reverberation_length_m = 0.0;
+    scene_->sensor.acoustics.second_trip_db = -100.0;
     scene_->mapping.detection.threshold = 90;
     result_ = new ScenarioResult(RunScenario(*scene_, RunOptions{}));
     cells_ = new MapCells(CollectMapCells(result_->mapper->tree()));

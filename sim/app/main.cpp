@@ -193,6 +193,11 @@ int Fidelity(const FidelityArgs& args) {
             << report.real_wall_peak[1] << "/" << report.real_wall_peak[2]
             << "; behind it (16-120 bins), mean |difference| "
             << report.wall_tail_mean_abs_difference << "\n"
+            << "second trip (around twice the strongest echo's bin, offsets -30..+10): excess "
+               "over its flanks sim "
+            << report.sim_second_trip_excess << " (" << report.sim_second_trip_beams
+            << " beams), real " << report.real_second_trip_excess << " ("
+            << report.real_second_trip_beams << " beams) [intensity x bins]\n"
             << "intensity histograms: intersection " << report.histogram_intersection << "\n"
             << "range correlation at 1/2/3 bins (far half): sim " << report.sim_range_correlation[1]
             << "/" << report.sim_range_correlation[2] << "/" << report.sim_range_correlation[3]
@@ -425,10 +430,12 @@ int main(int argc, char** argv) {
       "fidelity",
       "Compare a simulated scene with a real log of the same place: mean intensity against range "
       "(correlation), the strongest echo's range per head angle (median difference in bins) and "
-      "its intensity (percentiles), the profile around it (the tail behind the walls), "
+      "its intensity (percentiles), the profile around it (the tail behind the walls) and around "
+      "twice its range (the second trip), "
       "intensity histograms (intersection), the texture along range and across beams "
       "(correlations), and the first sweeps side by side (sim left, real right). Writes "
-      "fidelity.json, profile.csv/.png, wall_range.csv, wall_profile.csv, histogram.csv, "
+      "fidelity.json, profile.csv/.png, wall_range.csv, wall_profile.csv, "
+      "second_trip_profile.csv, histogram.csv, "
       "polar.png and fan.png into --out.");
   fidelity_cmd->add_option("scene", fidelity.scene, "Scene YAML file")
       ->required()

@@ -41,6 +41,15 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
     }
     for (double& w : sector_weights_) w = std::sqrt(w / total);
   }
+  if (sensor_.acoustics.second_trip_db > -100.0) {
+    second_trip_ = std::pow(10.0, sensor_.acoustics.second_trip_db / 10.0);
+    const mapping::SensorGeometry& g = sensor_.geometry;
+    for (int i = 0; i < g.num_bins; ++i) {
+      const double r = (i + 0.5) * g.bin_size_m;
+      tvg_at_bin_.push_back(std::pow(r, sensor_.acoustics.tvg_db_per_decade / 10.0));
+      untvg_at_bin_.push_back(1.0 / tvg_at_bin_.back());
+    }
+  }
   for (const double db : sensor_.acoustics.self_reflection_db) {
     self_reflection_power_.push_back(std::pow(10.0, db / 10.0));
   }
@@ -150,19 +159,37 @@ double BeamSynthesizer::RangeLoss(double range_m) const {
   return std::exp(-exponent);
 }
 
-std::uint8_t BeamSynthesizer::QuantisePower(double power) const {
-  // The largest q with ad_thresholds_[q] <= power (the thresholds increase; q = 0 below them):
-  // the table gives it at the start of the power's bucket, and the power may pass the next
+namespace {
+
+// QuantisePower's tables, held in locals by a loop over bins: an 8-bit store may alias anything,
+// so a loop reading them through `this` reloads them after every level it writes.
+struct AdSteps {
+  const double* thresholds;
+  const std::uint8_t* bucket_steps;
+  std::uint64_t first_bucket;
+  int bucket_shift;
+
+  // The largest q with thresholds[q] <= power (the thresholds increase; q = 0 below them): the
+  // table gives it at the start of the power's bucket, and the power may pass the next
   // threshold within the bucket (a compare added, not branched on: it is a coin toss). Buckets
   // of half an AD step hold at most one threshold; the loop keeps it exact for wider ones.
-  if (!(power >= ad_thresholds_[1])) return 0;
-  if (power >= ad_thresholds_[255]) return 255;
-  const std::uint64_t bucket =
-      (std::bit_cast<std::uint64_t>(power) >> ad_bucket_shift_) - ad_first_bucket_;
-  unsigned q = ad_bucket_steps_[bucket];
-  q += power >= ad_thresholds_[q + 1] ? 1 : 0;
-  while (power >= ad_thresholds_[q + 1]) ++q;
-  return static_cast<std::uint8_t>(q);
+  std::uint8_t operator()(double power) const {
+    if (!(power >= thresholds[1])) return 0;
+    if (power >= thresholds[255]) return 255;
+    const std::uint64_t bucket =
+        (std::bit_cast<std::uint64_t>(power) >> bucket_shift) - first_bucket;
+    unsigned q = bucket_steps[bucket];
+    q += power >= thresholds[q + 1] ? 1 : 0;
+    while (power >= thresholds[q + 1]) ++q;
+    return static_cast<std::uint8_t>(q);
+  }
+};
+
+}  // namespace
+
+std::uint8_t BeamSynthesizer::QuantisePower(double power) const {
+  return AdSteps{ad_thresholds_.data(), ad_bucket_steps_.data(), ad_first_bucket_,
+                 ad_bucket_shift_}(power);
 }
 
 namespace {
@@ -260,6 +287,48 @@ void BeamSynthesizer::AddReverberation(std::vector<double>& echo_power) const {
   }
 }
 
+void BeamSynthesizer::AddSecondTrip(std::vector<double>& echo_power,
+                                    std::span<const double> impulse_power) const {
+  if (second_trip_ <= 0.0) return;
+  const std::size_t bins = std::min({echo_power.size(), impulse_power.size(), tvg_at_bin_.size()});
+  // Each trip's powers with the time-varied gain taken off.
+  thread_local std::vector<double> out;
+  thread_local std::vector<double> back;
+  thread_local std::vector<double> sums;
+  out.resize(bins);
+  back.resize(bins);
+  double largest_out = 0.0;
+  double largest_back = 0.0;
+  for (std::size_t i = 0; i < bins; ++i) {
+    out[i] = echo_power[i] * untvg_at_bin_[i];
+    back[i] = impulse_power[i] * untvg_at_bin_[i];
+    largest_out = std::max(largest_out, out[i]);
+    largest_back = std::max(largest_back, back[i]);
+  }
+  if (largest_out <= 0.0 || largest_back <= 0.0) return;
+  // The way back's bins from its first to its last worth a product (1e-6 of its largest), as
+  // one span: the products of one way-out bin with them are one vectorisable loop.
+  std::size_t first = 0;
+  while (back[first] < 1e-6 * largest_back) ++first;
+  std::size_t last = bins - 1;
+  while (back[last] < 1e-6 * largest_back) --last;
+  // sums[m] = Σ_{i + j = m} out_i · back_j; a pair's half in m + 1 is added when spreading.
+  sums.assign(bins, 0.0);
+  double* const to = sums.data();
+  const double* const from = back.data();
+  for (std::size_t i = 0; i < bins && i + first < bins; ++i) {
+    const double o = out[i];
+    if (o < 1e-6 * largest_out) continue;
+    const std::size_t end = std::min(last + 1, bins - i);
+    for (std::size_t j = first; j < end; ++j) to[i + j] += o * from[j];
+  }
+  double previous = 0.0;
+  for (std::size_t m = 0; m < bins; ++m) {
+    echo_power[m] += second_trip_ * tvg_at_bin_[m] * (0.5 * (sums[m] + previous));
+    previous = sums[m];
+  }
+}
+
 namespace {
 
 // Bistatic returns weaker than this (relative to a perfect reflector filling the beam) are not
@@ -351,7 +420,9 @@ struct Scratch {
   std::vector<bool> occluded;
   PulseSpreader spreader;
   std::vector<double> echo_power;
+  std::vector<double> impulse_power;  // the second trip's: each echo over one bin
   std::vector<double> speckle;
+  std::vector<double> powers;
 };
 
 }  // namespace
@@ -365,7 +436,11 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const double max_range = g.MaxRangeM();
   Rng rng(seed);
   thread_local Scratch scratch;
-  if (scratch.spreader.Bins() != bins) scratch.spreader.Reset(bins);  // AddTo() leaves it empty
+  PulseSpreader& spreader =
+      scratch.spreader;  // a local reference: no thread-local look-up per echo
+  if (spreader.Bins() != bins) spreader.Reset(bins);  // AddTo() leaves it empty
+  std::vector<double>& impulse = scratch.impulse_power;
+  if (second_trip_ > 0.0) impulse.assign(bins, 0.0);
 
   SynthesizedBeam out;
   out.beam.time_s = time_s;
@@ -418,10 +493,20 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   // Adds an echo of strength `strength` (before range losses) from range `range` [m]: the echo
   // of a point lasts while the pulse passes it, so it is heard at every range in [r, r + L), and
   // each bin gets the power times the fraction of the bin that span covers.
-  // The range loss from its table (RangeLossFromTable).
-  auto deposit = [&](double range, double strength) {
+  // The range loss from its table (RangeLossFromTable). Inlined: a call per ray cost more than
+  // the work (synthesis_bench).
+  auto deposit = [&](double range, double strength) __attribute__((always_inline)) {
     const double start = range * bins_per_m;
-    scratch.spreader.Add(start, start + pulse_bins, strength * RangeLossFromTable(range));
+    const double power = strength * RangeLossFromTable(range);
+    spreader.Add(start, start + pulse_bins, power);
+    // The second trip's impulse response: the echo over [start, start + 1) bins, shared by the
+    // two bins it covers (the last bin's share past it dropped).
+    if (second_trip_ > 0.0 && start < static_cast<double>(bins)) {
+      const auto k = static_cast<std::size_t>(start);
+      const double after = start - static_cast<double>(k);
+      impulse[k] += power * (1.0 - after);
+      if (k + 1 < bins) impulse[k + 1] += power * after;
+    }
   };
   // The one-way pattern towards a world direction (unit), or 0 outside the half-space ahead;
   // with `blur` > 0 its mean over a 2-D Gaussian offset of that variance per axis [rad²]: for
@@ -568,7 +653,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       if (!scratch.occluded[q]) deposit(returns[q].range, returns[q].weight);
     }
   }
-  scratch.spreader.AddTo(echo);
+  spreader.AddTo(echo);
 
   if (const auto axis =
           tracer_.Intersect(origin, (R_world_beam * Eigen::Vector3d::UnitX()).cast<float>(),
@@ -580,6 +665,10 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const double noise_power = std::pow(10.0, a.noise_level_db / 10.0);
   const double gain = std::pow(10.0, a.gain_db / 10.0);
   for (double& power : echo) power /= weight_sum;
+  if (second_trip_ > 0.0) {
+    for (double& power : impulse) power /= weight_sum;
+    AddSecondTrip(echo, impulse);
+  }
   std::vector<double>& speckle = scratch.speckle;
   if (a.speckle) {
     speckle.resize(bins);
@@ -590,13 +679,19 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
     }
   }
   AddReverberation(echo);
+  // The powers first, then their levels: no 8-bit store inside the loop that draws the noise.
+  std::vector<double>& powers = scratch.powers;
+  powers.resize(bins);
   for (std::size_t k = 0; k < bins; ++k) {
     double signal = gain * echo[k];
     if (k < self_reflection_power_.size()) signal += self_reflection_power_[k];
     if (a.speckle) signal *= speckle[k];
-    const double power = signal + noise_power * rng.Exponential();
-    out.beam.intensities[k] = QuantisePower(power);
+    powers[k] = signal + noise_power * rng.Exponential();
   }
+  const AdSteps quantise{ad_thresholds_.data(), ad_bucket_steps_.data(), ad_first_bucket_,
+                         ad_bucket_shift_};
+  std::uint8_t* const levels = out.beam.intensities.data();
+  for (std::size_t k = 0; k < bins; ++k) levels[k] = quantise(powers[k]);
   if (echo_power == EchoPower::kKeep) out.echo_power = echo;
   return out;
 }

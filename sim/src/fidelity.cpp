@@ -275,6 +275,51 @@ double PearsonCorrelation(std::span<const double> a, std::span<const double> b) 
   return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
 }
 
+std::size_t SecondTripProfile(std::span<const mapping::Beam> beams,
+                              std::span<const std::optional<std::size_t>> strongest,
+                              std::size_t first_usable, std::vector<double>& profile,
+                              double& excess) {
+  constexpr long kReach = FidelityReport::kSecondTripReach;
+  profile.assign(2 * kReach + 1, 0.0);
+  excess = 0.0;
+  std::size_t count = 0;
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    if (!strongest[b]) continue;
+    const auto& v = beams[b].intensities;
+    const long centre = 2 * static_cast<long>(*strongest[b]);
+    if (centre - kReach < static_cast<long>(first_usable) ||
+        centre + kReach >= static_cast<long>(v.size())) {
+      continue;
+    }
+    for (long o = -kReach; o <= kReach; ++o) {
+      profile[static_cast<std::size_t>(o + kReach)] += v[static_cast<std::size_t>(centre + o)];
+    }
+    ++count;
+  }
+  if (count == 0) return 0;
+  // The flanks' least-squares line: the tail behind the walls falls with range.
+  double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+  for (long o = -kReach; o <= kReach; ++o) {
+    double& mean = profile[static_cast<std::size_t>(o + kReach)];
+    mean /= static_cast<double>(count);
+    if (o < FidelityReport::kRingFirst || o > FidelityReport::kRingLast) {
+      const auto x = static_cast<double>(o);
+      n += 1.0;
+      sx += x;
+      sy += mean;
+      sxx += x * x;
+      sxy += x * mean;
+    }
+  }
+  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  const double intercept = (sy - slope * sx) / n;
+  for (long o = FidelityReport::kRingFirst; o <= FidelityReport::kRingLast; ++o) {
+    excess += profile[static_cast<std::size_t>(o + kReach)] -
+              (intercept + slope * static_cast<double>(o));
+  }
+  return count;
+}
+
 FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
                               std::span<const mapping::Beam> real,
                               const mapping::SensorGeometry& sensor, double wall_min_range_m) {
@@ -302,6 +347,10 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   r.wall_tail_mean_abs_difference =
       MeanAbsDifference(std::span(r.sim_wall_profile).subspan(tail_start),
                         std::span(r.real_wall_profile).subspan(tail_start));
+  r.sim_second_trip_beams = SecondTripProfile(sim, sim_strongest, first, r.sim_second_trip_profile,
+                                              r.sim_second_trip_excess);
+  r.real_second_trip_beams = SecondTripProfile(
+      real, real_strongest, first, r.real_second_trip_profile, r.real_second_trip_excess);
   r.sim_wall_peak = WallPeaks(sim, sim_strongest);
   r.real_wall_peak = WallPeaks(real, real_strongest);
   std::vector<double> differences;
@@ -367,6 +416,13 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  << r.sim_wall_profile[i] << "," << r.real_wall_profile[i] << "\n";
   }
   WriteText((dir / "wall_profile.csv").string(), wall_profile.str());
+  std::ostringstream second_trip;
+  second_trip << "offset_bins,sim_mean,real_mean\n";
+  for (std::size_t i = 0; i < r.sim_second_trip_profile.size(); ++i) {
+    second_trip << static_cast<long>(i) - FidelityReport::kSecondTripReach << ","
+                << r.sim_second_trip_profile[i] << "," << r.real_second_trip_profile[i] << "\n";
+  }
+  WriteText((dir / "second_trip_profile.csv").string(), second_trip.str());
   std::ostringstream hist;
   hist << "intensity,sim_fraction,real_fraction\n";
   for (std::size_t v = 0; v < 256; ++v) {
@@ -404,6 +460,10 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"wall_peak_intensity_p10_p50_p90_sim", r.sim_wall_peak},
                  {"wall_tail_mean_abs_difference", r.wall_tail_mean_abs_difference},
                  {"wall_peak_intensity_p10_p50_p90_real", r.real_wall_peak},
+                 {"second_trip_excess_sim", r.sim_second_trip_excess},
+                 {"second_trip_excess_real", r.real_second_trip_excess},
+                 {"second_trip_beams_sim", r.sim_second_trip_beams},
+                 {"second_trip_beams_real", r.real_second_trip_beams},
                  {"histogram_intersection", r.histogram_intersection},
                  {"range_correlation_by_lag_sim", r.sim_range_correlation},
                  {"range_correlation_by_lag_real", r.real_range_correlation},
@@ -413,7 +473,7 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"sweep_spread_real", r.real_sweep_spread},
                  {"outputs",
                   {"profile.csv", "profile.png", "wall_range.csv", "wall_profile.csv",
-                   "histogram.csv", "polar.png", "fan.png"}}});
+                   "second_trip_profile.csv", "histogram.csv", "polar.png", "fan.png"}}});
   WriteJson((dir / "fidelity.json").string(), report);
 }
 

@@ -77,6 +77,9 @@ nlohmann::json SensorJson(const SensorModel& s) {
             {"max_bounces", a.max_bounces},
             {"speckle", a.speckle},
             {"speckle_correlation_m", a.speckle_correlation_m},
+            {"reverberation_length_m", a.reverberation_length_m},
+            {"reverberation_db", a.reverberation_db},
+            {"second_trip_db", a.second_trip_db},
             {"ad_low_db", a.ad_low_db},
             {"ad_span_db", a.ad_span_db},
             {"self_reflection_db", a.self_reflection_db}}}};

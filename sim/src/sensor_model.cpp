@@ -17,6 +17,7 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("speckle_correlation_m", a.speckle_correlation_m, InRange(0.0, 1000.0));
   node.Optional("reverberation_length_m", a.reverberation_length_m, InRange(0.0, 1000.0));
   node.Optional("reverberation_db", a.reverberation_db, InRange(-100.0, 20.0));
+  node.Optional("second_trip_db", a.second_trip_db, InRange(-100.0, 20.0));
   node.Optional("ad_low_db", a.ad_low_db, InRange(-300.0, 100.0));
   node.Optional("ad_span_db", a.ad_span_db, InRange(1.0, 200.0));
   node.Optional("self_reflection_db", a.self_reflection_db);

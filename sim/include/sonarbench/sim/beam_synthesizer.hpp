@@ -59,7 +59,8 @@ enum class EchoPower { kKeep, kDrop };
 /// the speckle is the place's, shared by overlapping beams (SectorSpeckle); background noise and
 /// the self-reflection profile add power; the level in dB is mapped to 0..255 by the AD window. In
 /// a closed place (a tank) each bin's echo also feeds a reverberation tail heard after it
-/// (AddReverberation), before speckle.
+/// (AddReverberation), and is heard again at the sum of two trips' ranges after the sonar head
+/// reflects it back out (AddSecondTrip), both before speckle.
 ///
 /// Thread-safe: Synthesize() is const and draws only from a generator seeded by its argument.
 class BeamSynthesizer {
@@ -105,6 +106,20 @@ class BeamSynthesizer {
   /// bin, falls by q per bin and holds R · P_j in all (before the beam's end cuts it). Echoes
   /// feed it, the tail does not. Nothing changes when reverberation_length_m is 0.
   void AddReverberation(std::vector<double>& echo_power) const;
+
+  /// Adds the second trip (Acoustics::second_trip_db) to a beam's noise-free echo power per bin
+  /// (in place), from the first trip's: `echo_power`, its echoes spread over the pulse, and
+  /// `impulse_power`, the same echoes each spread over one bin instead (the surfaces' response
+  /// without the pulse). The echo the head reflects goes out again and comes back from the same
+  /// surfaces: one trip to range r and one to r' are heard at r + r', so with the time-varied
+  /// gain g(r) = r^(G/10) taken off each trip and put back at the sum,
+  ///     P2(R) = T · g(R) · Σ_{r + r' = R} (P(r) / g(r)) · (h(r') / g(r')),
+  /// T = 10^(second_trip_db/10). Per bin, r = (i + ½) bins for bin i, and the pair (i, j), whose
+  /// ranges span [i + j, i + j + 2) bins, gives half to bin i + j and half to i + j + 1. Bins i
+  /// under 1e-6 of the largest P/g are skipped, and j runs from the first to the last bin with
+  /// h/g over 1e-6 of its largest; the sum stops at the last bin. Nothing changes at -100 dB
+  /// (the default).
+  void AddSecondTrip(std::vector<double>& echo_power, std::span<const double> impulse_power) const;
 
   /// Speckle factors for consecutive range bins: factor k is |Σ g_j|² / L over the L bins
   /// j = k - L + 1 .. k, the g_j independent circular complex Gaussians of unit power (an
@@ -172,6 +187,11 @@ class BeamSynthesizer {
   /// Whether any material is a rough mirror: only then do mirror paths track their image (the
   /// way back's direction).
   bool rough_mirrors_ = false;
+  /// The second trip's level T (0: none) and, per bin i, the time-varied gain r^(G/10) at its
+  /// centre r = (i + ½) bins and its inverse (AddSecondTrip).
+  double second_trip_ = 0.0;
+  std::vector<double> tvg_at_bin_;
+  std::vector<double> untvg_at_bin_;
   /// The self-reflection profile as linear power per bin.
   std::vector<double> self_reflection_power_;
   /// The speckle's correlation window: the pulse length in bins, rounded, at least 1.

@@ -47,6 +47,22 @@ struct FidelityReport {
   /// strongest echo to the end: the tail behind the walls (reverberation, ghosts) alone.
   double wall_tail_mean_abs_difference = 0.0;
   static constexpr int kWallTailStart = 16;
+  /// The second trip (the echo the sonar head sends out again): the mean intensity aligned on
+  /// twice each beam's strongest bin beyond `wall_min_range_m`, entry i at offset
+  /// i - kSecondTripReach, over the beams whose whole window lies in the usable bins. Its
+  /// excess: Σ over the ring's offsets [kRingFirst, kRingLast] of (mean - the flanks' line),
+  /// the flanks being the window's other offsets and their line the least-squares fit to their
+  /// means (the tail behind the walls falls with range) [intensity × bins]. Without a second
+  /// trip nothing marks twice the strongest bin, and the excess is near 0.
+  std::vector<double> sim_second_trip_profile;
+  std::vector<double> real_second_trip_profile;
+  double sim_second_trip_excess = 0.0;
+  double real_second_trip_excess = 0.0;
+  std::size_t sim_second_trip_beams = 0;
+  std::size_t real_second_trip_beams = 0;
+  static constexpr int kSecondTripReach = 40;
+  static constexpr int kRingFirst = -30;
+  static constexpr int kRingLast = 10;
   /// Median over head angles of |sim - real| wall range, in bins; and how many angles had both.
   double median_wall_difference_bins = 0.0;
   std::size_t wall_angles_compared = 0;
@@ -86,8 +102,16 @@ struct FidelityReport {
 /// Pearson correlation of two equally long series (0 if either is constant).
 [[nodiscard]] double PearsonCorrelation(std::span<const double> a, std::span<const double> b);
 
-/// Writes fidelity.json, profile.csv, wall_range.csv, wall_profile.csv, histogram.csv,
-/// profile.png (the two mean
+/// The second-trip profile and excess of FidelityReport for `beams`, whose strongest bins
+/// beyond the walls' minimum range are `strongest` and whose usable bins start at
+/// `first_usable`; returns how many beams it averaged.
+std::size_t SecondTripProfile(std::span<const mapping::Beam> beams,
+                              std::span<const std::optional<std::size_t>> strongest,
+                              std::size_t first_usable, std::vector<double>& profile,
+                              double& excess);
+
+/// Writes fidelity.json, profile.csv, wall_range.csv, wall_profile.csv,
+/// second_trip_profile.csv, histogram.csv, profile.png (the two mean
 /// profiles), and polar and fan images of each run's first sweep side by side (sim left, real
 /// right) into `out_dir`.
 void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& report,

@@ -27,7 +27,8 @@ class PulseSpreader {
 
   /// Adds `power` per bin over [start, end) bins (start ≤ end; parts beyond the last bin, or
   /// before bin 0, are dropped).
-  void Add(double start, double end, double power) {
+  // Inlined: the synthesis calls it for every echo of every ray.
+  [[gnu::always_inline]] void Add(double start, double end, double power) {
     Edge(start, power, 1);
     Edge(end, -power, -1);
   }
@@ -47,7 +48,7 @@ class PulseSpreader {
   }
 
  private:
-  void Edge(double at, double power, int count) {
+  [[gnu::always_inline]] void Edge(double at, double power, int count) {
     at = std::max(at, 0.0);
     if (!(at < static_cast<double>(edges_.size()))) return;
     const auto k = static_cast<std::size_t>(at);

@@ -50,6 +50,12 @@ struct Acoustics {
   /// BeamSynthesizer).
   double reverberation_length_m = 0.0;
   double reverberation_db = -20.0;
+  /// The second trip: the echo reflected back out by the sonar head and vehicle, heard again
+  /// from the same surfaces at the sum of the two ranges (a wall at r rings again at 2r, as the
+  /// real tank log does at 4.5-5 m). Its level [dB]: the head's reflection loss plus the
+  /// reference echo's level against the transmission, one number fitted to a log. -100, the
+  /// default, is none (not computed). See BeamSynthesizer::AddSecondTrip.
+  double second_trip_db = -100.0;
   /// Level mapped to intensity 0, and the span [dB] mapped onto 0..255 (the Micron's ADLow/ADSpan).
   double ad_low_db = -40.0;
   double ad_span_db = 40.0;
