@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <vector>
 
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
+#include "sonarbench/sim/dataset_writer.hpp"
 #include "sonarbench/sim/scene.hpp"
 #include "sonarbench/sim/sensor_model.hpp"
 #include "test_util.hpp"
@@ -202,10 +205,10 @@ TEST(SceneFile, ReverberationIsTheScenes) {
   }
 }
 
-// The scenes built on the fitted tank (the two that must fail, and the crate) restate its
-// acoustics, materials and detection rather than include them: they must stay in step with
-// scenes/cras-tank.yaml, or they no longer test what their comments say. The two must-fail
-// scenes also keep the tank's criteria, only expecting them to fail.
+// The scenes built on the fitted tank (the two that must fail, and the crate) extend it: they
+// must keep its acoustics, materials and detection, or they no longer test what their comments
+// say. The two must-fail scenes also keep the tank's criteria, only expecting them to fail, and
+// change only what they hold: 16 vertical rays, a drifting navigation.
 TEST(SceneFile, TankScenesShareTheFittedTank) {
   const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   for (const char* name : {"scenes/cras-tank-sparse-rays.yaml", "scenes/cras-tank-nav-drift.yaml",
@@ -223,7 +226,139 @@ TEST(SceneFile, TankScenesShareTheFittedTank) {
       EXPECT_TRUE(scene.criteria.expect_fail);
       EXPECT_EQ(scene.criteria.metrics, tank.criteria.metrics);
     }
+    EXPECT_EQ(scene.extends, std::vector<std::string>{test::SourcePath("scenes/cras-tank.yaml")});
   }
+  const sim::Scene sparse = sim::LoadScene(test::SourcePath("scenes/cras-tank-sparse-rays.yaml"));
+  EXPECT_EQ(sparse.mapping.rays_vertical, 16);
+  EXPECT_EQ(sparse.mapping.rays_horizontal, tank.mapping.rays_horizontal);
+  const sim::Scene drift = sim::LoadScene(test::SourcePath("scenes/cras-tank-nav-drift.yaml"));
+  EXPECT_EQ(drift.navigation.position_noise_m, 0.02);
+  EXPECT_EQ(drift.mapping.rays_vertical, tank.mapping.rays_vertical);
+}
+
+// Writes `text` to the file `name` in `dir`; returns its path.
+std::string WriteText(const test::TempDir& dir, const std::string& name, const std::string& text) {
+  const std::string path = (dir.path() / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+// A scene that extends another: the base first, then only what the derived file names changes
+// it (key by key, materials by name, meshes added, criteria metrics whole), and a scene that
+// extends none is read as before.
+TEST(SceneFile, ExtendsChangesOnlyWhatItNames) {
+  test::TempDir dir;
+  const auto write = [&](const std::string& name, const std::string& text) {
+    return WriteText(dir, name, text);
+  };
+  write("base.yaml",
+        "name: base\nsensor_model: " + test::SourcePath("sensor-models/shad-micron.yaml") +
+            "\nseed: 4\nsweeps: 3\nstart_head_angle_deg: 90\n"
+            "sonar_acoustics: {gain_db: 6.0, max_bounces: 2}\n"
+            "materials:\n"
+            "  - {name: rock, reflectivity: 0.8}\n"
+            "  - {name: sand, reflectivity: 0.3, backscatter_exponent: 0.5}\n"
+            "meshes:\n"
+            "  - {name: bed, type: plane, size_m: [10, 10, 0], material: sand}\n"
+            "trajectory: {type: static, position_m: [0, 0, 2]}\n"
+            "navigation: {position_noise_m: 0.01, heading_noise_deg: 0.5}\n"
+            "mapping: {resolution_m: 0.1, detection: {method: canny, canny_low: 40, "
+            "canny_high: 90}}\n"
+            "criteria:\n  metrics:\n    coverage: {min: 0.5}\n");
+  const std::string derived_path =
+      write("derived.yaml",
+            "name: derived\nextends: base.yaml\nsweeps: 5\n"
+            "sonar_acoustics: {noise_level_db: -50.0}\n"
+            "materials:\n"
+            "  - {name: sand, reflectivity: 0.1}\n"
+            "  - {name: steel, reflectivity: 0.9}\n"
+            "meshes:\n"
+            "  - {name: pipe, type: box, size_m: [0.3, 4, 0.3], material: steel}\n"
+            "navigation: {heading_noise_deg: 1.0}\n"
+            "mapping: {detection: {canny_high: 120}}\n"
+            "criteria: {expect: fail}\n");
+  const sim::Scene base = sim::LoadScene((dir.path() / "base.yaml").string());
+  const sim::Scene derived = sim::LoadScene(derived_path);
+  EXPECT_EQ(derived.name, "derived");
+  EXPECT_EQ(derived.file, derived_path);
+  EXPECT_EQ(derived.extends, std::vector<std::string>{(dir.path() / "base.yaml").string()});
+  EXPECT_TRUE(base.extends.empty());
+  EXPECT_EQ(derived.sensor_model_file, base.sensor_model_file);
+  EXPECT_EQ(derived.seed, 4u);
+  EXPECT_EQ(derived.sweeps, 5);
+  EXPECT_EQ(derived.start_head_angle_rad, base.start_head_angle_rad);
+  // Acoustics: the base's gain and bounces kept, the noise changed.
+  sim::Acoustics acoustics = base.sensor.acoustics;
+  acoustics.noise_level_db = -50.0;
+  EXPECT_EQ(derived.sensor.acoustics, acoustics);
+  // Materials by name: sand replaced whole (its exponent back to the default), steel added.
+  ASSERT_EQ(derived.materials.size(), 3u);
+  EXPECT_EQ(derived.materials[0], base.materials[0]);
+  EXPECT_EQ(derived.materials[1].name, "sand");
+  EXPECT_EQ(derived.materials[1].reflectivity, 0.1);
+  EXPECT_EQ(derived.materials[1].backscatter_exponent, sim::Material{}.backscatter_exponent);
+  EXPECT_EQ(derived.materials[2].name, "steel");
+  // Meshes added; the bed keeps its material (sand, replaced), the pipe takes steel.
+  ASSERT_EQ(derived.meshes.size(), 2u);
+  EXPECT_EQ(derived.meshes[0].name, "bed");
+  EXPECT_EQ(derived.meshes[0].material, 1u);
+  EXPECT_EQ(derived.meshes[1].name, "pipe");
+  EXPECT_EQ(derived.meshes[1].material, 2u);
+  // Navigation and mapping key by key.
+  EXPECT_EQ(derived.navigation.position_noise_m, 0.01);
+  EXPECT_NEAR(derived.navigation.heading_noise_rad, 1.0 * mapping::kDegToRad, 1e-15);
+  EXPECT_EQ(derived.mapping.resolution_m, 0.1);
+  EXPECT_EQ(derived.mapping.detection.method, mapping::DetectionConfig::Method::kCanny);
+  EXPECT_EQ(derived.mapping.detection.canny_low, 40.0);
+  EXPECT_EQ(derived.mapping.detection.canny_high, 120.0);
+  // Criteria: expect replaced, the metrics kept.
+  EXPECT_TRUE(derived.criteria.expect_fail);
+  EXPECT_EQ(derived.criteria.metrics, base.criteria.metrics);
+  // The dataset's configuration hash covers the base: change it, and the derived scene's
+  // changes too.
+  const std::string hash = sim::SceneConfigHash(derived, 1);
+  write(
+      "base.yaml", "# edited\n" + [&] {
+        std::ifstream in((dir.path() / "base.yaml").string());
+        return std::string(std::istreambuf_iterator<char>(in), {});
+      }());
+  EXPECT_NE(sim::SceneConfigHash(sim::LoadScene(derived_path), 1), hash);
+}
+
+// What a derived scene may not do, each a clear error naming the file, line and key: take its
+// own sensor model, reuse a mesh name, extend in a loop (or itself), or extend a broken base
+// (named in the base's own file).
+TEST(SceneFile, ExtendsRefusesWhatItCannotMean) {
+  test::TempDir dir;
+  const auto write = [&](const std::string& name, const std::string& text) {
+    return WriteText(dir, name, text);
+  };
+  const std::string model = test::SourcePath("sensor-models/shad-micron.yaml");
+  write("base.yaml", "name: base\nsensor_model: " + model +
+                         "\nsweeps: 1\nmaterials: [{name: m, reflectivity: 0.5}]\n"
+                         "meshes: [{name: bed, type: plane, size_m: [1, 1, 0], material: m}]\n"
+                         "trajectory: {type: static, position_m: [0, 0, 1]}\n");
+  const std::string own_model =
+      write("own_model.yaml", "name: x\nextends: base.yaml\nsensor_model: " + model + "\n");
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(own_model); },
+                                   {"own_model.yaml:3:", "'sensor_model'", "takes its model"}));
+  const std::string same_mesh =
+      write("same_mesh.yaml",
+            "name: x\nextends: base.yaml\n"
+            "meshes:\n  - {name: bed, type: plane, size_m: [2, 2, 0], material: m}\n");
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(same_mesh); },
+                                   {"same_mesh.yaml:4:", "'meshes[0].name'", "not used before"}));
+  write("a.yaml", "name: a\nextends: b.yaml\n");
+  const std::string b = write("b.yaml", "name: b\nextends: a.yaml\n");
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(b); },
+                                   {"a.yaml:2:", "'extends'", "outside the chain"}));
+  const std::string self = write("self.yaml", "name: s\nextends: self.yaml\n");
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(self); },
+                                   {"self.yaml:2:", "'extends'", "outside the chain"}));
+  write("broken.yaml", "name: broken\nsensor_model: " + model + "\nsweeps: 0\n");
+  const std::string on_broken = write("on_broken.yaml", "name: x\nextends: broken.yaml\n");
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(on_broken); },
+                                   {"broken.yaml:3:", "'sweeps'"}));
 }
 
 TEST(SceneFile, MissingFileIsAnInputError) {

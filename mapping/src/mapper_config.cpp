@@ -2,14 +2,16 @@
 
 namespace sonarbench::mapping {
 
-MapperConfig ReadMapperConfig(YamlReader& node) {
-  MapperConfig c;
+MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
+  MapperConfig c = std::move(base);
   node.Optional("resolution_m", c.resolution_m, InRange(0.001, 10.0));
   node.Optional("rays_horizontal", c.rays_horizontal, IntInRange(1, 4096));
   node.Optional("rays_vertical", c.rays_vertical, IntInRange(1, 4096));
   if (auto detection = node.OptionalChild("detection")) {
     DetectionConfig& d = c.detection;
-    std::string method = "threshold";
+    std::string method = d.method == DetectionConfig::Method::kThreshold ? "threshold"
+                         : d.method == DetectionConfig::Method::kCanny   ? "canny"
+                                                                         : "auto_canny";
     detection->Optional("method", method, OneOf({"threshold", "canny", "auto_canny"}));
     d.method = method == "threshold" ? DetectionConfig::Method::kThreshold
                : method == "canny"   ? DetectionConfig::Method::kCanny
@@ -30,7 +32,7 @@ MapperConfig ReadMapperConfig(YamlReader& node) {
       detection->Fail("canny_low", "a value no greater than canny_high");
     }
   }
-  std::string key_set = "open_addressing";
+  std::string key_set = c.key_set == KeySetKind::kStd ? "std" : "open_addressing";
   node.Optional("key_set", key_set, OneOf({"open_addressing", "std"}));
   c.key_set = key_set == "std" ? KeySetKind::kStd : KeySetKind::kOpenAddressing;
   node.Optional("prob_hit", c.prob_hit, InRange(0.5, 1.0));

@@ -105,11 +105,17 @@ double MetricValue(const MapMetrics& metrics, const std::string& name) {
   return NAN;
 }
 
-Criteria ReadCriteria(YamlReader& node, const std::vector<std::string>& mesh_names) {
-  Criteria criteria;
-  std::string expect = "pass";
+Criteria ReadCriteria(YamlReader& node, const std::vector<std::string>& mesh_names,
+                      const Criteria* base) {
+  Criteria criteria = base ? *base : Criteria{};
+  std::string expect = criteria.expect_fail ? "fail" : "pass";
   node.Optional("expect", expect, OneOf({"pass", "fail"}));
   criteria.expect_fail = expect == "fail";
+  if (base && !node.Has("metrics")) {
+    node.RejectUnknownKeys();
+    return criteria;
+  }
+  criteria.metrics.clear();
   YamlReader metrics = node.Child("metrics");
   for (const std::string& name : metrics.Keys()) {
     YamlReader entry = metrics.Child(name);

@@ -206,6 +206,12 @@ std::string SceneConfigHash(const Scene& scene, std::uint64_t seed) {
     meshes.push_back(mesh.file.empty() ? json(nullptr) : json(mapping::Sha256OfFile(mesh.file)));
   }
   inputs["mesh_files_sha256"] = meshes;
+  // The scenes it extends are part of it (a scene that extends none hashes as it always did).
+  if (!scene.extends.empty()) {
+    json bases = json::array();
+    for (const std::string& file : scene.extends) bases.push_back(mapping::Sha256OfFile(file));
+    inputs["extends_sha256"] = bases;
+  }
   return mapping::Sha256(inputs.dump());
 }
 

@@ -1,6 +1,8 @@
 #include "sonarbench/sim/scene.hpp"
 
+#include <algorithm>
 #include <filesystem>
+#include <optional>
 
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/mesh_file.hpp"
@@ -124,45 +126,108 @@ Eigen::Isometry3d Trajectory::T_world_vehicle(double time_s) const {
   return pose;
 }
 
-Scene LoadScene(const std::string& path) {
-  Scene scene;
-  scene.file = path;
-  YamlReader root = YamlReader::FromFile(path);
-  root.Required("name", scene.name);
-  root.Required("sensor_model", scene.sensor_model_file);
-  root.Optional("seed", scene.seed);
-  root.Required("sweeps", scene.sweeps, IntInRange(1, 100000));
-  double start_deg = 0.0;
-  root.Optional("start_head_angle_deg", start_deg, InRange(-360.0, 360.0));
-  scene.start_head_angle_rad = start_deg * kDegToRad;
+namespace {
 
-  for (YamlReader& item : root.Sequence("materials")) {
-    Material m;
-    item.Required("name", m.name);
-    item.Required("reflectivity", m.reflectivity, InRange(0.0, 1.0));
-    item.Optional("backscatter_exponent", m.backscatter_exponent, InRange(0.0, 100.0));
-    item.Optional("specular", m.specular, InRange(0.0, 1.0));
-    double spread_deg = 0.0;
-    item.Optional("specular_spread_deg", spread_deg, InRange(0.0, 30.0));
-    m.specular_spread_rad = spread_deg * kDegToRad;
-    item.RejectUnknownKeys();
-    scene.materials.push_back(m);
+// Scenes may extend one another this deep at most (a chain longer than this is surely a loop).
+constexpr std::size_t kMaxExtends = 8;
+
+// LoadScene, with the files being extended (the chain) that led to `path`.
+Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
+  YamlReader root = YamlReader::FromFile(path);
+  auto resolve = [&](const std::string& file) {
+    std::filesystem::path resolved(file);
+    if (resolved.is_relative()) resolved = std::filesystem::path(root.Directory()) / resolved;
+    return resolved.lexically_normal().string();
+  };
+  // A scene that extends another starts from it, loaded (and its errors reported) first.
+  std::optional<Scene> base;
+  std::string extends;
+  root.Optional("extends", extends);
+  if (!extends.empty()) {
+    const std::string base_path = resolve(extends);
+    chain.push_back(std::filesystem::path(path).lexically_normal().string());
+    if (std::find(chain.begin(), chain.end(), base_path) != chain.end() ||
+        chain.size() > kMaxExtends) {
+      std::string loop;
+      for (const std::string& file : chain) loop += file + " -> ";
+      root.Fail("extends", "a scene outside the chain of extends (" + loop + base_path + ")");
+      root.ThrowIfErrors();
+    }
+    base = LoadSceneIn(base_path, chain);
+    chain.pop_back();
   }
-  for (YamlReader& item : root.Sequence("meshes")) {
-    scene.meshes.push_back(ReadMesh(item, scene.materials));
+  Scene scene = base ? *base : Scene{};
+  scene.file = path;
+  if (base) scene.extends.insert(scene.extends.begin(), base->file);
+  root.Required("name", scene.name);
+  if (!base) {
+    root.Required("sensor_model", scene.sensor_model_file);
+  } else if (root.Has("sensor_model")) {
+    root.Fail("sensor_model", "no sensor_model: a scene that extends another takes its model");
   }
-  YamlReader trajectory = root.Child("trajectory");
-  scene.trajectory = ReadTrajectory(trajectory);
+  root.Optional("seed", scene.seed);
+  if (base) {
+    root.Optional("sweeps", scene.sweeps, IntInRange(1, 100000));
+  } else {
+    root.Required("sweeps", scene.sweeps, IntInRange(1, 100000));
+  }
+  if (root.Has("start_head_angle_deg")) {
+    double start_deg = 0.0;
+    root.Required("start_head_angle_deg", start_deg, InRange(-360.0, 360.0));
+    scene.start_head_angle_rad = start_deg * kDegToRad;
+  }
+
+  // Materials by name: one the base has is replaced, a new one added.
+  if (!base || root.Has("materials")) {
+    for (YamlReader& item : root.Sequence("materials")) {
+      Material m;
+      item.Required("name", m.name);
+      item.Required("reflectivity", m.reflectivity, InRange(0.0, 1.0));
+      item.Optional("backscatter_exponent", m.backscatter_exponent, InRange(0.0, 100.0));
+      item.Optional("specular", m.specular, InRange(0.0, 1.0));
+      double spread_deg = 0.0;
+      item.Optional("specular_spread_deg", spread_deg, InRange(0.0, 30.0));
+      m.specular_spread_rad = spread_deg * kDegToRad;
+      item.RejectUnknownKeys();
+      const auto same = std::find_if(scene.materials.begin(), scene.materials.end(),
+                                     [&](const Material& b) { return b.name == m.name; });
+      if (same != scene.materials.end() && base) {
+        *same = m;
+      } else {
+        scene.materials.push_back(m);
+      }
+    }
+  }
+  // Meshes are added to the base's; their names must be new.
+  const std::size_t base_meshes = scene.meshes.size();
+  if (!base || root.Has("meshes")) {
+    for (YamlReader& item : root.Sequence("meshes")) {
+      MeshSpec mesh = ReadMesh(item, scene.materials);
+      if (std::any_of(scene.meshes.begin(), scene.meshes.end(),
+                      [&](const MeshSpec& m) { return m.name == mesh.name; })) {
+        item.Fail("name", "a mesh name not used before in the scene, got '" + mesh.name + "'");
+      }
+      scene.meshes.push_back(std::move(mesh));
+    }
+  }
+  if (!base || root.Has("trajectory")) {
+    YamlReader trajectory = root.Child("trajectory");
+    scene.trajectory = ReadTrajectory(trajectory);
+  }
   if (auto nav = root.OptionalChild("navigation")) {
-    double heading_drift_deg = 0.0;
-    double heading_noise_deg = 0.0;
-    nav->Optional("drift_m_per_s", scene.navigation.drift_m_per_s);
-    nav->Optional("heading_drift_deg_per_s", heading_drift_deg, InRange(-90.0, 90.0));
-    nav->Optional("position_noise_m", scene.navigation.position_noise_m, InRange(0.0, 100.0));
-    nav->Optional("heading_noise_deg", heading_noise_deg, InRange(0.0, 90.0));
+    NavigationError& n = scene.navigation;
+    nav->Optional("drift_m_per_s", n.drift_m_per_s);
+    nav->Optional("position_noise_m", n.position_noise_m, InRange(0.0, 100.0));
+    // Only the keys given change the base's (a round trip through degrees could move it).
+    const auto read_degrees = [&](const char* key, double low, double high, double& out_rad) {
+      if (!nav->Has(key)) return;
+      double degrees = 0.0;
+      nav->Required(key, degrees, InRange(low, high));
+      out_rad = degrees * kDegToRad;
+    };
+    read_degrees("heading_drift_deg_per_s", -90.0, 90.0, n.heading_drift_rad_per_s);
+    read_degrees("heading_noise_deg", 0.0, 90.0, n.heading_noise_rad);
     nav->RejectUnknownKeys();
-    scene.navigation.heading_drift_rad_per_s = heading_drift_deg * kDegToRad;
-    scene.navigation.heading_noise_rad = heading_noise_deg * kDegToRad;
   }
   std::optional<Eigen::Isometry3d> T_vehicle_sonar;
   if (auto mounting = root.OptionalChild("sonar_mounting")) {
@@ -178,23 +243,20 @@ Scene LoadScene(const std::string& path) {
     acoustics->RejectUnknownKeys();
   }
   if (auto mapping = root.OptionalChild("mapping")) {
-    scene.mapping = mapping::ReadMapperConfig(*mapping);
+    scene.mapping = mapping::ReadMapperConfig(*mapping, scene.mapping);
   }
   if (auto criteria = root.OptionalChild("criteria")) {
     std::vector<std::string> mesh_names;
     for (const MeshSpec& mesh : scene.meshes) mesh_names.push_back(mesh.name);
-    scene.criteria = ReadCriteria(*criteria, mesh_names);
+    scene.criteria = ReadCriteria(*criteria, mesh_names, base ? &scene.criteria : nullptr);
   }
   root.RejectUnknownKeys();
   root.ThrowIfErrors();
 
-  // The sensor model is its own file, read (and its errors reported) only once the scene is sound.
-  auto resolve = [&](const std::string& file) {
-    std::filesystem::path resolved(file);
-    if (resolved.is_relative()) resolved = std::filesystem::path(root.Directory()) / resolved;
-    return resolved.lexically_normal().string();
-  };
-  for (MeshSpec& mesh : scene.meshes) {
+  // Mesh files and the sensor model are their own files, read (and their errors reported) only
+  // once the scene is sound; a base's were read with it.
+  for (std::size_t i = base_meshes; i < scene.meshes.size(); ++i) {
+    MeshSpec& mesh = scene.meshes[i];
     if (mesh.type != MeshSpec::Type::kFile) continue;
     mesh.file = resolve(mesh.file);
     try {
@@ -205,12 +267,20 @@ Scene LoadScene(const std::string& path) {
       throw InputError(path + ": mesh '" + mesh.name + "': " + e.what());
     }
   }
-  std::filesystem::path sensor_path = resolve(scene.sensor_model_file);
-  scene.sensor_model_file = sensor_path.lexically_normal().string();
-  scene.sensor = LoadSensorModel(scene.sensor_model_file);
+  if (!base) {
+    scene.sensor_model_file = resolve(scene.sensor_model_file);
+    scene.sensor = LoadSensorModel(scene.sensor_model_file);
+  }
   if (T_vehicle_sonar) scene.sensor.geometry.T_vehicle_sonar = *T_vehicle_sonar;
   if (acoustics) ReadAcoustics(*acoustics, scene.sensor.acoustics);
   return scene;
+}
+
+}  // namespace
+
+Scene LoadScene(const std::string& path) {
+  std::vector<std::string> chain;
+  return LoadSceneIn(path, chain);
 }
 
 }  // namespace sonarbench::sim

@@ -65,7 +65,8 @@ struct MapperConfig {
   KeySetKind key_set = KeySetKind::kOpenAddressing;
 };
 
-/// Reads a `mapping` mapping of a scene file.
-[[nodiscard]] MapperConfig ReadMapperConfig(YamlReader& node);
+/// Reads a `mapping` mapping of a scene file over `base` (absent keys keep its values; by default
+/// the struct's defaults).
+[[nodiscard]] MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base = {});
 
 }  // namespace sonarbench::mapping

@@ -48,7 +48,10 @@ inline constexpr const char* kMeshRecallPrefix = "mesh_recall.";
 
 /// Reads the `criteria` mapping of a scene (`expect: pass|fail`, `metrics: {name: bounds}`);
 /// `mesh_names` are the scene's meshes. Errors are collected in `node` like every other key.
-[[nodiscard]] Criteria ReadCriteria(YamlReader& node, const std::vector<std::string>& mesh_names);
+/// Over a `base` (the criteria of the scene this one extends), `metrics` is optional: given, it
+/// replaces the base's metrics whole; absent, they stay, as does `expect` when absent.
+[[nodiscard]] Criteria ReadCriteria(YamlReader& node, const std::vector<std::string>& mesh_names,
+                                    const Criteria* base = nullptr);
 
 /// The value of a criterion's metric, NaN when the metrics do not hold it.
 [[nodiscard]] double MetricValue(const MapMetrics& metrics, const std::string& name);

@@ -96,6 +96,8 @@ struct NavigationError {
 struct Scene {
   std::string name;
   std::string file;
+  /// The scenes this one extends (`extends:`), its base first, then the base's base and so on.
+  std::vector<std::string> extends;
   std::string sensor_model_file;
   /// The sensor model; the scene's optional `sonar_mounting` (position_m, rpy_deg) replaces the
   /// model's mounting, since where the sonar sits is the vehicle's business, not the sonar's, and
@@ -119,6 +121,18 @@ struct Scene {
 };
 
 /// Loads a scene YAML file and the sensor model it names (relative to the scene file).
+///
+/// A scene may extend another (`extends: FILE`, relative to it; chains allowed, loops refused):
+/// the base is loaded first (its errors name its file), then this file's keys change it:
+/// - `name` is required; `sensor_model` is refused (the base's model, as it set it); `seed`,
+///   `sweeps` and `start_head_angle_deg` replace the base's;
+/// - `materials`: one named as a base material replaces it, a new name is added;
+/// - `meshes`: added to the base's (a name the base uses is an error);
+/// - `trajectory` and `sonar_mounting` replace the base's whole;
+/// - `navigation`, `sonar_acoustics` and `mapping` (with its `detection`): key by key over
+///   the base's;
+/// - `criteria`: `expect` replaces the base's, and `metrics`, when given, replace its metrics
+///   whole (absent, they stay).
 [[nodiscard]] Scene LoadScene(const std::string& path);
 
 }  // namespace sonarbench::sim
