@@ -83,6 +83,26 @@ TEST(YamlReader, NonFiniteNumbersAreRejected) {
                                    {"'resolution_m'", "a finite number"}));
 }
 
+// A failure recorded at a key names that key's line and leaves the mapping as it was: the keys
+// after it still read (yaml-cpp assigns through a Node that shares another, so pointing at the
+// key's value must rebind, not assign).
+TEST(YamlReader, FailAtAKeyLeavesTheMappingIntact) {
+  YamlReader reader = YamlReader::FromString("a: 1\nb: 2\nc: 3\n", "scene.yaml");
+  reader.Fail("b", "something else");
+  int a = 0;
+  int c = 0;
+  reader.Required("a", a);
+  reader.Required("c", c);
+  EXPECT_EQ(a, 1);
+  EXPECT_EQ(c, 3);
+  EXPECT_EQ(reader.Keys(), (std::vector<std::string>{"a", "b", "c"}));
+  const std::string message = test::InputErrorOf([&] { reader.ThrowIfErrors(); });
+  EXPECT_NE(message.find("scene.yaml:2:"), std::string::npos) << message;
+  EXPECT_NE(message.find("key 'b': something else"), std::string::npos) << message;
+  EXPECT_EQ(message.find("'a'"), std::string::npos) << message;
+  EXPECT_EQ(message.find("'c'"), std::string::npos) << message;
+}
+
 TEST(YamlReader, SyntaxErrorNamesFileAndLine) {
   EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("a: [1, 2\nb: 3\n"); },
                                    {"scene.yaml:", "invalid YAML"}));

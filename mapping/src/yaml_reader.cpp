@@ -182,9 +182,11 @@ std::vector<std::string> YamlReader::Keys() const {
 }
 
 void YamlReader::Fail(const std::string& key, const std::string& expected) {
+  // reset(), not `=`: assigning to a Node that shares node_ would overwrite node_ itself (yaml-cpp
+  // assigns through to the referenced node), mid-iteration.
   YAML::Node at = node_;
   for (const auto& item : node_) {
-    if (item.first.Scalar() == key) at = item.second;
+    if (item.first.Scalar() == key) at.reset(item.second);
   }
   state_->errors.push_back(Where(at) + ": key '" + KeyPath(key) + "': " + expected);
 }
