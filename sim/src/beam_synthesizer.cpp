@@ -436,8 +436,8 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const double max_range = g.MaxRangeM();
   Rng rng(seed);
   thread_local Scratch scratch;
-  PulseSpreader& spreader =
-      scratch.spreader;  // a local reference: no thread-local look-up per echo
+  // A local reference: no thread-local look-up per echo.
+  PulseSpreader& spreader = scratch.spreader;
   if (spreader.Bins() != bins) spreader.Reset(bins);  // AddTo() leaves it empty
   std::vector<double>& impulse = scratch.impulse_power;
   if (second_trip_ > 0.0) impulse.assign(bins, 0.0);
