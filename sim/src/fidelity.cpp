@@ -409,20 +409,20 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
           << field(r.real_wall_peak_by_angle[a]) << "\n";
   }
   WriteText((dir / "wall_range.csv").string(), walls.str());
-  std::ostringstream wall_profile;
-  wall_profile << "offset_bins,sim_mean,real_mean\n";
-  for (std::size_t i = 0; i < r.sim_wall_profile.size(); ++i) {
-    wall_profile << static_cast<long>(i) - FidelityReport::kWallProfileBefore << ","
-                 << r.sim_wall_profile[i] << "," << r.real_wall_profile[i] << "\n";
-  }
-  WriteText((dir / "wall_profile.csv").string(), wall_profile.str());
-  std::ostringstream second_trip;
-  second_trip << "offset_bins,sim_mean,real_mean\n";
-  for (std::size_t i = 0; i < r.sim_second_trip_profile.size(); ++i) {
-    second_trip << static_cast<long>(i) - FidelityReport::kSecondTripReach << ","
-                << r.sim_second_trip_profile[i] << "," << r.real_second_trip_profile[i] << "\n";
-  }
-  WriteText((dir / "second_trip_profile.csv").string(), second_trip.str());
+  // An aligned profile, entry i at offset i - before.
+  const auto write_aligned = [&](const char* name, const std::vector<double>& sim,
+                                 const std::vector<double>& real, long before) {
+    std::ostringstream csv;
+    csv << "offset_bins,sim_mean,real_mean\n";
+    for (std::size_t i = 0; i < sim.size(); ++i) {
+      csv << static_cast<long>(i) - before << "," << sim[i] << "," << real[i] << "\n";
+    }
+    WriteText((dir / name).string(), csv.str());
+  };
+  write_aligned("wall_profile.csv", r.sim_wall_profile, r.real_wall_profile,
+                FidelityReport::kWallProfileBefore);
+  write_aligned("second_trip_profile.csv", r.sim_second_trip_profile, r.real_second_trip_profile,
+                FidelityReport::kSecondTripReach);
   std::ostringstream hist;
   hist << "intensity,sim_fraction,real_fraction\n";
   for (std::size_t v = 0; v < 256; ++v) {
