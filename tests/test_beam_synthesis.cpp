@@ -182,6 +182,71 @@ TEST(BeamSynthesis, ReverberationTailDecaysAtItsLengthAndHoldsItsShare) {
   EXPECT_NEAR(total_tail / total_echo, std::pow(10.0, -0.3), 1e-6);
 }
 
+// The pulse's skirts, exactly: one echo of power P in bin j keeps P / (1 + S) there and puts
+// P · S (1 - q) / (2q) · q^m / (1 + S) m bins to either side, q = exp(-bin / length),
+// S = 10^(db/10); the whole echo's power is kept (the two skirts' geometric series, which the
+// beam's ends cut at q^199 < 1e-21 here), and each side's bins fall by q. Nothing changes at length
+// 0.
+TEST(BeamSynthesis, PulseSkirtsShareTheEchoExponentiallyOnBothSides) {
+  SensorModel sensor = QuietSensor();
+  sensor.acoustics.pulse_skirt_length_m = 0.05;
+  sensor.acoustics.pulse_skirt_db = 3.0;
+  const RayTracer tracer(Wall(1.0, 0.0));
+  const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
+  const auto bins = static_cast<std::size_t>(sensor.geometry.num_bins);
+  const double q = std::exp(-sensor.geometry.bin_size_m / 0.05);
+  const double share = std::pow(10.0, 0.3);
+  std::vector<double> echo(bins, 0.0);
+  echo[200] = 2.0;
+  std::vector<double> heard = echo;
+  synthesizer.AddPulseSkirts(heard);
+  for (std::size_t k = 0; k < bins; ++k) {
+    const double m = std::abs(static_cast<double>(k) - 200.0);
+    const double expected =
+        k == 200 ? 2.0 / (1.0 + share)
+                 : 2.0 * share * (1.0 - q) / (2.0 * q) * std::pow(q, m) / (1.0 + share);
+    EXPECT_NEAR(heard[k], expected, 1e-12 * expected) << "bin " << k;
+  }
+  EXPECT_NEAR(std::accumulate(heard.begin(), heard.end(), 0.0), 2.0, 1e-12);
+  // Two echoes: the sum of each one's (the skirts are linear in the echo).
+  std::vector<double> other(bins, 0.0);
+  other[210] = 0.5;
+  std::vector<double> both = echo;
+  both[210] = 0.5;
+  synthesizer.AddPulseSkirts(other);
+  synthesizer.AddPulseSkirts(both);
+  for (std::size_t k = 0; k < bins; ++k) {
+    EXPECT_NEAR(both[k], heard[k] + other[k], 1e-12 * both[k]) << "bin " << k;
+  }
+  const BeamSynthesizer none(QuietSensor(), tracer, {Material{}});
+  std::vector<double> unchanged = echo;
+  none.AddPulseSkirts(unchanged);
+  EXPECT_EQ(unchanged, echo);
+}
+
+// Through the whole synthesis, a wall at normal incidence 2 m ahead: with skirts its echo starts
+// in front of the wall, each bin there q times the next (q = exp(-bin / length)), up to the
+// bin before the wall's; and the beam holds the same power as without them (the skirts share
+// the echo out; the beam's ends cut under 1e-21 of it).
+TEST(BeamSynthesis, WallEchoGainsSkirtsAndKeepsItsPower) {
+  const SensorModel bare = QuietSensor();
+  SensorModel skirted = bare;
+  skirted.acoustics.pulse_skirt_length_m = 0.04;
+  skirted.acoustics.pulse_skirt_db = 0.0;
+  const std::vector<TriangleMesh> wall = Wall(2.0, 0.0);
+  const SynthesizedBeam without = Ping(bare, wall);
+  const SynthesizedBeam with = Ping(skirted, wall);
+  const double bin = bare.geometry.bin_size_m;
+  const auto wall_bin = static_cast<std::size_t>(2.0 / bin);
+  ASSERT_EQ(without.echo_power[wall_bin - 1], 0.0);
+  ASSERT_GT(without.echo_power[wall_bin], 0.0);
+  const double q = std::exp(-bin / 0.04);
+  for (std::size_t k = 1; k < wall_bin; ++k) {
+    EXPECT_NEAR(with.echo_power[k - 1] / with.echo_power[k], q, 1e-9) << "bin " << k;
+  }
+  EXPECT_NEAR(TotalPower(with) / TotalPower(without), 1.0, 1e-12);
+}
+
 // The second trip, exactly: one first-trip echo in bin i (power P, pulse-spread) and one
 // impulse in bin j (power Q) give T · g(m) · (P / g(i)) · (Q / g(j)) / 2 to each of bins
 // m = i + j and i + j + 1, g(k) = ((k + ½) bins)^(G/10) the time-varied gain, T the level;
@@ -270,6 +335,37 @@ TEST(BeamSynthesis, WallRingsAgainAtTwiceItsRange) {
   const double total_h = std::accumulate(h.begin(), h.end(), 0.0);
   const double total_second = std::accumulate(second.begin(), second.end(), 0.0);
   EXPECT_NEAR(total_second / (total_p * total_h), std::pow(10.0, -0.3), 1e-9);
+}
+
+// Each trip reverberates. With no time-varied gain the beam is ρ ⊛ (E + T · ρ ⊛ E ⊛ h), E
+// the first trip's echo, h its impulse response (a one-bin pulse's echo), ρ the reverberation
+// (the echo itself and a tail holding R of it): its power is (1 + R)(ΣE + T · ΣE · Σh (1 + R)).
+// So the second trip, the beam less the beam without it, holds T (1 + R)² ΣE Σh; a second trip
+// that did not reverberate on its way back would hold T (1 + R) ΣE Σh, 1.5 times less. The
+// tails (0.1 m) end within the beam: the last, from 2.1 m, loses exp(-29) of itself. E and h
+// are one wall's echo, whose only bins under 1e-6 of their largest (which AddSecondTrip skips)
+// can be the two at each end, where the pulse just grazes a bin: each trip loses under 2e-6 of
+// its total, the product under 5e-6.
+TEST(BeamSynthesis, SecondTripReverberatesOnEachTrip) {
+  SensorModel flat = QuietSensor();
+  flat.acoustics.spreading_db_per_decade = 0.0;
+  flat.acoustics.tvg_db_per_decade = 0.0;
+  flat.acoustics.reverberation_length_m = 0.1;
+  flat.acoustics.reverberation_db = -3.0;
+  SensorModel ringing = flat;
+  ringing.acoustics.second_trip_db = -3.0;
+  SensorModel impulse = QuietSensor();
+  impulse.acoustics.spreading_db_per_decade = 0.0;
+  impulse.acoustics.tvg_db_per_decade = 0.0;
+  impulse.acoustics.pulse_length_m = flat.geometry.bin_size_m;
+  const std::vector<TriangleMesh> wall = Wall(1.0, 0.0);
+  const double once = TotalPower(Ping(flat, wall));
+  const double twice = TotalPower(Ping(ringing, wall));
+  const double h = TotalPower(Ping(impulse, wall));
+  const double reverberation = std::pow(10.0, -0.3);
+  const double echo = once / (1.0 + reverberation);
+  const double expected = std::pow(10.0, -0.3) * (1.0 + reverberation) * (1.0 + reverberation);
+  EXPECT_NEAR((twice - once) / (echo * h), expected, 5e-6 * expected);
 }
 
 // Multipath: a mirror that scatters nothing back (reflectivity 0, specular 1) at 45° one metre
@@ -575,52 +671,61 @@ TEST(RayTracer, BundleFindsWhatSingleRaysFind) {
   EXPECT_THROW(tracer.IntersectBundle(origin, directions, 3.0f, short_hits), std::invalid_argument);
 }
 
-// A beam's rays: ray (i, j) lies in horizontal stratum i and vertical stratum j of the aperture,
-// at one of the slots (the slot centres, to rounding), with the two-way pattern weight of its
-// direction; over pings every slot of a stratum is used (32 slots, 2000 draws: a slot missed
-// with probability 32 · (31/32)^2000 < 1e-26).
+// A beam's rays: ray (i, j) lies in horizontal stratum i and vertical stratum j of the aperture
+// (the nominal widths times each direction's aperture scale), at one of the slots (the slot
+// centres, to rounding), with the two-way pattern weight of its direction (of the nominal
+// widths, whatever the scale); over pings every slot of a stratum is used (32 slots, 2000
+// draws: a slot missed with probability 32 · (31/32)^2000 < 1e-26).
 TEST(BeamSynthesis, RaysFillTheirStrataWithThePatternsWeights) {
-  const SensorModel sensor;
-  const mapping::SensorGeometry& g = sensor.geometry;
-  const Acoustics& a = sensor.acoustics;
-  const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
-  const RayTracer tracer(meshes);
-  const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
-  constexpr int kSlots = BeamSynthesizer::kJitterSlots;
-  const double stratum_h = g.beam_width_horizontal_rad / a.rays_horizontal;
-  const double stratum_v = g.beam_width_vertical_rad / a.rays_vertical;
-  const double k_h = 4.0 * std::log(2.0) / std::pow(g.beam_width_horizontal_rad, 2);
-  const double k_v = 4.0 * std::log(2.0) / std::pow(g.beam_width_vertical_rad, 2);
-  Rng rng(3);
-  std::vector<Eigen::Vector3f> directions;
-  std::vector<double> patterns;
-  std::vector<int> slot_uses(kSlots, 0);
-  for (int ping = 0; ping < 2000; ++ping) {
-    const double sum = synthesizer.DrawRays(Eigen::Matrix3d::Identity(), rng, directions, patterns);
-    ASSERT_EQ(directions.size(), static_cast<std::size_t>(a.rays_horizontal * a.rays_vertical));
-    EXPECT_NEAR(sum, std::accumulate(patterns.begin(), patterns.end(), 0.0), 1e-9 * sum);
-    for (int i = 0, r = 0; i < a.rays_horizontal; ++i) {
-      for (int j = 0; j < a.rays_vertical; ++j, ++r) {
-        if (ping > 0 && r > 0) break;  // every ray of the first ping, then ray 0's slots
-        const Eigen::Vector3d d = directions[static_cast<std::size_t>(r)].cast<double>();
-        const double theta = std::atan2(d.y(), d.x());
-        const double epsilon = std::asin(d.z());
-        // Positions in slots of the stratum: within float rounding of a slot centre.
-        const double slot_h = (theta / stratum_h + 0.5 * a.rays_horizontal - i) * kSlots - 0.5;
-        const double slot_v = (epsilon / stratum_v + 0.5 * a.rays_vertical - j) * kSlots - 0.5;
-        ASSERT_NEAR(slot_h, std::round(slot_h), 1e-2) << "ray " << i << ", " << j;
-        ASSERT_NEAR(slot_v, std::round(slot_v), 1e-2) << "ray " << i << ", " << j;
-        ASSERT_GE(std::round(slot_h), 0);
-        ASSERT_LT(std::round(slot_h), kSlots);
-        ASSERT_GE(std::round(slot_v), 0);
-        ASSERT_LT(std::round(slot_v), kSlots);
-        EXPECT_NEAR(patterns[static_cast<std::size_t>(r)],
-                    std::exp(-k_h * theta * theta - k_v * epsilon * epsilon), 1e-6);
-        if (r == 0) ++slot_uses[static_cast<std::size_t>(std::round(slot_v))];
+  SensorModel scaled;
+  scaled.acoustics.aperture_scale_horizontal = 2.0;
+  scaled.acoustics.aperture_scale_vertical = 0.5;
+  for (const SensorModel& sensor : {SensorModel{}, scaled}) {
+    const mapping::SensorGeometry& g = sensor.geometry;
+    const Acoustics& a = sensor.acoustics;
+    SCOPED_TRACE(a.aperture_scale_horizontal);
+    const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
+    const RayTracer tracer(meshes);
+    const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
+    constexpr int kSlots = BeamSynthesizer::kJitterSlots;
+    const double stratum_h =
+        a.aperture_scale_horizontal * g.beam_width_horizontal_rad / a.rays_horizontal;
+    const double stratum_v =
+        a.aperture_scale_vertical * g.beam_width_vertical_rad / a.rays_vertical;
+    const double k_h = 4.0 * std::log(2.0) / std::pow(g.beam_width_horizontal_rad, 2);
+    const double k_v = 4.0 * std::log(2.0) / std::pow(g.beam_width_vertical_rad, 2);
+    Rng rng(3);
+    std::vector<Eigen::Vector3f> directions;
+    std::vector<double> patterns;
+    std::vector<int> slot_uses(kSlots, 0);
+    for (int ping = 0; ping < 2000; ++ping) {
+      const double sum =
+          synthesizer.DrawRays(Eigen::Matrix3d::Identity(), rng, directions, patterns);
+      ASSERT_EQ(directions.size(), static_cast<std::size_t>(a.rays_horizontal * a.rays_vertical));
+      EXPECT_NEAR(sum, std::accumulate(patterns.begin(), patterns.end(), 0.0), 1e-9 * sum);
+      for (int i = 0, r = 0; i < a.rays_horizontal; ++i) {
+        for (int j = 0; j < a.rays_vertical; ++j, ++r) {
+          if (ping > 0 && r > 0) break;  // every ray of the first ping, then ray 0's slots
+          const Eigen::Vector3d d = directions[static_cast<std::size_t>(r)].cast<double>();
+          const double theta = std::atan2(d.y(), d.x());
+          const double epsilon = std::asin(d.z());
+          // Positions in slots of the stratum: within float rounding of a slot centre.
+          const double slot_h = (theta / stratum_h + 0.5 * a.rays_horizontal - i) * kSlots - 0.5;
+          const double slot_v = (epsilon / stratum_v + 0.5 * a.rays_vertical - j) * kSlots - 0.5;
+          ASSERT_NEAR(slot_h, std::round(slot_h), 1e-2) << "ray " << i << ", " << j;
+          ASSERT_NEAR(slot_v, std::round(slot_v), 1e-2) << "ray " << i << ", " << j;
+          ASSERT_GE(std::round(slot_h), 0);
+          ASSERT_LT(std::round(slot_h), kSlots);
+          ASSERT_GE(std::round(slot_v), 0);
+          ASSERT_LT(std::round(slot_v), kSlots);
+          EXPECT_NEAR(patterns[static_cast<std::size_t>(r)],
+                      std::exp(-k_h * theta * theta - k_v * epsilon * epsilon), 1e-6);
+          if (r == 0) ++slot_uses[static_cast<std::size_t>(std::round(slot_v))];
+        }
       }
     }
+    for (int slot = 0; slot < kSlots; ++slot) EXPECT_GT(slot_uses[slot], 0) << "slot " << slot;
   }
-  for (int slot = 0; slot < kSlots; ++slot) EXPECT_GT(slot_uses[slot], 0) << "slot " << slot;
 }
 
 // Rays from anywhere in the tank, traced as one incoherent stream, and their occlusion tests as

@@ -198,18 +198,21 @@ TEST(SceneFile, SpecularSpreadIsReadInDegrees) {
                                    {"bad.yaml:5:", "'materials[0].specular_spread_deg'", "'45'"}));
 }
 
-// The tank's reverberation and second trip are the scene's (the sensor model has neither),
-// and a level outside -100..20 dB is refused, naming the key and line.
+// The tank's reverberation, second trip and pulse skirts are the scene's (the sensor model has
+// none), and a level outside -100..20 dB is refused, naming the key and line.
 TEST(SceneFile, ReverberationIsTheScenes) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
   EXPECT_EQ(micron.acoustics.reverberation_length_m, 0.0);
   EXPECT_EQ(micron.acoustics.second_trip_db, -100.0);
+  EXPECT_EQ(micron.acoustics.pulse_skirt_length_m, 0.0);
   const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   EXPECT_EQ(tank.sensor.acoustics.reverberation_length_m, 0.9);
   EXPECT_EQ(tank.sensor.acoustics.reverberation_db, -2.0);
-  EXPECT_EQ(tank.sensor.acoustics.second_trip_db, 7.0);
-  for (const char* key : {"reverberation_db", "second_trip_db"}) {
+  EXPECT_EQ(tank.sensor.acoustics.second_trip_db, 7.75);
+  EXPECT_EQ(tank.sensor.acoustics.pulse_skirt_length_m, 0.05);
+  EXPECT_EQ(tank.sensor.acoustics.pulse_skirt_db, 3.0);
+  for (const char* key : {"reverberation_db", "second_trip_db", "pulse_skirt_db"}) {
     test::TempDir dir;
     const std::string path = (dir.path() / "bad.yaml").string();
     std::ofstream(path) << "name: x\nsensor_model: "

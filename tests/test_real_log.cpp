@@ -303,6 +303,41 @@ TEST(Fidelity, WallPeaksArePercentilesOfEachBeamsStrongestEcho) {
                    5.0);
 }
 
+// The direct wall profile: the simulated walls (200) are at bin 170 at every head angle; the
+// real log's too, with a front of 60 over the 5 bins before them, but every 4th of its beams
+// also holds a ghost (230) at bin 250, its strongest echo. The all-beam profile aligns those on
+// the ghost; the direct one leaves them out (300 of 400 real beams), so its front is 60 and its
+// peak 200, and the front's mean |difference| is 5 bins x 50 over the 20 bins: 12.5. A real
+// wall 8 bins from the simulated one is still the wall; 9 bins is not.
+TEST(Fidelity, DirectWallProfileKeepsTheBeamsWhoseStrongestIsTheSimulatedWall) {
+  const mapping::SensorGeometry sensor;
+  const std::vector<mapping::Beam> sim =
+      TwoSweeps(sensor, [](int, int k) -> std::uint8_t { return k == 170 ? 200 : 10; });
+  const std::vector<mapping::Beam> real = TwoSweeps(sensor, [](int b, int k) -> std::uint8_t {
+    if (k == 170) return 200;
+    if (k >= 165 && k < 170) return 60;
+    return b % 4 == 0 && k == 250 ? 230 : 10;
+  });
+  const auto report = sim::CompareWithLog(sim, real, sensor, 1.0);
+  EXPECT_EQ(report.sim_direct_wall_beams, 400u);
+  EXPECT_EQ(report.real_direct_wall_beams, 300u);
+  ASSERT_EQ(report.real_direct_wall_profile.size(), 161u);
+  EXPECT_DOUBLE_EQ(report.real_wall_profile[40], 207.5);  // 300 walls and 100 ghosts
+  for (std::size_t i = 0; i < report.real_direct_wall_profile.size(); ++i) {
+    const double expected = i == 40 ? 200.0 : (i >= 35 && i < 40 ? 60.0 : 10.0);
+    EXPECT_DOUBLE_EQ(report.real_direct_wall_profile[i], expected) << "offset " << i - 40.0;
+    EXPECT_DOUBLE_EQ(report.sim_direct_wall_profile[i], i == 40 ? 200.0 : 10.0);
+  }
+  EXPECT_DOUBLE_EQ(report.wall_front_mean_abs_difference, 12.5);
+  const auto wall_at = [&](int bin) {
+    return TwoSweeps(sensor, [&](int, int k) -> std::uint8_t { return k == bin ? 200 : 10; });
+  };
+  EXPECT_EQ(sim::CompareWithLog(sim, wall_at(178), sensor, 1.0).real_direct_wall_beams, 400u);
+  EXPECT_EQ(sim::CompareWithLog(sim, wall_at(179), sensor, 1.0).real_direct_wall_beams, 0u);
+  EXPECT_EQ(sim::CompareWithLog(sim, wall_at(162), sensor, 1.0).real_direct_wall_beams, 400u);
+  EXPECT_EQ(sim::CompareWithLog(sim, wall_at(161), sensor, 1.0).real_direct_wall_beams, 0u);
+}
+
 // The second trip: beams whose strongest echo (200) is at bin 120 + b mod 10, on a background
 // falling with range (120 - ⌊k/4⌋), and in the "real" copy a ring around twice the wall's bin:
 // +3 at offsets -6..-2, 0, 2 and 4 (8 bins, 24 in all). The flanks are the same in both, so

@@ -2,7 +2,7 @@
 """Intensity statistics of a sonarbench dataset (docs/dataset-format.md), for comparing a
 simulated run with a real log bin by bin where `sonarbench fidelity` gives only summaries.
 
-    python3 tools/dataset_stats.py DIR [DIR ...]
+    python3 tools/dataset_stats.py DIR [DIR ...] [--crossing T --from R]
 
 DIR is what `sonarbench simulate SCENE --out DIR` or `sonarbench import LOG.mat --out DIR`
 wrote. For each, per range band: the mean intensity, the share of bins at 0 and at 150 or
@@ -10,8 +10,14 @@ more, and the sweep-to-sweep spread (per head angle, to 0.1°, and bin, the stan
 over the beams at that angle, averaged over the band's cells seen twice or more: a static
 sonar's echoes repeat, noise does not); and the ringing tail: each beam's largest 5-bin moving average over bins 30-63
 (0.38-0.79 m, past the self-reflection the mapper drops), as percentiles over beams and the
-share of beams whose tail reaches 60. Standard library only.
+share of beams whose tail reaches 60. With --crossing T --from R, where a threshold detector
+meets the first echo along each side (the walls of a tank): for the beams within 20° of head
+angle 0°, 90°, 180° and 270°, the first bin from R metres on whose 5-bin mean (the mapper's
+smoothing) reaches T, its centre's range times the cosine of the beam's angle off the side's
+(the wall's distance, for a wall square to the side), median over the beams. Standard library
+only.
 """
+import argparse
 import glob
 import math
 import os
@@ -73,7 +79,25 @@ def sweep_spreads(beams):
     return spreads
 
 
-def report(directory):
+def side_crossings(with_angles, threshold, from_m):
+    """Per side (0, 90, 180, 270 degrees): the median over its beams of the range at which the
+    5-bin mean first reaches `threshold` from `from_m` on, projected on the side's axis."""
+    sides = {side: [] for side in (0, 90, 180, 270)}
+    for angle, size, b in with_angles:
+        degrees = math.degrees(angle) % 360.0
+        for side, ranges in sides.items():
+            off = abs((degrees - side + 180.0) % 360.0 - 180.0)
+            if off > 20.0:
+                continue
+            for k in range(max(0, math.ceil(from_m / size - 0.5)), len(b)):
+                window = b[max(0, k - 2):k + 3]
+                if sum(window) / len(window) >= threshold:
+                    ranges.append((k + 0.5) * size * math.cos(math.radians(off)))
+                    break
+    return {side: sorted(r)[len(r) // 2] if r else None for side, r in sides.items()}
+
+
+def report(directory, crossing=None, from_m=None):
     with_angles = load_beams(directory, with_angles=True)
     beams = [(size, b) for _, size, b in with_angles]
     spreads = sweep_spreads(with_angles)
@@ -101,10 +125,23 @@ def report(directory):
               f"median {percentile(tails, 0.5):.0f}, p90 {percentile(tails, 0.9):.0f}, "
               f"p99 {percentile(tails, 0.99):.0f}, max {tails[-1]:.0f}; "
               f"{100 * sum(t >= 60 for t in tails) / len(tails):.1f}% of beams reach 60")
+    if crossing is not None:
+        sides = side_crossings(with_angles, crossing, from_m)
+        print(f"  first 5-bin mean at {crossing:g} or more from {from_m:g} m, median per side: " +
+              ", ".join(f"{side}° " + (f"{r:.2f} m" if r is not None else "none")
+                        for side, r in sides.items()))
 
 
 if __name__ == "__main__":
-    if len(sys.argv) < 2:
-        sys.exit(__doc__)
-    for d in sys.argv[1:]:
-        report(d)
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("directories", nargs="+", metavar="DIR")
+    parser.add_argument("--crossing", type=float, metavar="T",
+                        help="also report where the 5-bin mean first reaches T, per side")
+    parser.add_argument("--from", dest="from_m", type=float, metavar="R",
+                        help="range [m] the crossing search starts at (with --crossing)")
+    args = parser.parse_args()
+    if (args.crossing is None) != (args.from_m is None):
+        parser.error("--crossing and --from go together")
+    for d in args.directories:
+        report(d, args.crossing, args.from_m)

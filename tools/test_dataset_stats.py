@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """ctest for dataset_stats.py: a dataset of known intensities gives the shares and tail it must,
 and a truncated beams file is refused, naming the file."""
+import math
 import os
 import struct
 import subprocess
@@ -20,8 +21,9 @@ def write_beams(path, beams, angles=None):
             f.write(struct.pack("<dddI", 0.0, angle, BIN_M, len(intensities)) + bytes(intensities))
 
 
-def run(directory):
-    return subprocess.run([sys.executable, TOOL, directory], capture_output=True, text=True)
+def run(directory, *options):
+    return subprocess.run([sys.executable, TOOL, directory, *options], capture_output=True,
+                          text=True)
 
 
 def main():
@@ -57,6 +59,30 @@ def main():
         assert result.returncode == 0, result.stderr
         assert "3.0-4.0 m: mean 116.5, at 0 0.0%, at 150 or more 7.69%, sweep-to-sweep spread 5.5" \
             in result.stdout, result.stdout
+
+        # Where a detector meets each side: beams at 0° (a floor-like 80 at bins 100-119, a wall
+        # of 200 from bin 160), 10° (the wall from bin 170) and 90° (nothing); one at 45° belongs
+        # to no side. From 1.5 m (bin 120) on, the 5-bin mean over bins k-2..k+2 first reaches
+        # 100 at bin 160 (three bins of 200: 120; at 159 two, 80), 160.5 bins out; at 10°, bin
+        # 170, 170.5 bins x cos 10°. The upper median of the two: 2.10 m.
+        os.makedirs(os.path.join(tmp, "sides", "beams"))
+
+        def wall_beam(first_wall_bin):
+            return [80 if 100 <= k < 120 else (200 if k >= first_wall_bin else 0)
+                    for k in range(BINS)]
+        write_beams(os.path.join(tmp, "sides", "beams", "sweep_0000.bin"),
+                    [wall_beam(160), wall_beam(170), [0] * BINS, wall_beam(100)],
+                    [0.0, math.radians(10.0), math.radians(90.0), math.radians(45.0)])
+        result = run(os.path.join(tmp, "sides"), "--crossing", "100", "--from", "1.5")
+        assert result.returncode == 0, result.stderr
+        assert ("first 5-bin mean at 100 or more from 1.5 m, median per side: 0° 2.10 m, "
+                "90° none, 180° none, 270° none") in result.stdout, result.stdout
+        # From 1.2 m (bin 96) at 80, the floor-like echo is met first: bin 102, whose window
+        # (100-104) is all 80, 102.5 bins out at 0° and x cos 10° at 10°: 1.28 m.
+        result = run(os.path.join(tmp, "sides"), "--crossing", "80", "--from", "1.2")
+        assert "0° 1.28 m" in result.stdout, result.stdout
+        result = run(os.path.join(tmp, "sides"), "--crossing", "100")
+        assert result.returncode != 0 and "go together" in result.stderr, result.stderr
 
         os.makedirs(os.path.join(tmp, "bad", "beams"))
         path = os.path.join(tmp, "bad", "beams", "sweep_0000.bin")

@@ -193,6 +193,10 @@ int Fidelity(const FidelityArgs& args) {
             << report.real_wall_peak[1] << "/" << report.real_wall_peak[2]
             << "; behind it (16-120 bins), mean |difference| "
             << report.wall_tail_mean_abs_difference << "\n"
+            << "wall echo's front (20 bins before the strongest, over the beams whose strongest "
+               "echo is the simulated wall: sim "
+            << report.sim_direct_wall_beams << ", real " << report.real_direct_wall_beams
+            << " beams): mean |difference| " << report.wall_front_mean_abs_difference << "\n"
             << "second trip (around twice the strongest echo's bin, offsets -30..+10): excess "
                "over its flanks sim "
             << report.sim_second_trip_excess << " (" << report.sim_second_trip_beams
@@ -430,12 +434,13 @@ int main(int argc, char** argv) {
       "fidelity",
       "Compare a simulated scene with a real log of the same place: mean intensity against range "
       "(correlation), the strongest echo's range per head angle (median difference in bins) and "
-      "its intensity (percentiles), the profile around it (the tail behind the walls) and around "
+      "its intensity (percentiles), the profile around it (the tail behind the walls; and its "
+      "front, over the beams whose strongest echo is the simulated wall) and around "
       "twice its range (the second trip), "
       "intensity histograms (intersection), the texture along range and across beams "
       "(correlations), and the first sweeps side by side (sim left, real right). Writes "
       "fidelity.json, profile.csv/.png, wall_range.csv, wall_profile.csv, "
-      "second_trip_profile.csv, histogram.csv, "
+      "direct_wall_profile.csv, second_trip_profile.csv, histogram.csv, "
       "polar.png and fan.png into --out.");
   fidelity_cmd->add_option("scene", fidelity.scene, "Scene YAML file")
       ->required()

@@ -105,10 +105,10 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
     }
     return slots;
   };
-  horizontal_slots_ =
-      tabulate(a.rays_horizontal, a.aperture_scale * g.beam_width_horizontal_rad, pattern_k_h_);
-  vertical_slots_ =
-      tabulate(a.rays_vertical, a.aperture_scale * g.beam_width_vertical_rad, pattern_k_v_);
+  horizontal_slots_ = tabulate(
+      a.rays_horizontal, a.aperture_scale_horizontal * g.beam_width_horizontal_rad, pattern_k_h_);
+  vertical_slots_ = tabulate(a.rays_vertical, a.aperture_scale_vertical * g.beam_width_vertical_rad,
+                             pattern_k_v_);
 
   // A standard 2-D Gaussian offset has a Rayleigh radius, P(radius ≤ ρ) = 1 - exp(-ρ²/2), and a
   // uniform direction: radius quantiles times evenly spaced directions.
@@ -274,6 +274,33 @@ void BeamSynthesizer::SectorSpeckle(std::span<double> factors, int window,
   WindowPower(amplitudes, size, factors);
 }
 
+void BeamSynthesizer::AddPulseSkirts(std::vector<double>& echo_power) const {
+  const Acoustics& a = sensor_.acoustics;
+  if (a.pulse_skirt_length_m <= 0.0) return;
+  const double q = std::exp(-sensor_.geometry.bin_size_m / a.pulse_skirt_length_m);
+  // The skirts hold S = 10^(db/10) of the pulse's power, shared out of the echo's: the pulse
+  // keeps 1 / (1 + S), each side S / (2 (1 + S)), a geometric series of ratio q from q.
+  const double skirts_share = std::pow(10.0, a.pulse_skirt_db / 10.0);
+  const double keep = 1.0 / (1.0 + skirts_share);
+  const double feed = keep * skirts_share * (1.0 - q) / (2.0 * q);
+  // Two passes, each an exponential sum of the bins on one side: `before` holds
+  // Σ_{j<k} P_j q^(k-j) and `after` Σ_{j>k} P_j q^(j-k), from the unchanged powers.
+  thread_local std::vector<double> skirts;
+  const std::size_t bins = echo_power.size();
+  skirts.assign(bins, 0.0);
+  double before = 0.0;
+  for (std::size_t k = 0; k < bins; ++k) {
+    skirts[k] = before;
+    before = q * (before + echo_power[k]);
+  }
+  double after = 0.0;
+  for (std::size_t k = bins; k-- > 0;) {
+    const double power = echo_power[k];
+    echo_power[k] = keep * power + feed * (skirts[k] + after);
+    after = q * (after + power);
+  }
+}
+
 void BeamSynthesizer::AddReverberation(std::vector<double>& echo_power) const {
   const Acoustics& a = sensor_.acoustics;
   if (a.reverberation_length_m <= 0.0) return;
@@ -322,11 +349,16 @@ void BeamSynthesizer::AddSecondTrip(std::vector<double>& echo_power,
     const std::size_t end = std::min(last + 1, bins - i);
     for (std::size_t j = first; j < end; ++j) to[i + j] += o * from[j];
   }
+  // Each pair's halves in m and m + 1, the gain at the summed range put back; then the way
+  // back's reverberation (the way out's, which the whole beam gets, comes after).
   double previous = 0.0;
   for (std::size_t m = 0; m < bins; ++m) {
-    echo_power[m] += second_trip_ * tvg_at_bin_[m] * (0.5 * (sums[m] + previous));
-    previous = sums[m];
+    const double pair_sum = sums[m];
+    sums[m] = second_trip_ * tvg_at_bin_[m] * (0.5 * (pair_sum + previous));
+    previous = pair_sum;
   }
+  AddReverberation(sums);
+  for (std::size_t m = 0; m < bins; ++m) echo_power[m] += sums[m];
 }
 
 namespace {
@@ -665,6 +697,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   const double noise_power = std::pow(10.0, a.noise_level_db / 10.0);
   const double gain = std::pow(10.0, a.gain_db / 10.0);
   for (double& power : echo) power /= weight_sum;
+  AddPulseSkirts(echo);
   if (second_trip_ > 0.0) {
     for (double& power : impulse) power /= weight_sum;
     AddSecondTrip(echo, impulse);

@@ -98,6 +98,24 @@ std::vector<double> WallProfile(std::span<const mapping::Beam> beams,
   return sum;
 }
 
+// `strongest`, less the beams whose strongest bin lies more than `reach` bins from the range
+// `wall_m` gives for their head angle (or whose angle has none); `kept` counts the rest.
+StrongestBins NearWall(std::span<const mapping::Beam> beams, const StrongestBins& strongest,
+                       const std::vector<std::optional<double>>& wall_m,
+                       const mapping::SensorGeometry& sensor, int reach, std::size_t& kept) {
+  StrongestBins out(strongest.size());
+  kept = 0;
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    const std::optional<double>& wall = wall_m[StepIndex(beams[b], sensor)];
+    if (!strongest[b] || !wall) continue;
+    const double bins_off = (beams[b].BinCentreRange(*strongest[b]) - *wall) / sensor.bin_size_m;
+    if (std::labs(std::lround(bins_off)) > reach) continue;
+    out[b] = strongest[b];
+    ++kept;
+  }
+  return out;
+}
+
 // Each beam's bins [first, bins) (fewer for a short beam), less the beam's mean over them.
 std::vector<std::vector<double>> CentredRows(std::span<const mapping::Beam> beams,
                                              std::size_t first, std::size_t bins) {
@@ -347,6 +365,22 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   r.wall_tail_mean_abs_difference =
       MeanAbsDifference(std::span(r.sim_wall_profile).subspan(tail_start),
                         std::span(r.real_wall_profile).subspan(tail_start));
+  r.sim_direct_wall_profile =
+      WallProfile(sim,
+                  NearWall(sim, sim_strongest, r.sim_wall_m, sensor,
+                           FidelityReport::kDirectWallReach, r.sim_direct_wall_beams),
+                  first);
+  r.real_direct_wall_profile =
+      WallProfile(real,
+                  NearWall(real, real_strongest, r.sim_wall_m, sensor,
+                           FidelityReport::kDirectWallReach, r.real_direct_wall_beams),
+                  first);
+  constexpr auto kFront = static_cast<std::size_t>(FidelityReport::kWallFront);
+  constexpr auto kFrontStart =
+      static_cast<std::size_t>(FidelityReport::kWallProfileBefore) - kFront;
+  r.wall_front_mean_abs_difference =
+      MeanAbsDifference(std::span(r.sim_direct_wall_profile).subspan(kFrontStart, kFront),
+                        std::span(r.real_direct_wall_profile).subspan(kFrontStart, kFront));
   r.sim_second_trip_beams = SecondTripProfile(sim, sim_strongest, first, r.sim_second_trip_profile,
                                               r.sim_second_trip_excess);
   r.real_second_trip_beams = SecondTripProfile(
@@ -421,6 +455,8 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
   };
   write_aligned("wall_profile.csv", r.sim_wall_profile, r.real_wall_profile,
                 FidelityReport::kWallProfileBefore);
+  write_aligned("direct_wall_profile.csv", r.sim_direct_wall_profile, r.real_direct_wall_profile,
+                FidelityReport::kWallProfileBefore);
   write_aligned("second_trip_profile.csv", r.sim_second_trip_profile, r.real_second_trip_profile,
                 FidelityReport::kSecondTripReach);
   std::ostringstream hist;
@@ -460,6 +496,9 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"wall_peak_intensity_p10_p50_p90_sim", r.sim_wall_peak},
                  {"wall_tail_mean_abs_difference", r.wall_tail_mean_abs_difference},
                  {"wall_peak_intensity_p10_p50_p90_real", r.real_wall_peak},
+                 {"wall_front_mean_abs_difference", r.wall_front_mean_abs_difference},
+                 {"direct_wall_beams_sim", r.sim_direct_wall_beams},
+                 {"direct_wall_beams_real", r.real_direct_wall_beams},
                  {"second_trip_excess_sim", r.sim_second_trip_excess},
                  {"second_trip_excess_real", r.real_second_trip_excess},
                  {"second_trip_beams_sim", r.sim_second_trip_beams},
@@ -473,7 +512,8 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"sweep_spread_real", r.real_sweep_spread},
                  {"outputs",
                   {"profile.csv", "profile.png", "wall_range.csv", "wall_profile.csv",
-                   "second_trip_profile.csv", "histogram.csv", "polar.png", "fan.png"}}});
+                   "direct_wall_profile.csv", "second_trip_profile.csv", "histogram.csv",
+                   "polar.png", "fan.png"}}});
   WriteJson((dir / "fidelity.json").string(), report);
 }
 

@@ -5,12 +5,15 @@ namespace sonarbench::sim {
 void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("rays_horizontal", a.rays_horizontal, IntInRange(1, 1024));
   node.Optional("rays_vertical", a.rays_vertical, IntInRange(1, 8192));
-  node.Optional("aperture_scale", a.aperture_scale, InRange(0.1, 4.0));
+  node.Optional("aperture_scale_horizontal", a.aperture_scale_horizontal, InRange(0.1, 4.0));
+  node.Optional("aperture_scale_vertical", a.aperture_scale_vertical, InRange(0.1, 4.0));
   node.Optional("spreading_db_per_decade", a.spreading_db_per_decade, InRange(0.0, 80.0));
   node.Optional("absorption_db_per_m", a.absorption_db_per_m, InRange(0.0, 100.0));
   node.Optional("tvg_db_per_decade", a.tvg_db_per_decade, InRange(0.0, 80.0));
   node.Optional("gain_db", a.gain_db, InRange(-200.0, 200.0));
   node.Optional("pulse_length_m", a.pulse_length_m, Positive());
+  node.Optional("pulse_skirt_length_m", a.pulse_skirt_length_m, InRange(0.0, 10.0));
+  node.Optional("pulse_skirt_db", a.pulse_skirt_db, InRange(-100.0, 20.0));
   node.Optional("noise_level_db", a.noise_level_db, InRange(-300.0, 100.0));
   node.Optional("max_bounces", a.max_bounces, IntInRange(0, 16));
   node.Optional("speckle", a.speckle);

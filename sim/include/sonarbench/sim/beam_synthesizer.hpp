@@ -58,9 +58,11 @@ enum class EchoPower { kKeep, kDrop };
 /// exponential draw of mean 1, correlated over the pulse length (CorrelatedSpeckle) and, when
 /// the speckle is the place's, shared by overlapping beams (SectorSpeckle); background noise and
 /// the self-reflection profile add power; the level in dB is mapped to 0..255 by the AD window. In
-/// a closed place (a tank) each bin's echo also feeds a reverberation tail heard after it
-/// (AddReverberation), and is heard again at the sum of two trips' ranges after the sonar head
-/// reflects it back out (AddSecondTrip), both before speckle.
+/// a closed place (a tank) each bin's echo is shared with skirts in range around its pulse
+/// (AddPulseSkirts), is heard again at the sum of two trips' ranges after the sonar head
+/// reflects it back out (AddSecondTrip; the second trip reverberates on its way back as the
+/// first trip does) and feeds a reverberation tail heard after it (AddReverberation), all
+/// before speckle.
 ///
 /// Thread-safe: Synthesize() is const and draws only from a generator seeded by its argument.
 class BeamSynthesizer {
@@ -100,6 +102,15 @@ class BeamSynthesizer {
   /// 3.7%); exact nearer and beyond the table.
   [[nodiscard]] double RangeLossFromTable(double range_m) const;
 
+  /// Spreads a beam's noise-free echo power per bin over the pulse's skirts (in place): with
+  /// S = 10^(pulse_skirt_db/10) and q = exp(-bin / pulse_skirt_length_m), bin k becomes
+  ///     (P_k + Σ_{j≠k} P_j · S (1 - q) / (2q) · q^|k-j|) / (1 + S),
+  /// so the echo in bin j keeps 1 / (1 + S) of its power and is heard in the bins on both sides
+  /// of it, falling by q per bin, its two skirts holding S / (1 + S) in all (before the beam's
+  /// ends cut them): the echo's power is redistributed, not added to. Nothing changes when
+  /// pulse_skirt_length_m is 0.
+  void AddPulseSkirts(std::vector<double>& echo_power) const;
+
   /// Adds the place's reverberation to a beam's noise-free echo power per bin (in place): bin k
   /// gains Σ_{j<k} P_j · R · (1 - q) · q^(k-1-j), with q = exp(-bin / reverberation_length_m)
   /// and R = 10^(reverberation_db/10), so the echo in bin j feeds a tail that starts in the next
@@ -117,7 +128,9 @@ class BeamSynthesizer {
   /// T = 10^(second_trip_db/10). Per bin, r = (i + ½) bins for bin i, and the pair (i, j), whose
   /// ranges span [i + j, i + j + 2) bins, gives half to bin i + j and half to i + j + 1. Bins i
   /// under 1e-6 of the largest P/g are skipped, and j runs from the first to the last bin with
-  /// h/g over 1e-6 of its largest; the sum stops at the last bin. Nothing changes at -100 dB
+  /// h/g over 1e-6 of its largest; the sum stops at the last bin. In a place that reverberates
+  /// the way back reverberates as the way out does: P2 gets its own tail (AddReverberation)
+  /// before it is added, and with the echo it joins, the way out's. Nothing changes at -100 dB
   /// (the default).
   void AddSecondTrip(std::vector<double>& echo_power, std::span<const double> impulse_power) const;
 

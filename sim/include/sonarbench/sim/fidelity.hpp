@@ -47,6 +47,21 @@ struct FidelityReport {
   /// strongest echo to the end: the tail behind the walls (reverberation, ghosts) alone.
   double wall_tail_mean_abs_difference = 0.0;
   static constexpr int kWallTailStart = 16;
+  /// The wall profile again over the beams whose strongest echo is the wall the simulation
+  /// puts there: within kDirectWallReach bins of the simulated run's median strongest range at
+  /// the beam's head angle (sim_wall_m). The real log's strongest echo lies far behind its wall
+  /// at some head angles (a ghost or a fixture of the tank); these beams leave them out, so the
+  /// front of the wall's echo (the pulse's rise and skirts, the beam's footprint) is compared
+  /// echo for echo. How many beams each averaged.
+  std::vector<double> sim_direct_wall_profile;
+  std::vector<double> real_direct_wall_profile;
+  std::size_t sim_direct_wall_beams = 0;
+  std::size_t real_direct_wall_beams = 0;
+  static constexpr int kDirectWallReach = 8;
+  /// Mean |sim - real| of the two direct wall profiles over the kWallFront bins in front of the
+  /// strongest echo.
+  double wall_front_mean_abs_difference = 0.0;
+  static constexpr int kWallFront = 20;
   /// The second trip (the echo the sonar head sends out again): the mean intensity aligned on
   /// twice each beam's strongest bin beyond `wall_min_range_m`, entry i at offset
   /// i - kSecondTripReach, over the beams whose whole window lies in the usable bins. Its
@@ -111,7 +126,7 @@ std::size_t SecondTripProfile(std::span<const mapping::Beam> beams,
                               double& excess);
 
 /// Writes fidelity.json, profile.csv, wall_range.csv, wall_profile.csv,
-/// second_trip_profile.csv, histogram.csv, profile.png (the two mean
+/// direct_wall_profile.csv, second_trip_profile.csv, histogram.csv, profile.png (the two mean
 /// profiles), and polar and fan images of each run's first sweep side by side (sim left, real
 /// right) into `out_dir`.
 void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& report,

@@ -14,8 +14,11 @@ struct Acoustics {
   /// Stratified-jittered ray samples across the horizontal and vertical aperture per beam.
   int rays_horizontal = 4;
   int rays_vertical = 160;
-  /// Rays cover this multiple of the nominal (-3 dB) beam widths, weighted by the pattern.
-  double aperture_scale = 1.0;
+  /// Rays cover this multiple of the nominal (-3 dB) beam width, horizontally and vertically,
+  /// weighted by the pattern: beyond 1 they also hear the pattern's skirts (at 2, down to the
+  /// two-way Gaussian's -12 dB).
+  double aperture_scale_horizontal = 1.0;
+  double aperture_scale_vertical = 1.0;
   /// Net geometric loss of an area-scattering echo [dB per decade of range] (two-way spherical
   /// spreading, 40 dB, less the growth of the ensonified area, 20 dB).
   double spreading_db_per_decade = 20.0;
@@ -27,6 +30,15 @@ struct Acoustics {
   double gain_db = 0.0;
   /// Range extent of the transmitted pulse, c·τ/2 [m].
   double pulse_length_m = 0.0375;
+  /// Skirts in range around the pulse (a receiver filter's or the pulse's own rise and fall;
+  /// the tank's scene fits them to its log without telling those from the tank's own): every
+  /// echo is also heard before and after its pulse, falling exponentially
+  /// with range away from it, e-folding over `pulse_skirt_length_m` [m] (0: no skirts, the
+  /// default), the two skirts holding `pulse_skirt_db` [dB] of the power the pulse itself keeps
+  /// (the echo's power is shared between them, not added to). See
+  /// BeamSynthesizer::AddPulseSkirts.
+  double pulse_skirt_length_m = 0.0;
+  double pulse_skirt_db = -20.0;
   /// Mean background noise power at the receiver output [dB].
   double noise_level_db = -40.0;
   /// Specular reflections a ray follows after its first hit (0: no multipath). Every hit after
