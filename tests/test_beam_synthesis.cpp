@@ -1007,6 +1007,21 @@ TEST(BeamSynthesis, SpeckleIsExponentialAndCorrelatedOverThePulse) {
   for (double v : single) EXPECT_EQ(v, b.Exponential());
 }
 
+// The speckle's window is the range response's extent in bins: the pulse (5 cm, 4 bins of
+// 1.2531 cm) alone, or with skirts the pulse and one e-folding of each (5 + 2 · 5 cm: 12 bins),
+// rounded; a pulse shorter than half a bin still has a window of one.
+TEST(BeamSynthesis, SpeckleWindowSpansThePulseAndItsSkirts) {
+  SensorModel sensor;
+  sensor.acoustics.pulse_length_m = 0.05;
+  const RayTracer tracer(Wall(1.0, 0.0));
+  EXPECT_EQ(BeamSynthesizer(sensor, tracer, {Material{}}).SpeckleWindow(), 4);
+  sensor.acoustics.pulse_skirt_length_m = 0.05;
+  EXPECT_EQ(BeamSynthesizer(sensor, tracer, {Material{}}).SpeckleWindow(), 12);
+  sensor.acoustics.pulse_skirt_length_m = 0.0;
+  sensor.acoustics.pulse_length_m = 0.005;
+  EXPECT_EQ(BeamSynthesizer(sensor, tracer, {Material{}}).SpeckleWindow(), 1);
+}
+
 // Speckle shared between beams through their azimuth sectors (a static sonar's scatterers are
 // the place's; the Micron's beams, 3° wide and 1.8° apart, share most of theirs):
 //  - the sector weights are the square roots of the pattern's shares: squares summing to 1,

@@ -201,7 +201,9 @@ int Fidelity(const FidelityArgs& args) {
                "over its flanks sim "
             << report.sim_second_trip_excess << " (" << report.sim_second_trip_beams
             << " beams), real " << report.real_second_trip_excess << " ("
-            << report.real_second_trip_beams << " beams) [intensity x bins]\n"
+            << report.real_second_trip_beams
+            << " beams) [intensity x bins]; profile mean |difference| "
+            << report.second_trip_mean_abs_difference << "\n"
             << "intensity histograms: intersection " << report.histogram_intersection << "\n"
             << "range correlation at 1/2/3 bins (far half): sim " << report.sim_range_correlation[1]
             << "/" << report.sim_range_correlation[2] << "/" << report.sim_range_correlation[3]

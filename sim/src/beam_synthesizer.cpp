@@ -23,8 +23,12 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
       rough_mirrors_(std::ranges::any_of(materials_by_mesh_, [](const Material& m) {
         return m.specular > 0.0 && m.specular_spread_rad > 0.0;
       })) {
+  // A bin's speckle is the coherent sum of the scatterers its range response covers: the pulse
+  // and, with skirts, one e-folding of each.
+  const Acoustics& acoustics = sensor_.acoustics;
   speckle_window_ = static_cast<int>(
-      std::max(1L, std::lround(sensor_.acoustics.pulse_length_m / sensor_.geometry.bin_size_m)));
+      std::max(1L, std::lround((acoustics.pulse_length_m + 2.0 * acoustics.pulse_skirt_length_m) /
+                               sensor_.geometry.bin_size_m)));
   // Sector d's share of the two-way horizontal pattern exp(-θ²/2σ²), σ = w_h / √(8 ln 2): the
   // normal distribution's mass over [(d - ½) Δ, (d + ½) Δ], Δ the head step.
   {

@@ -385,6 +385,8 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
                                               r.sim_second_trip_excess);
   r.real_second_trip_beams = SecondTripProfile(
       real, real_strongest, first, r.real_second_trip_profile, r.real_second_trip_excess);
+  r.second_trip_mean_abs_difference =
+      MeanAbsDifference(r.sim_second_trip_profile, r.real_second_trip_profile);
   r.sim_wall_peak = WallPeaks(sim, sim_strongest);
   r.real_wall_peak = WallPeaks(real, real_strongest);
   std::vector<double> differences;
@@ -503,6 +505,7 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"second_trip_excess_real", r.real_second_trip_excess},
                  {"second_trip_beams_sim", r.sim_second_trip_beams},
                  {"second_trip_beams_real", r.real_second_trip_beams},
+                 {"second_trip_mean_abs_difference", r.second_trip_mean_abs_difference},
                  {"histogram_intersection", r.histogram_intersection},
                  {"range_correlation_by_lag_sim", r.sim_range_correlation},
                  {"range_correlation_by_lag_real", r.real_range_correlation},

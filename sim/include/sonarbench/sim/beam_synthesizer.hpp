@@ -55,7 +55,8 @@ enum class EchoPower { kKeep, kDrop };
 /// to every bin that the pulse [r, r + L) overlaps, in proportion to the overlap, where ρ and n
 /// are the material's reflectivity and backscatter exponent, S the spreading loss per decade, α
 /// the two-way absorption and G the time-varied gain. Speckle multiplies each bin's power by an
-/// exponential draw of mean 1, correlated over the pulse length (CorrelatedSpeckle) and, when
+/// exponential draw of mean 1, correlated over the range response (the pulse and its skirts:
+/// SpeckleWindow; CorrelatedSpeckle) and, when
 /// the speckle is the place's, shared by overlapping beams (SectorSpeckle); background noise and
 /// the self-reflection profile add power; the level in dB is mapped to 0..255 by the AD window. In
 /// a closed place (a tank) each bin's echo is shared with skirts in range around its pulse
@@ -160,6 +161,11 @@ class BeamSynthesizer {
   /// two-way horizontal pattern's share of power in each sector, sectors carrying under 1e-3 of
   /// it dropped, so that the squares sum to 1.
   [[nodiscard]] const std::vector<double>& SectorWeights() const { return sector_weights_; }
+
+  /// The speckle's correlation window L in bins (CorrelatedSpeckle, SectorSpeckle): the range
+  /// response's extent, the pulse length plus one e-folding of each of its skirts
+  /// (pulse_length_m + 2 pulse_skirt_length_m), rounded, at least 1.
+  [[nodiscard]] int SpeckleWindow() const { return speckle_window_; }
   static constexpr int kSectorReach = 4;
 
   /// Phases of the speckle's complex Gaussians.
@@ -207,7 +213,7 @@ class BeamSynthesizer {
   std::vector<double> untvg_at_bin_;
   /// The self-reflection profile as linear power per bin.
   std::vector<double> self_reflection_power_;
-  /// The speckle's correlation window: the pulse length in bins, rounded, at least 1.
+  /// SpeckleWindow().
   int speckle_window_ = 1;
   /// SectorWeights().
   std::vector<double> sector_weights_;

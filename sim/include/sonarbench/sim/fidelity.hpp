@@ -75,6 +75,9 @@ struct FidelityReport {
   double real_second_trip_excess = 0.0;
   std::size_t sim_second_trip_beams = 0;
   std::size_t real_second_trip_beams = 0;
+  /// Mean |sim - real| of the two second-trip profiles over the whole window: the ring's level
+  /// and shape, where the excess is its height over its flanks alone.
+  double second_trip_mean_abs_difference = 0.0;
   static constexpr int kSecondTripReach = 40;
   static constexpr int kRingFirst = -30;
   static constexpr int kRingLast = 10;
