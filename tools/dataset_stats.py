@@ -2,7 +2,7 @@
 """Intensity statistics of a sonarbench dataset (docs/dataset-format.md), for comparing a
 simulated run with a real log bin by bin where `sonarbench fidelity` gives only summaries.
 
-    python3 tools/dataset_stats.py DIR [DIR ...] [--crossing T --from R]
+    python3 tools/dataset_stats.py DIR [DIR ...] [--crossing T --from R] [--bins FIRST LAST]
 
 DIR is what `sonarbench simulate SCENE --out DIR` or `sonarbench import LOG.mat --out DIR`
 wrote. For each, per range band: the mean intensity, the share of bins at 0 and at 150 or
@@ -14,8 +14,10 @@ share of beams whose tail reaches 60. With --crossing T --from R, where a thresh
 meets the first echo along each side (the walls of a tank): for the beams within 20° of head
 angle 0°, 90°, 180° and 270°, the first bin from R metres on whose 5-bin mean (the mapper's
 smoothing) reaches T, its centre's range times the cosine of the beam's angle off the side's
-(the wall's distance, for a wall square to the side), median over the beams. Standard library
-only.
+(the wall's distance, for a wall square to the side), median over the beams. With --bins
+FIRST LAST, bin by bin from FIRST to LAST: over every beam that long, the mean intensity, the
+share at 0 and the 10th percentile (what lies under every direction at that range: the floor,
+or the sonar's own). Standard library only.
 """
 import argparse
 import glob
@@ -97,7 +99,21 @@ def side_crossings(with_angles, threshold, from_m):
     return {side: sorted(r)[len(r) // 2] if r else None for side, r in sides.items()}
 
 
-def report(directory, crossing=None, from_m=None):
+def bin_rows(beams, first, last):
+    """Per bin k in [first, last] held by some beam: (k, its centre's range, mean, share at 0,
+    10th percentile) over the beams that hold it."""
+    rows = []
+    for k in range(first, last + 1):
+        values = sorted(b[k] for _, b in beams if len(b) > k)
+        if not values:
+            continue
+        size = next(size for size, b in beams if len(b) > k)
+        rows.append((k, (k + 0.5) * size, sum(values) / len(values),
+                     sum(v == 0 for v in values) / len(values), percentile(values, 0.1)))
+    return rows
+
+
+def report(directory, crossing=None, from_m=None, bins=None):
     with_angles = load_beams(directory, with_angles=True)
     beams = [(size, b) for _, size, b in with_angles]
     spreads = sweep_spreads(with_angles)
@@ -130,6 +146,10 @@ def report(directory, crossing=None, from_m=None):
         print(f"  first 5-bin mean at {crossing:g} or more from {from_m:g} m, median per side: " +
               ", ".join(f"{side}° " + (f"{r:.2f} m" if r is not None else "none")
                         for side, r in sides.items()))
+    if bins is not None:
+        for k, range_m, mean, zeros, p10 in bin_rows(beams, *bins):
+            print(f"  bin {k} ({range_m:.3f} m): mean {mean:.1f}, at 0 {100 * zeros:.1f}%, "
+                  f"p10 {p10}")
 
 
 if __name__ == "__main__":
@@ -140,8 +160,12 @@ if __name__ == "__main__":
                         help="also report where the 5-bin mean first reaches T, per side")
     parser.add_argument("--from", dest="from_m", type=float, metavar="R",
                         help="range [m] the crossing search starts at (with --crossing)")
+    parser.add_argument("--bins", type=int, nargs=2, metavar=("FIRST", "LAST"),
+                        help="also report bins FIRST to LAST one by one")
     args = parser.parse_args()
     if (args.crossing is None) != (args.from_m is None):
         parser.error("--crossing and --from go together")
+    if args.bins is not None and not 0 <= args.bins[0] <= args.bins[1]:
+        parser.error(f"--bins {args.bins[0]} {args.bins[1]}: expected 0 <= FIRST <= LAST")
     for d in args.directories:
-        report(d, args.crossing, args.from_m)
+        report(d, args.crossing, args.from_m, args.bins)

@@ -84,6 +84,19 @@ def main():
         result = run(os.path.join(tmp, "sides"), "--crossing", "100")
         assert result.returncode != 0 and "go together" in result.stderr, result.stderr
 
+        # Bin by bin: in the first dataset bin 4 is 0 in every beam and bin 5 is 200; in the
+        # second, bin 3 holds 100 six times, 110 six times and 255 once: the 10th percentile
+        # (the second of 13 sorted) is 100, the mean 116.5.
+        result = run(os.path.join(tmp, "ds"), "--bins", "4", "5")
+        assert "  bin 4 (0.056 m): mean 0.0, at 0 100.0%, p10 0\n" \
+            "  bin 5 (0.069 m): mean 200.0, at 0 0.0%, p10 200\n" in result.stdout, result.stdout
+        result = run(os.path.join(tmp, "spread"), "--bins", "3", "3")
+        assert "  bin 3 (0.044 m): mean 116.5, at 0 0.0%, p10 100\n" in result.stdout, \
+            result.stdout
+        result = run(os.path.join(tmp, "ds"), "--bins", "5", "4")
+        assert result.returncode != 0 and "expected 0 <= FIRST <= LAST" in result.stderr, \
+            result.stderr
+
         os.makedirs(os.path.join(tmp, "bad", "beams"))
         path = os.path.join(tmp, "bad", "beams", "sweep_0000.bin")
         write_beams(path, [beam])

@@ -239,7 +239,7 @@ class BeamSynthesizer {
 };
 
 // Inline: the synthesis calls it for every echo.
-inline double BeamSynthesizer::RangeLossFromTable(double range_m) const {
+[[gnu::always_inline]] inline double BeamSynthesizer::RangeLossFromTable(double range_m) const {
   const double x = range_m * range_steps_per_m_;
   // From 8 bins out (128 steps) to the table's last interval. The interpolation's relative
   // error is at most h²/8 · f''/f, with f''/f = s(s+1)/r² + 2sα/r + α² for f = r^-s·e^-αr:
