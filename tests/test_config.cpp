@@ -228,6 +228,29 @@ TEST(SceneFile, ReverberationIsTheScenes) {
   }
 }
 
+// The place's angular correlation needs the place's speckle: set without it (the sensor model
+// has none), the scene is refused, naming the key, its line and what it needs.
+TEST(SceneFile, AngularCorrelationNeedsThePlacesSpeckle) {
+  for (const std::string extra : {"", "  speckle_correlation_m: 0.05\n  speckle: false\n"}) {
+    test::TempDir dir;
+    const std::string path = (dir.path() / "bad.yaml").string();
+    std::ofstream(path)
+        << "name: x\nsensor_model: " << test::SourcePath("sensor-models/shad-micron.yaml")
+        << "\nsweeps: 1\nsonar_acoustics:\n"
+        << "  speckle_angular_correlation_deg: 7.2\n"
+        << extra << "materials:\n  - {name: rock, reflectivity: 0.5}\n"
+        << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
+        << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+    EXPECT_TRUE(ThrowsInputErrorWith(
+        [&] { (void)sim::LoadScene(path); },
+        {"bad.yaml:5:", "'sonar_acoustics.speckle_angular_correlation_deg'", "the place's speckle",
+         extra.empty() ? "got speckle_correlation_m 0" : "got speckle: false"}))
+        << extra;
+  }
+  const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  EXPECT_EQ(tank.sensor.acoustics.speckle_angular_correlation_deg, 7.2);
+}
+
 // The scenes built on the fitted tank (the two that must fail, and the crate) extend it: they
 // must keep its acoustics, materials and detection, or they no longer test what their comments
 // say. The two must-fail scenes also keep the tank's criteria, only expecting them to fail, and

@@ -35,15 +35,16 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
     const mapping::SensorGeometry& g = sensor_.geometry;
     const double sigma = g.beam_width_horizontal_rad / std::sqrt(8.0 * std::log(2.0));
     const auto cdf = [&](double x) { return 0.5 * std::erfc(-x / (sigma * std::sqrt(2.0))); };
-    sector_weights_.assign(2 * kSectorReach + 1, 0.0);
+    sector_weights_.assign(2 * kPatternReach + 1, 0.0);
     double total = 0.0;
-    for (int d = -kSectorReach; d <= kSectorReach; ++d) {
+    for (int d = -kPatternReach; d <= kPatternReach; ++d) {
       const double share = cdf((d + 0.5) * g.step_angle_rad) - cdf((d - 0.5) * g.step_angle_rad);
       if (share < 1e-3) continue;
-      sector_weights_[static_cast<std::size_t>(d + kSectorReach)] = share;
+      sector_weights_[static_cast<std::size_t>(d + kPatternReach)] = share;
       total += share;
     }
     for (double& w : sector_weights_) w = std::sqrt(w / total);
+    if (acoustics.speckle_angular_correlation_deg > 0.0) CorrelateSectors();
   }
   if (sensor_.acoustics.second_trip_db > -100.0) {
     second_trip_ = std::pow(10.0, sensor_.acoustics.second_trip_db / 10.0);
@@ -125,6 +126,50 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
                                    static_cast<float>(radius * std::sin(angle)));
     }
   }
+}
+
+void BeamSynthesizer::CorrelateSectors() {
+  const mapping::SensorGeometry& g = sensor_.geometry;
+  // Sector s's scatterers are Σ_e c_e u_{s+e}, the u independent and c_e ∝ exp(-|e| Δ / θ)
+  // (cut where what is left holds under 1e-12 of its power; normalised with the weights below),
+  // so a beam hears Σ_d w_d Σ_e c_e u_{a+d+e}: its weights on the independent sectors are w
+  // convolved with c.
+  const double steps = sensor_.acoustics.speckle_angular_correlation_deg * std::numbers::pi /
+                       180.0 / g.step_angle_rad;
+  const int kernel_reach = static_cast<int>(std::ceil(steps * std::log(1e12) / 2.0));
+  std::vector<double> kernel(2 * static_cast<std::size_t>(kernel_reach) + 1);
+  for (int e = -kernel_reach; e <= kernel_reach; ++e) {
+    kernel[static_cast<std::size_t>(e + kernel_reach)] = std::exp(-std::abs(e) / steps);
+  }
+  const int reach = kPatternReach + kernel_reach;
+  std::vector<double> weights(2 * static_cast<std::size_t>(reach) + 1, 0.0);
+  for (int d = -kPatternReach; d <= kPatternReach; ++d) {
+    const double w = sector_weights_[static_cast<std::size_t>(d + kPatternReach)];
+    for (int e = -kernel_reach; e <= kernel_reach; ++e) {
+      weights[static_cast<std::size_t>(d + e + reach)] +=
+          w * kernel[static_cast<std::size_t>(e + kernel_reach)];
+    }
+  }
+  // The sectors beyond ±kept dropped while they hold under 1e-3 of the power in all, and never
+  // more sectors than a turn has (each sector once).
+  double total = 0.0;
+  for (const double w : weights) total += w * w;
+  const long long turn = std::llround(2.0 * std::numbers::pi / g.step_angle_rad);
+  int kept = std::min<int>(reach, static_cast<int>((turn - 1) / 2));
+  const auto square = [&](int d) {
+    const double w = weights[static_cast<std::size_t>(d + reach)];
+    return w * w;
+  };
+  double dropped = 0.0;
+  for (int d = reach; d > kept; --d) dropped += square(d) + square(-d);
+  while (kept > 0 && dropped + square(kept) + square(-kept) < 1e-3 * total) {
+    dropped += square(kept) + square(-kept);
+    --kept;
+  }
+  sector_weights_.assign(weights.begin() + (reach - kept), weights.begin() + (reach + kept + 1));
+  double kept_total = 0.0;
+  for (const double w : sector_weights_) kept_total += w * w;
+  for (double& w : sector_weights_) w /= std::sqrt(kept_total);
 }
 
 Eigen::Vector3f BeamSynthesizer::Tilt(const Eigen::Vector3f& unit, float sigma, Rng& rng) const {
@@ -266,8 +311,9 @@ void BeamSynthesizer::SectorSpeckle(std::span<double> factors, int window,
     std::uint64_t seed = 0;
     std::vector<std::complex<double>> phasors;
   };
-  thread_local std::array<Sector, 2 * kSectorReach + 2> cache;
+  thread_local std::vector<Sector> cache;
   thread_local std::size_t next_slot = 0;
+  if (cache.size() < amplitude_weights.size() + 1) cache.resize(amplitude_weights.size() + 1);
   const auto phasors_of = [&](std::uint64_t seed) -> const std::vector<std::complex<double>>& {
     for (const Sector& sector : cache) {
       if (sector.seed == seed && sector.phasors.size() == length) return sector.phasors;
@@ -474,6 +520,7 @@ struct Scratch {
   std::vector<double> impulse_power;  // the second trip's: each echo over one bin
   std::vector<double> speckle;
   std::vector<double> powers;
+  std::vector<std::uint64_t> sector_seeds;
 };
 
 }  // namespace
@@ -511,7 +558,9 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   // The place's speckle is its scatterers': each head-step-wide azimuth sector has its own,
   // which every beam whose pattern covers it hears (SectorSpeckle).
   std::optional<Rng> place_rng;
-  std::array<std::uint64_t, 2 * kSectorReach + 1> sector_seeds{};
+  std::vector<std::uint64_t>& sector_seeds = scratch.sector_seeds;
+  const int sector_reach = static_cast<int>(sector_weights_.size() / 2);
+  sector_seeds.resize(sector_weights_.size());
   if (a.speckle_correlation_m > 0.0) {
     const double step = g.step_angle_rad;
     const long long turn = std::llround(2.0 * std::numbers::pi / step);
@@ -532,8 +581,8 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       return place;
     };
     place_rng.emplace(place_of(azimuth));
-    for (int d = -kSectorReach; d <= kSectorReach; ++d) {
-      sector_seeds[static_cast<std::size_t>(d + kSectorReach)] =
+    for (int d = -sector_reach; d <= sector_reach; ++d) {
+      sector_seeds[static_cast<std::size_t>(d + sector_reach)] =
           DeriveSeed(place_of(azimuth + d), 0x737065636bULL);  // "speck"
     }
   }

@@ -80,6 +80,7 @@ nlohmann::json SensorJson(const SensorModel& s) {
             {"max_bounces", a.max_bounces},
             {"speckle", a.speckle},
             {"speckle_correlation_m", a.speckle_correlation_m},
+            {"speckle_angular_correlation_deg", a.speckle_angular_correlation_deg},
             {"reverberation_length_m", a.reverberation_length_m},
             {"reverberation_db", a.reverberation_db},
             {"second_trip_db", a.second_trip_db},

@@ -272,7 +272,11 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
     scene.sensor = LoadSensorModel(scene.sensor_model_file);
   }
   if (T_vehicle_sonar) scene.sensor.geometry.T_vehicle_sonar = *T_vehicle_sonar;
-  if (acoustics) ReadAcoustics(*acoustics, scene.sensor.acoustics);
+  if (acoustics) {
+    ReadAcoustics(*acoustics, scene.sensor.acoustics);
+    CheckAcoustics(*acoustics, scene.sensor.acoustics);
+    root.ThrowIfErrors();
+  }
   return scene;
 }
 

@@ -18,12 +18,30 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("max_bounces", a.max_bounces, IntInRange(0, 16));
   node.Optional("speckle", a.speckle);
   node.Optional("speckle_correlation_m", a.speckle_correlation_m, InRange(0.0, 1000.0));
+  node.Optional("speckle_angular_correlation_deg", a.speckle_angular_correlation_deg,
+                InRange(0.0, 30.0));
   node.Optional("reverberation_length_m", a.reverberation_length_m, InRange(0.0, 1000.0));
   node.Optional("reverberation_db", a.reverberation_db, InRange(-100.0, 20.0));
   node.Optional("second_trip_db", a.second_trip_db, InRange(-100.0, 20.0));
   node.Optional("ad_low_db", a.ad_low_db, InRange(-300.0, 100.0));
   node.Optional("ad_span_db", a.ad_span_db, InRange(1.0, 200.0));
   node.Optional("self_reflection_db", a.self_reflection_db);
+}
+
+std::string Acoustics::Conflict() const {
+  if (speckle_angular_correlation_deg > 0.0 && !(speckle && speckle_correlation_m > 0.0)) {
+    return std::string(
+               "the place's speckle to correlate (speckle: true and "
+               "speckle_correlation_m > 0), got ") +
+           (speckle ? "speckle_correlation_m 0" : "speckle: false");
+  }
+  return {};
+}
+
+void CheckAcoustics(YamlReader& node, const Acoustics& merged) {
+  if (const std::string conflict = merged.Conflict(); !conflict.empty()) {
+    node.Fail("speckle_angular_correlation_deg", conflict);
+  }
 }
 
 SensorModel ReadSensorModel(YamlReader& root) {
@@ -33,6 +51,7 @@ SensorModel ReadSensorModel(YamlReader& root) {
   model.geometry = mapping::ReadSensorGeometry(geometry);
   YamlReader node = root.Child("acoustics");
   ReadAcoustics(node, model.acoustics);
+  CheckAcoustics(node, model.acoustics);
   node.RejectUnknownKeys();
   root.RejectUnknownKeys();
   return model;

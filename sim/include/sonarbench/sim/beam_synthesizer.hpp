@@ -156,17 +156,22 @@ class BeamSynthesizer {
                             std::span<const double> amplitude_weights,
                             std::span<const std::uint64_t> sector_seeds);
 
-  /// Amplitude weights of the head-step-wide azimuth sectors around a beam's own (index
-  /// kSectorReach is the beam's; d steps off it, kSectorReach + d): the square roots of the
-  /// two-way horizontal pattern's share of power in each sector, sectors carrying under 1e-3 of
-  /// it dropped, so that the squares sum to 1.
+  /// Amplitude weights of the head-step-wide azimuth sectors around a beam's own (an odd count
+  /// 2R + 1: index R is the beam's; d steps off it, R + d), their squares summing to 1: the
+  /// square roots of the two-way horizontal pattern's share of power in each sector, sectors
+  /// carrying under 1e-3 of it dropped (R = kPatternReach, zeros beyond the pattern). With
+  /// speckle_angular_correlation_deg θ, each sector's scatterers are correlated with their
+  /// neighbours' (sector s is Σ_e c_e u_{s+e}, u independent, c_e ∝ exp(-|e| Δ / θ), Δ the head
+  /// step), so the weights are the pattern's convolved with c, on the independent sectors u,
+  /// less the outermost sectors that hold under 1e-3 of the power in all (at most a turn's).
   [[nodiscard]] const std::vector<double>& SectorWeights() const { return sector_weights_; }
 
   /// The speckle's correlation window L in bins (CorrelatedSpeckle, SectorSpeckle): the range
   /// response's extent, the pulse length plus one e-folding of each of its skirts
   /// (pulse_length_m + 2 pulse_skirt_length_m), rounded, at least 1.
   [[nodiscard]] int SpeckleWindow() const { return speckle_window_; }
-  static constexpr int kSectorReach = 4;
+  /// Sectors on each side of a beam's own that its pattern's weights cover.
+  static constexpr int kPatternReach = 4;
 
   /// Phases of the speckle's complex Gaussians.
   static constexpr int kSpecklePhases = 1024;
@@ -217,6 +222,8 @@ class BeamSynthesizer {
   int speckle_window_ = 1;
   /// SectorWeights().
   std::vector<double> sector_weights_;
+  /// Convolves sector_weights_ (the pattern's) with the place's angular correlation.
+  void CorrelateSectors();
   /// Power at which each AD step begins: step q for power ≥ ad_thresholds_[q] (index 0 unused).
   std::array<double, 256> ad_thresholds_{};
   /// Per bucket of powers (the top bits of the double, from the bucket of ad_thresholds_[1]

@@ -55,6 +55,13 @@ struct Acoustics {
   /// only the background noise varies; a moving one decorrelates cell by cell. The speckle is
   /// then drawn per head-step azimuth sector and shared by the beams whose pattern covers it.
   double speckle_correlation_m = 0.0;
+  /// With the place's speckle (speckle_correlation_m > 0), how far across azimuth [deg] the
+  /// place's scattering stays alike: neighbouring head-step sectors' scatterers are correlated,
+  /// sector amplitudes d steps apart by exp(-|d| · step / this) (each sector a sum of
+  /// independent ones with weights e-folding over this angle), so that the echoes' texture runs
+  /// along arcs of about this angle rather than changing from beam to beam as the pattern's
+  /// overlap alone makes it. 0, the default: independent sectors. Needs speckle_correlation_m.
+  double speckle_angular_correlation_deg = 0.0;
   /// The reverberation of a closed place (a tank): every echo feeds a diffuse tail heard after
   /// it, decaying exponentially with range, e-folding over `reverberation_length_m` [m] (0: no
   /// tail, the default), holding in all `reverberation_db` [dB] of the echo's power. A
@@ -76,6 +83,9 @@ struct Acoustics {
   std::vector<double> self_reflection_db;
 
   bool operator==(const Acoustics&) const = default;
+  /// What is wrong with these settings taken together (a key that needs another), naming the
+  /// keys; empty when nothing is.
+  [[nodiscard]] std::string Conflict() const;
 };
 
 /// A sensor model file: `geometry` for the mapper, `acoustics` for the simulator.
@@ -90,6 +100,9 @@ struct SensorModel {
 /// Reads the keys of an `acoustics` mapping that are present into `a` (absent ones keep their
 /// value), without rejecting unknown keys: the caller does, once.
 void ReadAcoustics(YamlReader& node, Acoustics& a);
+/// Reports on `node` (an acoustics mapping) what Acoustics::Conflict finds in `merged`, the
+/// settings in force once that mapping is applied.
+void CheckAcoustics(YamlReader& node, const Acoustics& merged);
 /// Reads a sensor model from an already-open reader (the root of a sensor model file).
 [[nodiscard]] SensorModel ReadSensorModel(YamlReader& root);
 
