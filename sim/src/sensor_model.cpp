@@ -28,19 +28,13 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("self_reflection_db", a.self_reflection_db);
 }
 
-std::string Acoustics::Conflict() const {
-  if (speckle_angular_correlation_deg > 0.0 && !(speckle && speckle_correlation_m > 0.0)) {
-    return std::string(
-               "the place's speckle to correlate (speckle: true and "
-               "speckle_correlation_m > 0), got ") +
-           (speckle ? "speckle_correlation_m 0" : "speckle: false");
-  }
-  return {};
-}
-
 void CheckAcoustics(YamlReader& node, const Acoustics& merged) {
-  if (const std::string conflict = merged.Conflict(); !conflict.empty()) {
-    node.Fail("speckle_angular_correlation_deg", conflict);
+  if (merged.speckle_angular_correlation_deg > 0.0 &&
+      !(merged.speckle && merged.speckle_correlation_m > 0.0)) {
+    node.Fail("speckle_angular_correlation_deg",
+              std::string("the place's speckle to correlate (speckle: true and "
+                          "speckle_correlation_m > 0), got ") +
+                  (merged.speckle ? "speckle_correlation_m 0" : "speckle: false"));
   }
 }
 

@@ -83,9 +83,6 @@ struct Acoustics {
   std::vector<double> self_reflection_db;
 
   bool operator==(const Acoustics&) const = default;
-  /// What is wrong with these settings taken together (a key that needs another), naming the
-  /// keys; empty when nothing is.
-  [[nodiscard]] std::string Conflict() const;
 };
 
 /// A sensor model file: `geometry` for the mapper, `acoustics` for the simulator.
@@ -100,8 +97,9 @@ struct SensorModel {
 /// Reads the keys of an `acoustics` mapping that are present into `a` (absent ones keep their
 /// value), without rejecting unknown keys: the caller does, once.
 void ReadAcoustics(YamlReader& node, Acoustics& a);
-/// Reports on `node` (an acoustics mapping) what Acoustics::Conflict finds in `merged`, the
-/// settings in force once that mapping is applied.
+/// Reports on `node` (an acoustics mapping) a key that `merged`, the settings in force once that
+/// mapping is applied, sets without what it needs: speckle_angular_correlation_deg without the
+/// place's speckle.
 void CheckAcoustics(YamlReader& node, const Acoustics& merged);
 /// Reads a sensor model from an already-open reader (the root of a sensor model file).
 [[nodiscard]] SensorModel ReadSensorModel(YamlReader& root);
