@@ -177,7 +177,7 @@ TEST_F(TankDataset, ReadsBackTheSimulatedBeamsAndPoses) {
   EXPECT_EQ(f[0], "200");
   EXPECT_NEAR(std::stod(f[2]), M_PI, 1e-6);
   EXPECT_EQ(f[4], "floor");
-  const double height = 0.45 - 0.0005;
+  const double height = expected[200].T_world_sonar.translation().z() - 0.0005;
   const double edge = 17.5 * M_PI / 180;
   EXPECT_GE(std::stod(f[3]), height / std::sin(edge) - 1e-6);
   EXPECT_LE(std::stod(f[3]), height / std::sin(edge - 35.0 / 160 * M_PI / 180));

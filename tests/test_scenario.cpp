@@ -137,8 +137,8 @@ TEST_F(TankScenario, EveryWallIsMappedAtTheSonarsHeight) {
   }
 }
 
-// The floor enters the 35° fan where the lowest ray meets it: slant range h / sin 17.5° = 1.50 m,
-// horizontal radius h / tan 17.5° = 1.43 m for h = 0.45 m. The floor's echo is the first run of
+// The floor enters the 35° fan where the lowest ray meets it: slant range h / sin 17.5° = 1.53 m,
+// horizontal radius h / tan 17.5° = 1.46 m for h = 0.46 m. The floor's echo is the first run of
 // nearly every beam, so the floor layer holds occupied cells around that radius in every
 // direction: at least 90% of 5° sectors, allowing for beams whose floor echo speckle hides.
 TEST_F(TankScenario, FloorRingAppearsWhereTheFanMeetsTheFloor) {

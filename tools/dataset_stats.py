@@ -3,6 +3,7 @@
 simulated run with a real log bin by bin where `sonarbench fidelity` gives only summaries.
 
     python3 tools/dataset_stats.py DIR [DIR ...] [--crossing T --from R] [--bins FIRST LAST]
+                                   [--lit FIRST LAST]
 
 DIR is what `sonarbench simulate SCENE --out DIR` or `sonarbench import LOG.mat --out DIR`
 wrote. For each, per range band: the mean intensity, the share of bins at 0 and at 150 or
@@ -17,7 +18,12 @@ smoothing) reaches T, its centre's range times the cosine of the beam's angle of
 (the wall's distance, for a wall square to the side), median over the beams. With --bins
 FIRST LAST, bin by bin from FIRST to LAST: over every beam that long, the mean intensity, the
 share at 0 and the 10th percentile (what lies under every direction at that range: the floor,
-or the sonar's own). Standard library only.
+or the sonar's own). With --lit FIRST LAST, where an echo heard under every head angle (a
+floor's or a water surface's, where the fan's edge meets it) begins: the first bin after FIRST,
+up to LAST, at which the share of beams at 0 falls to half or less, interpolated linearly from
+the bin before (so 122.5 is halfway between bins 122 and 123), over all beams and per octant of
+head angle ([0°, 45°), [45°, 90°), ...): a level sonar's ring begins at one range all round, a
+tilted one's earlier on one side and later on the other. Standard library only.
 """
 import argparse
 import glob
@@ -113,7 +119,33 @@ def bin_rows(beams, first, last):
     return rows
 
 
-def report(directory, crossing=None, from_m=None, bins=None):
+def half_lit_bin(beams, first, last):
+    """The first k in (first, last] whose share of `beams` (intensity lists) at 0 is 0.5 or less
+    while bin k - 1's is more, interpolated between the two; None if there is none."""
+    def share_at_zero(k):
+        values = [b[k] for b in beams if len(b) > k]
+        return sum(v == 0 for v in values) / len(values) if values else None
+    before = share_at_zero(first)
+    for k in range(first + 1, last + 1):
+        share = share_at_zero(k)
+        if before is not None and share is not None and before > 0.5 >= share:
+            return k - 1 + (before - 0.5) / (before - share)
+        before = share
+    return None
+
+
+def lit_rows(with_angles, first, last):
+    """[("all", bin or None)] and then, per octant of head angle holding beams, (its first
+    degree, bin or None)."""
+    octants = {}
+    for angle, _, b in with_angles:
+        octants.setdefault(int(math.degrees(angle) % 360.0 // 45.0) % 8, []).append(b)
+    rows = [("all", half_lit_bin([b for _, _, b in with_angles], first, last))]
+    rows += [(45 * o, half_lit_bin(octants[o], first, last)) for o in sorted(octants)]
+    return rows
+
+
+def report(directory, crossing=None, from_m=None, bins=None, lit=None):
     with_angles = load_beams(directory, with_angles=True)
     beams = [(size, b) for _, size, b in with_angles]
     spreads = sweep_spreads(with_angles)
@@ -150,6 +182,11 @@ def report(directory, crossing=None, from_m=None, bins=None):
         for k, range_m, mean, zeros, p10 in bin_rows(beams, *bins):
             print(f"  bin {k} ({range_m:.3f} m): mean {mean:.1f}, at 0 {100 * zeros:.1f}%, "
                   f"p10 {p10}")
+    if lit is not None:
+        rows = lit_rows(with_angles, *lit)
+        print(f"  half the beams lit from bin (searched {lit[0]}-{lit[1]}): " +
+              ", ".join(f"{name}{'' if name == 'all' else '°'} " +
+                        (f"{k:.2f}" if k is not None else "none") for name, k in rows))
 
 
 if __name__ == "__main__":
@@ -162,10 +199,15 @@ if __name__ == "__main__":
                         help="range [m] the crossing search starts at (with --crossing)")
     parser.add_argument("--bins", type=int, nargs=2, metavar=("FIRST", "LAST"),
                         help="also report bins FIRST to LAST one by one")
+    parser.add_argument("--lit", type=int, nargs=2, metavar=("FIRST", "LAST"),
+                        help="also report where half the beams are lit, from FIRST to LAST, "
+                             "over all beams and per octant of head angle")
     args = parser.parse_args()
     if (args.crossing is None) != (args.from_m is None):
         parser.error("--crossing and --from go together")
     if args.bins is not None and not 0 <= args.bins[0] <= args.bins[1]:
         parser.error(f"--bins {args.bins[0]} {args.bins[1]}: expected 0 <= FIRST <= LAST")
+    if args.lit is not None and not 0 <= args.lit[0] < args.lit[1]:
+        parser.error(f"--lit {args.lit[0]} {args.lit[1]}: expected 0 <= FIRST < LAST")
     for d in args.directories:
-        report(d, args.crossing, args.from_m, args.bins)
+        report(d, args.crossing, args.from_m, args.bins, args.lit)

@@ -97,6 +97,25 @@ def main():
         assert result.returncode != 0 and "expected 0 <= FIRST <= LAST" in result.stderr, \
             result.stderr
 
+        # Where half the beams are lit: of four beams at 0°, three are still 0 at bin 100
+        # (share 0.75) and one at 101 (0.25): half at 100.5. Four at 90° are 0 up to bin 109
+        # and lit from 110: 109.5. Two at 200° stay dark: none. All ten: 0.6 from bin 102 to
+        # 109 and 0.2 at 110: 109.25.
+        os.makedirs(os.path.join(tmp, "lit", "beams"))
+
+        def ring_beam(first_lit_bin):
+            return [0 if k < first_lit_bin else 30 for k in range(BINS)]
+        lit_beams = [ring_beam(b) for b in (100, 101, 101, 102, 110, 110, 110, 110, BINS, BINS)]
+        lit_angles = [0.0] * 4 + [math.radians(90.0)] * 4 + [math.radians(200.0)] * 2
+        write_beams(os.path.join(tmp, "lit", "beams", "sweep_0000.bin"), lit_beams, lit_angles)
+        result = run(os.path.join(tmp, "lit"), "--lit", "90", "130")
+        assert result.returncode == 0, result.stderr
+        assert "half the beams lit from bin (searched 90-130): all 109.25, 0° 100.50, " \
+            "90° 109.50, 180° none\n" in result.stdout, result.stdout
+        result = run(os.path.join(tmp, "lit"), "--lit", "130", "130")
+        assert result.returncode != 0 and "expected 0 <= FIRST < LAST" in result.stderr, \
+            result.stderr
+
         os.makedirs(os.path.join(tmp, "bad", "beams"))
         path = os.path.join(tmp, "bad", "beams", "sweep_0000.bin")
         write_beams(path, [beam])
