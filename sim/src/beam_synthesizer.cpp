@@ -504,9 +504,78 @@ struct StraightReturn {
   double weight = 0.0;
 };
 
+// Adds echoes to a beam's bins: an echo of strength `strength` (before range losses) from range
+// `range` [m] lasts while the pulse passes it, so it is heard at every range in [r, r + L), and
+// each bin gets the power times the fraction of the bin that span covers; with a second trip,
+// the echo also goes to the trip's impulse response, over [r, r + 1 bin). Built per step as a
+// local, its scalars copied in: held through a reference they would be reloaded after every
+// store to the bins.
+class EchoDeposit {
+ public:
+  EchoDeposit(const BeamSynthesizer& synthesizer, const mapping::SensorGeometry& geometry,
+              double pulse_length_m, bool second_trip, PulseSpreader& spreader,
+              std::vector<double>& impulse)
+      : synthesizer_(synthesizer),
+        pulse_bins_(pulse_length_m / geometry.bin_size_m),
+        bins_per_m_(1.0 / geometry.bin_size_m),
+        bins_(static_cast<std::size_t>(geometry.num_bins)),
+        second_trip_(second_trip),
+        spreader_(spreader),
+        impulse_(impulse) {}
+
+  // Inlined, with the range loss from its table (RangeLossFromTable): a call per ray cost more
+  // than the work (synthesis_bench).
+  [[gnu::always_inline]] void operator()(double range, double strength) {
+    const double start = range * bins_per_m_;
+    const double power = strength * synthesizer_.RangeLossFromTable(range);
+    spreader_.Add(start, start + pulse_bins_, power);
+    // The second trip's impulse response: the echo over [start, start + 1) bins, shared by the
+    // two bins it covers (the last bin's share past it dropped).
+    if (second_trip_ && start < static_cast<double>(bins_)) {
+      const auto k = static_cast<std::size_t>(start);
+      const double after = start - static_cast<double>(k);
+      impulse_[k] += power * (1.0 - after);
+      if (k + 1 < bins_) impulse_[k + 1] += power * after;
+    }
+  }
+
+ private:
+  const BeamSynthesizer& synthesizer_;
+  double pulse_bins_;
+  double bins_per_m_;
+  std::size_t bins_;
+  bool second_trip_;
+  PulseSpreader& spreader_;
+  std::vector<double>& impulse_;
+};
+
+// A beam's one-way pattern towards a world direction (unit), R_beam_world taking world
+// directions into the beam's frame (x along its axis, z up the fan): 0 outside the half-space
+// ahead; with `blur` > 0 its mean over a 2-D Gaussian offset of that variance per axis [rad²]:
+// for exp(-k θ²/2) per axis, exp(-k θ² / (2 (1 + k τ²))) / √(1 + k τ²). k_h and k_v are the
+// two-way pattern's exponents.
+struct OneWayPattern {
+  Eigen::Matrix3d R_beam_world;
+  double k_h = 0.0;
+  double k_v = 0.0;
+
+  double operator()(const Eigen::Vector3d& towards, double blur = 0.0) const {
+    const Eigen::Vector3d u = R_beam_world * towards;
+    if (u.x() <= 0.0) return 0.0;
+    const double theta = std::atan2(u.y(), u.x());
+    const double epsilon = std::asin(std::clamp(u.z(), -1.0, 1.0));
+    const double wide_h = 1.0 + k_h * blur;
+    const double wide_v = 1.0 + k_v * blur;
+    return std::exp(-0.5 * (k_h * theta * theta / wide_h + k_v * epsilon * epsilon / wide_v)) /
+           std::sqrt(wide_h * wide_v);
+  }
+};
+
+}  // namespace
+
 // Synthesize()'s working memory, one per thread, kept between beams: a beam allocates only its
 // output.
-struct Scratch {
+struct BeamSynthesizer::Scratch {
   std::vector<Eigen::Vector3f> directions;
   std::vector<double> patterns;
   std::vector<std::optional<Hit>> hits;
@@ -523,154 +592,155 @@ struct Scratch {
   std::vector<std::uint64_t> sector_seeds;
 };
 
-}  // namespace
+// One beam's synthesis: what its steps share, each step a method. Synthesize() runs them in
+// the order declared; each takes what the ones before it left in the job and the scratch.
+class BeamSynthesizer::BeamJob {
+ public:
+  BeamJob(const BeamSynthesizer& synthesizer, double head_angle_rad,
+          const Eigen::Isometry3d& T_world_sonar, std::uint64_t seed, Scratch& scratch,
+          SynthesizedBeam& out)
+      : s_(synthesizer),
+        g_(synthesizer.sensor_.geometry),
+        a_(synthesizer.sensor_.acoustics),
+        bins_(static_cast<std::size_t>(g_.num_bins)),
+        max_range_(g_.MaxRangeM()),
+        rng_(seed),
+        scratch_(scratch),
+        out_(out),
+        T_world_sonar_(T_world_sonar),
+        R_world_beam_(
+            T_world_sonar.linear() *
+            Eigen::AngleAxisd(head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix()),
+        origin_(T_world_sonar.translation().cast<float>()) {
+    PulseSpreader& spreader = scratch_.spreader;
+    if (spreader.Bins() != bins_) spreader.Reset(bins_);  // AddTo() leaves it empty
+    if (s_.second_trip_ > 0.0) scratch_.impulse_power.assign(bins_, 0.0);
+    scratch_.echo_power.assign(bins_, 0.0);
+  }
 
-SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad,
-                                            const Eigen::Isometry3d& T_world_sonar,
-                                            std::uint64_t seed, EchoPower echo_power) const {
-  const mapping::SensorGeometry& g = sensor_.geometry;
-  const Acoustics& a = sensor_.acoustics;
-  const auto bins = static_cast<std::size_t>(g.num_bins);
-  const double max_range = g.MaxRangeM();
-  Rng rng(seed);
-  thread_local Scratch scratch;
-  // A local reference: no thread-local look-up per echo.
-  PulseSpreader& spreader = scratch.spreader;
-  if (spreader.Bins() != bins) spreader.Reset(bins);  // AddTo() leaves it empty
-  std::vector<double>& impulse = scratch.impulse_power;
-  if (second_trip_ > 0.0) impulse.assign(bins, 0.0);
-
-  SynthesizedBeam out;
-  out.beam.time_s = time_s;
-  out.beam.head_angle_rad = head_angle_rad;
-  out.beam.T_world_sonar = T_world_sonar;
-  out.truth.T_world_sonar = T_world_sonar;
-  out.beam.bin_size_m = g.bin_size_m;
-  std::vector<double>& echo = scratch.echo_power;
-  echo.assign(bins, 0.0);
-
-  const Eigen::Matrix3d R_world_beam =
-      T_world_sonar.linear() *
-      Eigen::AngleAxisd(head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Vector3f origin = T_world_sonar.translation().cast<float>();
   // The echo's own randomness (ray jitter, speckle) is the ping's, or, with a correlation
   // length, the place's: the same for every ping from the same azimuth, tilt and position cell.
   // The place's speckle is its scatterers': each head-step-wide azimuth sector has its own,
   // which every beam whose pattern covers it hears (SectorSpeckle).
-  std::optional<Rng> place_rng;
-  std::vector<std::uint64_t>& sector_seeds = scratch.sector_seeds;
-  const int sector_reach = static_cast<int>(sector_weights_.size() / 2);
-  sector_seeds.resize(sector_weights_.size());
-  if (a.speckle_correlation_m > 0.0) {
-    const double step = g.step_angle_rad;
-    const long long turn = std::llround(2.0 * std::numbers::pi / step);
-    const Eigen::Vector3d axis = R_world_beam.col(0);
-    const long long azimuth = std::llround(std::atan2(axis.y(), axis.x()) / step);
-    const long long tilt = std::llround(std::asin(std::clamp(axis.z(), -1.0, 1.0)) / step);
-    std::array<std::uint64_t, 3> cells{};
-    for (int i = 0; i < 3; ++i) {
-      const double cell = std::floor(T_world_sonar.translation()[i] / a.speckle_correlation_m);
-      cells[static_cast<std::size_t>(i)] =
-          static_cast<std::uint64_t>(static_cast<std::int64_t>(cell));
-    }
-    const auto place_of = [&](long long sector) {
-      std::uint64_t place =
-          DeriveSeed(place_seed_, static_cast<std::uint64_t>(((sector % turn) + turn) % turn));
-      place = DeriveSeed(place, static_cast<std::uint64_t>(tilt));
-      for (const std::uint64_t cell : cells) place = DeriveSeed(place, cell);
-      return place;
-    };
-    place_rng.emplace(place_of(azimuth));
-    for (int d = -sector_reach; d <= sector_reach; ++d) {
-      sector_seeds[static_cast<std::size_t>(d + sector_reach)] =
-          DeriveSeed(place_of(azimuth + d), 0x737065636bULL);  // "speck"
-    }
+  void SeedPlace();
+  // The aperture's rays and their first hits, traced as one coherent bundle: each hit's echo,
+  // and the mirror paths that go on from it.
+  void TracePrimaries();
+  // The mirror paths, one bounce at a time (see above the definition).
+  void TraceMultipath();
+  // The echo's bins, its skirts, second trip, speckle, reverberation, self-reflection and
+  // noise, and the 8-bit levels; the noise-free power kept if asked.
+  void FormLevels(EchoPower echo_power);
+
+ private:
+  EchoDeposit Deposit() {
+    return {s_,
+            g_,
+            a_.pulse_length_m,
+            s_.second_trip_ > 0.0,
+            scratch_.spreader,
+            scratch_.impulse_power};
   }
-  Rng& echo_rng = place_rng ? *place_rng : rng;
-  const double pulse_bins = a.pulse_length_m / g.bin_size_m;
-  const double bins_per_m = 1.0 / g.bin_size_m;
 
-  // Adds an echo of strength `strength` (before range losses) from range `range` [m]: the echo
-  // of a point lasts while the pulse passes it, so it is heard at every range in [r, r + L), and
-  // each bin gets the power times the fraction of the bin that span covers.
-  // The range loss from its table (RangeLossFromTable). Inlined: a call per ray cost more than
-  // the work (synthesis_bench).
-  auto deposit = [&](double range, double strength) __attribute__((always_inline)) {
-    const double start = range * bins_per_m;
-    const double power = strength * RangeLossFromTable(range);
-    spreader.Add(start, start + pulse_bins, power);
-    // The second trip's impulse response: the echo over [start, start + 1) bins, shared by the
-    // two bins it covers (the last bin's share past it dropped).
-    if (second_trip_ > 0.0 && start < static_cast<double>(bins)) {
-      const auto k = static_cast<std::size_t>(start);
-      const double after = start - static_cast<double>(k);
-      impulse[k] += power * (1.0 - after);
-      if (k + 1 < bins) impulse[k + 1] += power * after;
-    }
-  };
-  // The one-way pattern towards a world direction (unit), or 0 outside the half-space ahead;
-  // with `blur` > 0 its mean over a 2-D Gaussian offset of that variance per axis [rad²]: for
-  // exp(-k θ²/2) per axis, exp(-k θ² / (2 (1 + k τ²))) / √(1 + k τ²).
-  const Eigen::Matrix3d R_beam_world = R_world_beam.transpose();
-  auto one_way_pattern = [&](const Eigen::Vector3d& towards, double blur = 0.0) {
-    const Eigen::Vector3d u = R_beam_world * towards;
-    if (u.x() <= 0.0) return 0.0;
-    const double theta = std::atan2(u.y(), u.x());
-    const double epsilon = std::asin(std::clamp(u.z(), -1.0, 1.0));
-    const double wide_h = 1.0 + pattern_k_h_ * blur;
-    const double wide_v = 1.0 + pattern_k_v_ * blur;
-    return std::exp(-0.5 * (pattern_k_h_ * theta * theta / wide_h +
-                            pattern_k_v_ * epsilon * epsilon / wide_v)) /
-           std::sqrt(wide_h * wide_v);
-  };
+  const BeamSynthesizer& s_;
+  const mapping::SensorGeometry& g_;
+  const Acoustics& a_;
+  std::size_t bins_;
+  double max_range_;
+  Rng rng_;
+  Scratch& scratch_;
+  SynthesizedBeam& out_;
+  const Eigen::Isometry3d& T_world_sonar_;
+  Eigen::Matrix3d R_world_beam_;
+  Eigen::Vector3f origin_;
+  std::optional<Rng> place_rng_;
+  // The place's generator if there is one, else the ping's (SeedPlace()).
+  Rng* echo_rng_ = &rng_;
+  // The primary rays' pattern weights' sum (TracePrimaries()).
+  double weight_sum_ = 0.0;
+};
 
-  // The aperture's rays and their first hits, traced as one coherent bundle.
-  const auto rays = static_cast<std::size_t>(a.rays_horizontal) * a.rays_vertical;
-  std::vector<Eigen::Vector3f>& directions = scratch.directions;
-  std::vector<double>& patterns = scratch.patterns;
-  const double weight_sum = DrawRays(R_world_beam, echo_rng, directions, patterns);
-  std::vector<std::optional<Hit>>& hits = scratch.hits;
+void BeamSynthesizer::BeamJob::SeedPlace() {
+  std::vector<std::uint64_t>& sector_seeds = scratch_.sector_seeds;
+  const int sector_reach = static_cast<int>(s_.sector_weights_.size() / 2);
+  sector_seeds.resize(s_.sector_weights_.size());
+  if (a_.speckle_correlation_m <= 0.0) return;
+  const double step = g_.step_angle_rad;
+  const long long turn = std::llround(2.0 * std::numbers::pi / step);
+  const Eigen::Vector3d axis = R_world_beam_.col(0);
+  const long long azimuth = std::llround(std::atan2(axis.y(), axis.x()) / step);
+  const long long tilt = std::llround(std::asin(std::clamp(axis.z(), -1.0, 1.0)) / step);
+  std::array<std::uint64_t, 3> cells{};
+  for (int i = 0; i < 3; ++i) {
+    const double cell = std::floor(T_world_sonar_.translation()[i] / a_.speckle_correlation_m);
+    cells[static_cast<std::size_t>(i)] =
+        static_cast<std::uint64_t>(static_cast<std::int64_t>(cell));
+  }
+  const auto place_of = [&](long long sector) {
+    std::uint64_t place =
+        DeriveSeed(s_.place_seed_, static_cast<std::uint64_t>(((sector % turn) + turn) % turn));
+    place = DeriveSeed(place, static_cast<std::uint64_t>(tilt));
+    for (const std::uint64_t cell : cells) place = DeriveSeed(place, cell);
+    return place;
+  };
+  place_rng_.emplace(place_of(azimuth));
+  echo_rng_ = &*place_rng_;
+  for (int d = -sector_reach; d <= sector_reach; ++d) {
+    sector_seeds[static_cast<std::size_t>(d + sector_reach)] =
+        DeriveSeed(place_of(azimuth + d), 0x737065636bULL);  // "speck"
+  }
+}
+
+void BeamSynthesizer::BeamJob::TracePrimaries() {
+  const auto rays = static_cast<std::size_t>(a_.rays_horizontal) * a_.rays_vertical;
+  std::vector<Eigen::Vector3f>& directions = scratch_.directions;
+  std::vector<double>& patterns = scratch_.patterns;
+  weight_sum_ = s_.DrawRays(R_world_beam_, *echo_rng_, directions, patterns);
+  std::vector<std::optional<Hit>>& hits = scratch_.hits;
   hits.resize(rays);
-  tracer_.IntersectBundle(origin, directions, static_cast<float>(max_range), hits);
-  out.traced_rays += rays;
-  std::vector<MirrorPath>& paths = scratch.paths;
+  s_.tracer_.IntersectBundle(origin_, directions, static_cast<float>(max_range_), hits);
+  out_.traced_rays += rays;
+  std::vector<MirrorPath>& paths = scratch_.paths;
   paths.clear();
+  EchoDeposit deposit = Deposit();
   for (std::size_t r = 0; r < rays; ++r) {
     const auto& hit = hits[r];
     if (!hit) continue;
     const Eigen::Vector3f& direction = directions[r];
     const double pattern = patterns[r];
-    const double range = std::max<double>(hit->distance, g.bin_size_m);
-    if (!out.truth.first_hit_range_m || range < *out.truth.first_hit_range_m) {
-      out.truth.first_hit_range_m = range;
-      out.truth.first_hit_mesh = hit->mesh;
+    const double range = std::max<double>(hit->distance, g_.bin_size_m);
+    if (!out_.truth.first_hit_range_m || range < *out_.truth.first_hit_range_m) {
+      out_.truth.first_hit_range_m = range;
+      out_.truth.first_hit_mesh = hit->mesh;
     }
-    const Material& material = materials_by_mesh_[hit->mesh];
+    const Material& material = s_.materials_by_mesh_[hit->mesh];
     const double cos_incidence = std::abs(hit->normal.dot(direction));
     deposit(range, pattern * material.reflectivity *
                        CosPower(cos_incidence, material.backscatter_exponent));
-    if (a.max_bounces > 0 && material.specular > 0.0) {
-      paths.push_back({.from = origin,
+    if (a_.max_bounces > 0 && material.specular > 0.0) {
+      paths.push_back({.from = origin_,
                        .direction = direction,
                        .hit = *hit,
                        .path = hit->distance,
                        .pattern = pattern});
     }
   }
+}
 
-  // Multipath, one bounce at a time for all the beam's rays (each bounce's mirrored rays one
-  // stream, their occlusion rays another): a ray with two-way pattern weight `pattern` goes on
-  // in the mirror direction with the specular fraction of its energy, up to max_bounces times.
-  // At each later hit P_k, after a path of length L from the sonar, two returns:
-  //  - back through the same mirrors: range L, weight pattern · s² · ρ cosⁿ, where s is the
-  //    product of the specular fractions so far and pattern the two-way pattern of the way out
-  //    and back (return_pattern);
-  //  - straight back to the sonar if P_k is in view (an occlusion ray) and in the receive lobe:
-  //    range R = (L + d)/2 with d = |P_k - sonar|, weight 2 · √pattern · p(P_k) · s · ρ (cos_i
-  //    cos_s)^(n/2) · (R/d)^(S/10); p is the one-way pattern towards P_k, the factor 2 counts
-  //    the reverse path (sonar → P_k → mirrors → sonar), equal by reciprocity, and (R/d)^(S/10)
-  //    turns the monostatic spreading at R into the last leg's own.
-  //
+// Multipath, one bounce at a time for all the beam's rays (each bounce's mirrored rays one
+// stream, their occlusion rays another): a ray with two-way pattern weight `pattern` goes on in
+// the mirror direction with the specular fraction of its energy, up to max_bounces times. At
+// each later hit P_k, after a path of length L from the sonar, two returns:
+//  - back through the same mirrors: range L, weight pattern · s² · ρ cosⁿ, where s is the
+//    product of the specular fractions so far and pattern the two-way pattern of the way out
+//    and back (return_pattern);
+//  - straight back to the sonar if P_k is in view (an occlusion ray) and in the receive lobe:
+//    range R = (L + d)/2 with d = |P_k - sonar|, weight 2 · √pattern · p(P_k) · s · ρ (cos_i
+//    cos_s)^(n/2) · (R/d)^(S/10); p is the one-way pattern towards P_k, the factor 2 counts the
+//    reverse path (sonar → P_k → mirrors → sonar), equal by reciprocity, and (R/d)^(S/10) turns
+//    the monostatic spreading at R into the last leg's own.
+void BeamSynthesizer::BeamJob::TraceMultipath() {
+  const OneWayPattern one_way_pattern{R_world_beam_.transpose(), s_.pattern_k_h_, s_.pattern_k_v_};
   // The two-way pattern of the way out and back along a mirror path ending at p's hit. Through
   // perfect mirrors the echo comes back along the way out: the ray's own two-way pattern.
   // Through rough ones the way back is a path of its own, each rough mirror tilting it
@@ -685,20 +755,25 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
         std::max(p.blur[0] - 2.0 * p.blur[1] * inverse + p.blur[2] * inverse * inverse, 0.0);
     return std::sqrt(p.pattern) * one_way_pattern(image.cast<double>().normalized(), blur);
   };
-  const Eigen::Vector3d sonar = T_world_sonar.translation();
-  const double spreading_db = a.spreading_db_per_decade;
-  std::vector<MirrorPath>& next_paths = scratch.next_paths;
-  std::vector<Ray>& stream = scratch.rays;
-  std::vector<StraightReturn>& returns = scratch.returns;
-  for (int bounce = 1; bounce <= a.max_bounces && !paths.empty(); ++bounce) {
+  const Eigen::Vector3d sonar = T_world_sonar_.translation();
+  const double spreading_db = a_.spreading_db_per_decade;
+  const double max_range = max_range_;
+  EchoDeposit deposit = Deposit();
+  Rng& echo_rng = *echo_rng_;
+  std::vector<MirrorPath>& paths = scratch_.paths;
+  std::vector<MirrorPath>& next_paths = scratch_.next_paths;
+  std::vector<std::optional<Hit>>& hits = scratch_.hits;
+  std::vector<Ray>& stream = scratch_.rays;
+  std::vector<StraightReturn>& returns = scratch_.returns;
+  for (int bounce = 1; bounce <= a_.max_bounces && !paths.empty(); ++bounce) {
     next_paths.clear();
     stream.clear();
     for (MirrorPath p : paths) {
-      const Material& mirror = materials_by_mesh_[p.hit.mesh];
+      const Material& mirror = s_.materials_by_mesh_[p.hit.mesh];
       p.specular *= mirror.specular;
       if (p.specular <= 0.0 || p.path >= 2.0 * max_range) continue;
       p.from += p.hit.distance * p.direction;
-      if (rough_mirrors_) {
+      if (s_.rough_mirrors_) {
         p.image += p.unfold * (p.hit.distance * p.direction);
         p.unfold -= 2.0f * (p.unfold * p.hit.normal) * p.hit.normal.transpose();
       }
@@ -708,7 +783,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
         p.blur[1] += variance * p.path;
         p.blur[2] += variance * p.path * p.path;
       }
-      p.direction = SpreadMirror(
+      p.direction = s_.SpreadMirror(
           (p.direction - 2.0f * p.direction.dot(p.hit.normal) * p.hit.normal).normalized(),
           p.hit.normal, mirror, echo_rng);
       stream.push_back({p.from + 1e-4f * p.direction, p.direction,
@@ -716,8 +791,8 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       next_paths.push_back(p);
     }
     hits.resize(stream.size());
-    tracer_.IntersectStream(stream, hits);
-    out.traced_rays += stream.size();
+    s_.tracer_.IntersectStream(stream, hits);
+    out_.traced_rays += stream.size();
 
     paths.clear();
     stream.clear();
@@ -727,7 +802,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       MirrorPath& p = paths.emplace_back(next_paths[q]);
       p.hit = *hits[q];
       p.path += p.hit.distance;
-      const Material& m = materials_by_mesh_[p.hit.mesh];
+      const Material& m = s_.materials_by_mesh_[p.hit.mesh];
       const double cos_in = std::abs(p.hit.normal.dot(p.direction));
       if (p.path <= max_range) {
         deposit(p.path, return_pattern(p) * p.specular * p.specular * m.reflectivity *
@@ -737,7 +812,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       const Eigen::Vector3d back = sonar - at.cast<double>();
       const double d = back.norm();
       const double range = 0.5 * (p.path + d);
-      if (range > max_range || d < g.bin_size_m) continue;
+      if (range > max_range || d < g_.bin_size_m) continue;
       const double receive = one_way_pattern(-back / d);
       const double weight = 2.0 * std::sqrt(p.pattern) * receive * p.specular * m.reflectivity;
       if (weight < kNegligibleWeight) continue;
@@ -747,53 +822,75 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
       returns.push_back({range, weight * CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) *
                                     std::pow(range / d, spreading_db / 10.0)});
     }
-    tracer_.OccludedStream(stream, scratch.occluded);
-    out.traced_rays += stream.size();
+    s_.tracer_.OccludedStream(stream, scratch_.occluded);
+    out_.traced_rays += stream.size();
     for (std::size_t q = 0; q < returns.size(); ++q) {
-      if (!scratch.occluded[q]) deposit(returns[q].range, returns[q].weight);
+      if (!scratch_.occluded[q]) deposit(returns[q].range, returns[q].weight);
     }
   }
-  spreader.AddTo(echo);
+}
+
+void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
+  std::vector<double>& echo = scratch_.echo_power;
+  scratch_.spreader.AddTo(echo);
 
   if (const auto axis =
-          tracer_.Intersect(origin, (R_world_beam * Eigen::Vector3d::UnitX()).cast<float>(),
-                            static_cast<float>(max_range))) {
-    out.truth.axis_hit_range_m = axis->distance;
+          s_.tracer_.Intersect(origin_, (R_world_beam_ * Eigen::Vector3d::UnitX()).cast<float>(),
+                               static_cast<float>(max_range_))) {
+    out_.truth.axis_hit_range_m = axis->distance;
   }
 
-  out.beam.intensities.resize(bins);
-  const double noise_power = std::pow(10.0, a.noise_level_db / 10.0);
-  const double gain = std::pow(10.0, a.gain_db / 10.0);
-  for (double& power : echo) power /= weight_sum;
-  AddPulseSkirts(echo);
-  if (second_trip_ > 0.0) {
-    for (double& power : impulse) power /= weight_sum;
-    AddSecondTrip(echo, impulse);
+  out_.beam.intensities.resize(bins_);
+  const double noise_power = std::pow(10.0, a_.noise_level_db / 10.0);
+  const double gain = std::pow(10.0, a_.gain_db / 10.0);
+  for (double& power : echo) power /= weight_sum_;
+  s_.AddPulseSkirts(echo);
+  if (s_.second_trip_ > 0.0) {
+    for (double& power : scratch_.impulse_power) power /= weight_sum_;
+    s_.AddSecondTrip(echo, scratch_.impulse_power);
   }
-  std::vector<double>& speckle = scratch.speckle;
-  if (a.speckle) {
-    speckle.resize(bins);
-    if (place_rng) {
-      SectorSpeckle(speckle, speckle_window_, sector_weights_, sector_seeds);
+  std::vector<double>& speckle = scratch_.speckle;
+  if (a_.speckle) {
+    speckle.resize(bins_);
+    if (place_rng_) {
+      SectorSpeckle(speckle, s_.speckle_window_, s_.sector_weights_, scratch_.sector_seeds);
     } else {
-      CorrelatedSpeckle(speckle, speckle_window_, echo_rng);
+      CorrelatedSpeckle(speckle, s_.speckle_window_, *echo_rng_);
     }
   }
-  AddReverberation(echo);
+  s_.AddReverberation(echo);
   // The powers first, then their levels: no 8-bit store inside the loop that draws the noise.
-  std::vector<double>& powers = scratch.powers;
-  powers.resize(bins);
-  for (std::size_t k = 0; k < bins; ++k) {
+  std::vector<double>& powers = scratch_.powers;
+  powers.resize(bins_);
+  const std::vector<double>& self_reflection = s_.self_reflection_power_;
+  for (std::size_t k = 0; k < bins_; ++k) {
     double signal = gain * echo[k];
-    if (k < self_reflection_power_.size()) signal += self_reflection_power_[k];
-    if (a.speckle) signal *= speckle[k];
-    powers[k] = signal + noise_power * rng.Exponential();
+    if (k < self_reflection.size()) signal += self_reflection[k];
+    if (a_.speckle) signal *= speckle[k];
+    powers[k] = signal + noise_power * rng_.Exponential();
   }
-  const AdSteps quantise{ad_thresholds_.data(), ad_bucket_steps_.data(), ad_first_bucket_,
-                         ad_bucket_shift_};
-  std::uint8_t* const levels = out.beam.intensities.data();
-  for (std::size_t k = 0; k < bins; ++k) levels[k] = quantise(powers[k]);
-  if (echo_power == EchoPower::kKeep) out.echo_power = echo;
+  const AdSteps quantise{s_.ad_thresholds_.data(), s_.ad_bucket_steps_.data(), s_.ad_first_bucket_,
+                         s_.ad_bucket_shift_};
+  std::uint8_t* const levels = out_.beam.intensities.data();
+  for (std::size_t k = 0; k < bins_; ++k) levels[k] = quantise(powers[k]);
+  if (echo_power == EchoPower::kKeep) out_.echo_power = echo;
+}
+
+SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad,
+                                            const Eigen::Isometry3d& T_world_sonar,
+                                            std::uint64_t seed, EchoPower echo_power) const {
+  SynthesizedBeam out;
+  out.beam.time_s = time_s;
+  out.beam.head_angle_rad = head_angle_rad;
+  out.beam.T_world_sonar = T_world_sonar;
+  out.truth.T_world_sonar = T_world_sonar;
+  out.beam.bin_size_m = sensor_.geometry.bin_size_m;
+  thread_local Scratch scratch;
+  BeamJob job(*this, head_angle_rad, T_world_sonar, seed, scratch, out);
+  job.SeedPlace();
+  job.TracePrimaries();
+  job.TraceMultipath();
+  job.FormLevels(echo_power);
   return out;
 }
 

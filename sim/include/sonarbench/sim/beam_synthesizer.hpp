@@ -193,6 +193,10 @@ class BeamSynthesizer {
   static constexpr int kSpreadOffsets = 64 * 64;
 
  private:
+  /// Synthesize()'s per-thread working memory and its steps (beam_synthesizer.cpp).
+  struct Scratch;
+  class BeamJob;
+
   /// `unit` tilted by atan(σ·g) towards a direction across it, g a standard 2-D Gaussian offset
   /// from the kSpreadOffsets tabled ones (one draw from `rng`). Unit length.
   [[nodiscard]] Eigen::Vector3f Tilt(const Eigen::Vector3f& unit, float sigma, Rng& rng) const;
