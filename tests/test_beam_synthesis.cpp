@@ -966,6 +966,92 @@ TEST(BeamSynthesis, SpeckleIsFrozenPerPlaceWithACorrelationLength) {
             fresh.Synthesize(8.5, 0.0, here, 2).beam.intensities);
 }
 
+// The receiver's level jitter (level_jitter_db σ = 2 dB here, 12.75 AD steps, so that the
+// levels' rounding is small beside it): with the echoes frozen by the place (speckle off, the
+// rays' jitter the place's) and no noise, pings differ by the jitter alone. Each bright bin's
+// level less the exact level of its noise-free echo, 10 log10 P, in dB:
+//  - is normal with mean 0 and variance σ² v + s²/12, v the tabled quantiles' variance and s
+//    the AD step (the rounding): mean within 5 standard errors, variance within 5 of its own
+//    (σ² √(2/n)), a false alarm under 1e-5 each;
+//  - KS against the normal at a 0.1% false-alarm rate (1.949/√n), plus the rounding's most
+//    (half a step moves the distribution by at most φ(0) s / 2σ) and the table's 1/4096;
+//  - neighbouring bins' deviations are uncorrelated (within 5/√n);
+// and the same seed gives the same beam.
+TEST(BeamSynthesis, LevelJitterIsTheReceiversPerBinAndPerPing) {
+  const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
+  const RayTracer tracer(meshes);
+  Material wall;
+  wall.reflectivity = 0.5;
+  SensorModel sensor = QuietSensor();
+  sensor.acoustics.speckle_correlation_m = 0.05;
+  sensor.acoustics.level_jitter_db = 2.0;
+  const Acoustics& a = sensor.acoustics;
+  const double sigma = a.level_jitter_db;
+  const double step = a.ad_span_db / 255.0;
+  const BeamSynthesizer synthesizer(sensor, tracer, {wall}, 7);
+  const auto reference = synthesizer.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 0);
+  // Bins whose exact level lies 4σ inside the AD window: no clipping at 0 or 255.
+  std::vector<std::size_t> bright;
+  std::vector<double> exact_db;
+  for (std::size_t k = 0; k < reference.echo_power.size(); ++k) {
+    const double p = reference.echo_power[k];
+    if (p <= 0.0) continue;
+    const double db = 10.0 * std::log10(p);
+    if (db < a.ad_low_db + 4.0 * sigma || db > a.ad_low_db + a.ad_span_db - 4.0 * sigma) continue;
+    bright.push_back(k);
+    exact_db.push_back(db);
+  }
+  ASSERT_GE(bright.size(), 4u);
+  std::vector<double> deviations;
+  double lag_one = 0.0;
+  double lag_pairs = 0.0;
+  constexpr std::uint64_t kPings = 4000;
+  for (std::uint64_t seed = 1; seed <= kPings; ++seed) {
+    const auto beam = synthesizer.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), seed);
+    ASSERT_EQ(beam.echo_power, reference.echo_power);  // the echoes are the place's
+    std::optional<double> previous;
+    for (std::size_t i = 0; i < bright.size(); ++i) {
+      const double level = a.ad_low_db + beam.beam.intensities[bright[i]] * step;
+      const double d = level - exact_db[i];
+      deviations.push_back(d);
+      if (previous && bright[i] == bright[i - 1] + 1) {
+        lag_one += d * *previous;
+        lag_pairs += 1.0;
+      }
+      previous = d;
+    }
+  }
+  const auto n = static_cast<double>(deviations.size());
+  const double mean = std::accumulate(deviations.begin(), deviations.end(), 0.0) / n;
+  double variance = 0.0;
+  for (double d : deviations) variance += (d - mean) * (d - mean);
+  variance /= n - 1.0;
+  double table_variance = 0.0;
+  for (int i = 0; i < BeamSynthesizer::kLevelJitters; ++i) {
+    const double u = (i + 0.5) / BeamSynthesizer::kLevelJitters;
+    // The quantile by bisection, as the synthesizer tables it.
+    double low = -8.0;
+    double high = 8.0;
+    for (int j = 0; j < 64; ++j) {
+      const double mid = 0.5 * (low + high);
+      (0.5 * std::erfc(-mid / std::numbers::sqrt2) < u ? low : high) = mid;
+    }
+    table_variance += std::pow(0.5 * (low + high), 2) / BeamSynthesizer::kLevelJitters;
+  }
+  const double expected = sigma * sigma * table_variance + step * step / 12.0;
+  EXPECT_NEAR(mean, 0.0, 5.0 * std::sqrt(expected / n));
+  EXPECT_NEAR(variance, expected, 5.0 * expected * std::sqrt(2.0 / n));
+  const double rounding = 0.5 * step / sigma / std::sqrt(2.0 * std::numbers::pi);
+  std::vector<double> z;
+  for (double d : deviations) z.push_back(d / sigma);
+  EXPECT_LT(KsDistance(z, [](double x) { return 0.5 * std::erfc(-x / std::numbers::sqrt2); }),
+            1.949 / std::sqrt(n) + rounding + 1.0 / BeamSynthesizer::kLevelJitters);
+  ASSERT_GT(lag_pairs, 1000.0);
+  EXPECT_NEAR(lag_one / lag_pairs / expected, 0.0, 5.0 / std::sqrt(lag_pairs));
+  EXPECT_EQ(synthesizer.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 3).beam.intensities,
+            synthesizer.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 3).beam.intensities);
+}
+
 // The speckle and noise draws are exponential with mean 1 (the power of a Rayleigh amplitude).
 // Kolmogorov-Smirnov against F(x) = 1 - exp(-x) on 200000 draws, fixed seed: the critical value
 // at a 0.1% false-alarm rate is 1.949 / sqrt(n).

@@ -198,8 +198,9 @@ TEST(SceneFile, SpecularSpreadIsReadInDegrees) {
                                    {"bad.yaml:5:", "'materials[0].specular_spread_deg'", "'45'"}));
 }
 
-// The tank's reverberation, second trip and pulse skirts are the scene's (the sensor model has
-// none), and a level outside -100..20 dB is refused, naming the key and line.
+// The tank's reverberation, second trip, pulse skirts and level jitter are the scene's (the
+// sensor model has none), and a level outside its range (-100..20 dB, the jitter 0..20 dB) is
+// refused, naming the key and line.
 TEST(SceneFile, ReverberationIsTheScenes) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
@@ -212,7 +213,10 @@ TEST(SceneFile, ReverberationIsTheScenes) {
   EXPECT_EQ(tank.sensor.acoustics.second_trip_db, 7.75);
   EXPECT_EQ(tank.sensor.acoustics.pulse_skirt_length_m, 0.05);
   EXPECT_EQ(tank.sensor.acoustics.pulse_skirt_db, 3.0);
-  for (const char* key : {"reverberation_db", "second_trip_db", "pulse_skirt_db"}) {
+  EXPECT_EQ(micron.acoustics.level_jitter_db, 0.0);
+  EXPECT_EQ(tank.sensor.acoustics.level_jitter_db, 0.19);
+  for (const char* key :
+       {"reverberation_db", "second_trip_db", "pulse_skirt_db", "level_jitter_db"}) {
     test::TempDir dir;
     const std::string path = (dir.path() / "bad.yaml").string();
     std::ofstream(path) << "name: x\nsensor_model: "

@@ -9,7 +9,10 @@ DIR is what `sonarbench simulate SCENE --out DIR` or `sonarbench import LOG.mat 
 wrote. For each, per range band: the mean intensity, the share of bins at 0 and at 150 or
 more, and the sweep-to-sweep spread (per head angle, to 0.1°, and bin, the standard deviation
 over the beams at that angle, averaged over the band's cells seen twice or more: a static
-sonar's echoes repeat, noise does not); and the ringing tail: each beam's largest 5-bin moving average over bins 30-63
+sonar's echoes repeat, noise does not); that spread's median over the cells from bin 32 whose
+mean lies in 30-69, 70-99 and 100-255 (bright cells show a receiver's own noise, which the
+background noise cannot reach there), and how neighbouring bins' deviations from their cells'
+means correlate, pooled over the pairs of cells of mean 60 or more; and the ringing tail: each beam's largest 5-bin moving average over bins 30-63
 (0.38-0.79 m, past the self-reflection the mapper drops), as percentiles over beams and the
 share of beams whose tail reaches 60. With --crossing T --from R, where a threshold detector
 meets the first echo along each side (the walls of a tank): for the beams within 20° of head
@@ -34,6 +37,9 @@ import sys
 
 BANDS_M = [(0.4, 1.5), (1.5, 2.0), (2.0, 2.5), (2.5, 3.0), (3.0, 4.0), (4.0, 5.0)]
 TAIL_BINS = (30, 64)  # centres of the 5-bin windows
+SPREAD_BY_MEAN = [(30, 70), (70, 100), (100, 256)]  # bands of a cell's mean intensity
+FIRST_SPREAD_BIN = 32  # past the self-reflection's bright bins
+CORRELATED_MEAN = 60
 
 
 def load_beams(directory, with_angles=False):
@@ -85,6 +91,42 @@ def sweep_spreads(beams):
             cell[0] += sd
             cell[1] += 1
     return spreads
+
+
+def cell_deviations(with_angles):
+    """Per head angle (to 0.1 degree) seen twice or more, from bin FIRST_SPREAD_BIN to the
+    shortest beam's end: (the cells' means, each beam's deviations from them)."""
+    by_angle = {}
+    for angle, _, b in with_angles:
+        by_angle.setdefault(round(math.degrees(angle) % 360.0, 1) % 360.0, []).append(b)
+    for group in by_angle.values():
+        if len(group) < 2:
+            continue
+        bins = range(FIRST_SPREAD_BIN, min(len(b) for b in group))
+        means = [sum(b[k] for b in group) / len(group) for k in bins]
+        yield means, [[b[k] - m for k, m in zip(bins, means)] for b in group]
+
+
+def spread_by_mean(with_angles):
+    """The median sweep-to-sweep spread of the cells in each SPREAD_BY_MEAN band of their mean
+    ({band: median or None}), and the correlation of neighbouring bins' deviations from their
+    cells' means over the pairs of cells both of mean CORRELATED_MEAN or more (None if none)."""
+    spreads = {band: [] for band in SPREAD_BY_MEAN}
+    products = squares_a = squares_b = 0.0
+    for means, deviations in cell_deviations(with_angles):
+        for k, mean in enumerate(means):
+            sd = math.sqrt(sum(d[k] ** 2 for d in deviations) / (len(deviations) - 1))
+            for band in SPREAD_BY_MEAN:
+                if band[0] <= mean < band[1]:
+                    spreads[band].append(sd)
+            if k + 1 < len(means) and min(mean, means[k + 1]) >= CORRELATED_MEAN:
+                products += sum(d[k] * d[k + 1] for d in deviations)
+                squares_a += sum(d[k] ** 2 for d in deviations)
+                squares_b += sum(d[k + 1] ** 2 for d in deviations)
+    medians = {band: sorted(v)[len(v) // 2] if v else None for band, v in spreads.items()}
+    correlation = (products / math.sqrt(squares_a * squares_b)
+                   if squares_a > 0 and squares_b > 0 else None)
+    return medians, correlation
 
 
 def side_crossings(with_angles, threshold, from_m):
@@ -162,6 +204,14 @@ def report(directory, crossing=None, from_m=None, bins=None, lit=None):
         if cells:
             line += (f", sweep-to-sweep spread {sum(c[0] for c in cells) / sum(c[1] for c in cells):.1f}")
         print(line)
+    medians, correlation = spread_by_mean(with_angles)
+    if any(m is not None for m in medians.values()):
+        print(f"  sweep-to-sweep spread by the cell's mean, median over cells from bin "
+              f"{FIRST_SPREAD_BIN}: " +
+              ", ".join(f"{low}-{high - 1} " + (f"{m:.2f}" if m is not None else "none")
+                        for (low, high), m in medians.items()) +
+              f"; neighbouring bins' deviations (cells of mean {CORRELATED_MEAN} or more) "
+              "correlate by " + (f"{correlation:.2f}" if correlation is not None else "none"))
     tails = []
     for _, b in beams:
         if len(b) < TAIL_BINS[1] + 2:

@@ -59,6 +59,30 @@ def main():
         assert result.returncode == 0, result.stderr
         assert "3.0-4.0 m: mean 116.5, at 0 0.0%, at 150 or more 7.69%, sweep-to-sweep spread 5.5" \
             in result.stdout, result.stdout
+        # By the cell's mean: every cell from bin 32 has mean 105 and spread sqrt(30), and each
+        # beam's deviations share one sign along it: correlation 1. In the first dataset no
+        # cell varies: spread 0, and no deviations to correlate.
+        assert "median over cells from bin 32: 30-69 none, 70-99 none, 100-255 5.48; " \
+            "neighbouring bins' deviations (cells of mean 60 or more) correlate by 1.00" \
+            in result.stdout, result.stdout
+        assert "30-69 none, 70-99 none, 100-255 0.00; neighbouring bins' deviations " \
+            "(cells of mean 60 or more) correlate by none" in out, out
+        # A chequerboard at one angle (100 and 110 alternating along the beam and from beam to
+        # beam): deviations of opposite sign in neighbouring bins, correlation -1; at another
+        # angle 40 and 50 alternating from beam to beam: cells of mean 45 in the 30-69 band.
+        os.makedirs(os.path.join(tmp, "chequer", "beams"))
+        beams, angles = [], []
+        for sweep in range(6):
+            beams.append([100 + 10 * ((sweep + k) % 2) for k in range(BINS)])
+            angles.append(0.0)
+            beams.append([40 + 10 * (sweep % 2)] * BINS)
+            angles.append(1.0)
+        write_beams(os.path.join(tmp, "chequer", "beams", "sweep_0000.bin"), beams, angles)
+        result = run(os.path.join(tmp, "chequer"))
+        assert result.returncode == 0, result.stderr
+        assert "median over cells from bin 32: 30-69 5.48, 70-99 none, 100-255 5.48; " \
+            "neighbouring bins' deviations (cells of mean 60 or more) correlate by -1.00" \
+            in result.stdout, result.stdout
 
         # Where a detector meets each side: beams at 0° (a floor-like 80 at bins 100-119, a wall
         # of 200 from bin 160), 10° (the wall from bin 170) and 90° (nothing); one at 45° belongs
@@ -124,7 +148,7 @@ def main():
         result = run(os.path.join(tmp, "bad"))
         assert result.returncode != 0, "a truncated file was accepted"
         assert "sweep_0000.bin: beam 0 truncated" in result.stderr, result.stderr
-    print("dataset_stats.py: shares, tail and a truncated file as expected")
+    print("dataset_stats.py: shares, spreads, tail and a truncated file as expected")
 
 
 if __name__ == "__main__":

@@ -115,6 +115,25 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
   vertical_slots_ = tabulate(a.rays_vertical, a.aperture_scale_vertical * g.beam_width_vertical_rad,
                              pattern_k_v_);
 
+  // The standard normal's quantile at u, by bisection on its distribution Φ(z) = ½ erfc(-z/√2):
+  // 64 halvings of [-8, 8] leave it exact to the last bit.
+  if (a.level_jitter_db > 0.0) {
+    const auto quantile = [](double u) {
+      double low = -8.0;
+      double high = 8.0;
+      for (int i = 0; i < 64; ++i) {
+        const double mid = 0.5 * (low + high);
+        (0.5 * std::erfc(-mid / std::numbers::sqrt2) < u ? low : high) = mid;
+      }
+      return 0.5 * (low + high);
+    };
+    level_jitter_factors_.reserve(kLevelJitters);
+    for (int i = 0; i < kLevelJitters; ++i) {
+      const double z = quantile((i + 0.5) / kLevelJitters);
+      level_jitter_factors_.push_back(std::pow(10.0, a.level_jitter_db * z / 10.0));
+    }
+  }
+
   // A standard 2-D Gaussian offset has a Rayleigh radius, P(radius ≤ ρ) = 1 - exp(-ρ²/2), and a
   // uniform direction: radius quantiles times evenly spaced directions.
   spread_offsets_.reserve(kSpreadOffsets);
@@ -868,6 +887,21 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
     if (k < self_reflection.size()) signal += self_reflection[k];
     if (a_.speckle) signal *= speckle[k];
     powers[k] = signal + noise_power * rng_.Exponential();
+  }
+  // The receiver's level jitter, the ping's whatever the echoes are: five 12-bit picks per draw.
+  if (const std::vector<double>& jitter = s_.level_jitter_factors_; !jitter.empty()) {
+    static_assert(kLevelJitters == 1 << 12, "12 bits per pick");
+    std::uint64_t bits = 0;
+    int picks_left = 0;
+    for (double& power : powers) {
+      if (picks_left == 0) {
+        bits = rng_.Next();
+        picks_left = 5;
+      }
+      power *= jitter[bits & (kLevelJitters - 1)];
+      bits >>= 12;
+      --picks_left;
+    }
   }
   const AdSteps quantise{s_.ad_thresholds_.data(), s_.ad_bucket_steps_.data(), s_.ad_first_bucket_,
                          s_.ad_bucket_shift_};

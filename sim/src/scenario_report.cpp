@@ -77,6 +77,7 @@ nlohmann::json SensorJson(const SensorModel& s) {
             {"pulse_skirt_length_m", a.pulse_skirt_length_m},
             {"pulse_skirt_db", a.pulse_skirt_db},
             {"noise_level_db", a.noise_level_db},
+            {"level_jitter_db", a.level_jitter_db},
             {"max_bounces", a.max_bounces},
             {"speckle", a.speckle},
             {"speckle_correlation_m", a.speckle_correlation_m},

@@ -176,6 +176,11 @@ class BeamSynthesizer {
   /// Phases of the speckle's complex Gaussians.
   static constexpr int kSpecklePhases = 1024;
 
+  /// The receiver's level jitter (Acoustics::level_jitter_db) is tabled: the standard normal's
+  /// quantiles z_i at (i + ½)/kLevelJitters (up to 3.66), each a power factor 10^(σ z_i / 10),
+  /// one picked by 12 random bits per bin (five bins per 64-bit draw of the ping's generator).
+  static constexpr int kLevelJitters = 4096;
+
   /// Jitter positions per stratum and direction.
   static constexpr int kJitterSlots = 32;
 
@@ -220,6 +225,8 @@ class BeamSynthesizer {
   double second_trip_ = 0.0;
   std::vector<double> tvg_at_bin_;
   std::vector<double> untvg_at_bin_;
+  /// kLevelJitters power factors of the receiver's level jitter; empty when it has none.
+  std::vector<double> level_jitter_factors_;
   /// The self-reflection profile as linear power per bin.
   std::vector<double> self_reflection_power_;
   /// SpeckleWindow().

@@ -41,6 +41,13 @@ struct Acoustics {
   double pulse_skirt_db = -20.0;
   /// Mean background noise power at the receiver output [dB].
   double noise_level_db = -40.0;
+  /// The receiver's own noise on its output level [dB, standard deviation]: every bin's level,
+  /// echo and background alike, moves by a normal draw of this size from ping to ping,
+  /// independently bin by bin (each bin's power times 10^(σ z / 10); a log detector's output
+  /// noise). Drawn per ping even when the echoes are the place's (speckle_correlation_m), so a
+  /// static sonar's bright bins still vary a little from sweep to sweep, as the real log's do.
+  /// 0, the default: none (not drawn). See BeamSynthesizer::kLevelJitters.
+  double level_jitter_db = 0.0;
   /// Specular reflections a ray follows after its first hit (0: no multipath). Every hit after
   /// one echoes back along its path and, when the sonar is in view and in the beam's lobe, also
   /// straight to the sonar (see BeamSynthesizer).
