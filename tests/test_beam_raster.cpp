@@ -94,6 +94,11 @@ TEST(BeamRaster, VectorKernelGivesOneRayAtATimesCells) {
   ExpectSameCellsAsOneRayAtATime(BeamRaster::Kernel::kFastest);
 }
 
+TEST(BeamRaster, Avx2KernelGivesOneRayAtATimesCells) {
+  if (!BeamRaster::HasAvx2Kernel()) GTEST_SKIP() << "this processor has no AVX2";
+  ExpectSameCellsAsOneRayAtATime(BeamRaster::Kernel::kAvx2);
+}
+
 // The vector set-up of the walks gives StartRayWalkFromKey's values bit for bit (an ulp off
 // would change a cell only at a rare tie, which the cell comparisons above could miss).
 TEST(BeamRaster, VectorWalkSetUpIsStartRayWalksBitForBit) {

@@ -69,6 +69,13 @@ bool IsMarked(const std::uint64_t* marks, std::uint64_t index) {
 void Mark(std::uint64_t* marks, std::uint64_t index) {
   marks[index >> 6] |= std::uint64_t{1} << (index & 63);
 }
+// A visit to a cell: its mark set and its index kept, unless it was marked already.
+void Visit(std::uint64_t* marks, std::vector<std::uint64_t>& touched, std::uint64_t index) {
+  if (!IsMarked(marks, index)) {
+    Mark(marks, index);
+    touched.push_back(index);
+  }
+}
 
 // The portable kernel: one walk after another, each visit checked against the marks.
 std::size_t WalkPortable(std::span<const RayWalk> walks, const Box& box, std::uint64_t* marks,
@@ -80,10 +87,7 @@ std::size_t WalkPortable(std::span<const RayWalk> walks, const Box& box, std::ui
     WalkRay(walk, box.Index(walk.origin_key), box.Index(walk.end_key), unit,
             [&](std::uint64_t index) {
               ++visits;
-              if (!IsMarked(marks, index)) {
-                Mark(marks, index);
-                touched.push_back(index);
-              }
+              Visit(marks, touched, index);
             });
   }
   return visits;
@@ -93,6 +97,47 @@ std::size_t WalkPortable(std::span<const RayWalk> walks, const Box& box, std::ui
 #define SONARBENCH_HAVE_AVX512_KERNEL 1
 
 constexpr std::size_t kLanes = 8;  // 64-bit lanes of an AVX-512 vector
+
+// A batch of walks laid out by lane for the vector kernels, each array 64-byte aligned.
+template <std::size_t kBatch>
+struct WalkLanes {
+  alignas(64) double t[3][kBatch];
+  alignas(64) double delta[3][kBatch];
+  alignas(64) std::int64_t step[3][kBatch];  // the index's change per step along each axis
+  alignas(64) std::int64_t cell[kBatch];
+  alignas(64) std::int64_t last[kBatch];
+  alignas(64) double length[kBatch];
+
+  // Lays out walks[first, first + kBatch), as many as there are, and returns how many; lanes
+  // without a walk repeat the last one (the kernels keep them inactive).
+  std::size_t Fill(std::span<const RayWalk> walks, std::size_t first, const Box& box) {
+    const std::int64_t unit[3] = {std::int64_t{1} << box.shift_x, std::int64_t{1} << box.shift_y,
+                                  1};
+    const std::size_t count = std::min(kBatch, walks.size() - first);
+    for (std::size_t l = 0; l < kBatch; ++l) {
+      const RayWalk& w = walks[first + std::min(l, count - 1)];
+      for (unsigned i = 0; i < 3; ++i) {
+        t[i][l] = w.t_max[i];
+        delta[i][l] = w.t_delta[i];
+        step[i][l] = unit[i] * w.step[i];
+      }
+      cell[l] = static_cast<std::int64_t>(box.Index(w.origin_key));
+      last[l] = static_cast<std::int64_t>(box.Index(w.end_key));
+      length[l] = w.length;
+    }
+    return count;
+  }
+};
+
+// Visits the cells (`index`) of the lanes whose bits are set in `check`, lowest lane first.
+void VisitLanes(unsigned check, const std::uint64_t* index, std::uint64_t* marks,
+                std::vector<std::uint64_t>& touched) {
+  while (check != 0) {
+    const auto l = static_cast<unsigned>(__builtin_ctz(check));
+    check &= check - 1;
+    Visit(marks, touched, index[l]);
+  }
+}
 
 // The AVX-512 kernel: eight walks side by side, one per 64-bit lane, each step of WalkRay done
 // for all eight with masks instead of branches (the same IEEE additions and comparisons, so the
@@ -105,44 +150,22 @@ __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWal
   // unrolled so that each group's state stays in registers.
   constexpr std::size_t kGroups = 4;
   constexpr std::size_t kBatch = kGroups * kLanes;
-  const std::int64_t unit[3] = {std::int64_t{1} << box.shift_x, std::int64_t{1} << box.shift_y, 1};
   std::size_t visits = 0;
-  alignas(64) double lane_t[3][kBatch];
-  alignas(64) double lane_delta[3][kBatch];
-  alignas(64) std::int64_t lane_step[3][kBatch];
-  alignas(64) std::int64_t lane_cell[kBatch];
-  alignas(64) std::int64_t lane_last[kBatch];
-  alignas(64) double lane_length[kBatch];
+  WalkLanes<kBatch> batch;
   alignas(64) std::uint64_t index[kLanes];
   for (std::size_t first = 0; first < walks.size(); first += kBatch) {
-    const std::size_t count = std::min(kBatch, walks.size() - first);
-    for (std::size_t l = 0; l < kBatch; ++l) {
-      // Lanes without a walk repeat the last one, inactive.
-      const RayWalk& w = walks[first + std::min(l, count - 1)];
-      for (unsigned i = 0; i < 3; ++i) {
-        lane_t[i][l] = w.t_max[i];
-        lane_delta[i][l] = w.t_delta[i];
-        lane_step[i][l] = unit[i] * w.step[i];
-      }
-      lane_cell[l] = static_cast<std::int64_t>(box.Index(w.origin_key));
-      lane_last[l] = static_cast<std::int64_t>(box.Index(w.end_key));
-      lane_length[l] = w.length;
-    }
+    const std::size_t count = batch.Fill(walks, first, box);
     // Every walk starts by visiting the origin's cell.
-    const auto origin = static_cast<std::uint64_t>(lane_cell[0]);
-    if (!IsMarked(marks, origin)) {
-      Mark(marks, origin);
-      touched.push_back(origin);
-    }
+    Visit(marks, touched, static_cast<std::uint64_t>(batch.cell[0]));
     visits += count;
     __m512d tx[kGroups], ty[kGroups], tz[kGroups];
     __m512i cell[kGroups];
     __mmask8 active[kGroups];
     for (std::size_t g = 0; g < kGroups; ++g) {
-      tx[g] = _mm512_load_pd(lane_t[0] + g * kLanes);
-      ty[g] = _mm512_load_pd(lane_t[1] + g * kLanes);
-      tz[g] = _mm512_load_pd(lane_t[2] + g * kLanes);
-      cell[g] = _mm512_load_si512(lane_cell + g * kLanes);
+      tx[g] = _mm512_load_pd(batch.t[0] + g * kLanes);
+      ty[g] = _mm512_load_pd(batch.t[1] + g * kLanes);
+      tz[g] = _mm512_load_pd(batch.t[2] + g * kLanes);
+      cell[g] = _mm512_load_si512(batch.cell + g * kLanes);
       const std::size_t lanes = std::min(kLanes, count - std::min(count, g * kLanes));
       active[g] = static_cast<__mmask8>((1u << lanes) - 1);
     }
@@ -156,18 +179,18 @@ __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWal
         const __mmask8 step_y = active[g] & static_cast<__mmask8>(~x_first) &
                                 _mm512_cmp_pd_mask(ty[g], tz[g], _CMP_LT_OQ);
         const __mmask8 step_z = active[g] & static_cast<__mmask8>(~(step_x | step_y));
-        tx[g] = _mm512_mask_add_pd(tx[g], step_x, tx[g], _mm512_load_pd(lane_delta[0] + o));
-        ty[g] = _mm512_mask_add_pd(ty[g], step_y, ty[g], _mm512_load_pd(lane_delta[1] + o));
-        tz[g] = _mm512_mask_add_pd(tz[g], step_z, tz[g], _mm512_load_pd(lane_delta[2] + o));
+        tx[g] = _mm512_mask_add_pd(tx[g], step_x, tx[g], _mm512_load_pd(batch.delta[0] + o));
+        ty[g] = _mm512_mask_add_pd(ty[g], step_y, ty[g], _mm512_load_pd(batch.delta[1] + o));
+        tz[g] = _mm512_mask_add_pd(tz[g], step_z, tz[g], _mm512_load_pd(batch.delta[2] + o));
         cell[g] =
-            _mm512_mask_add_epi64(cell[g], step_x, cell[g], _mm512_load_si512(lane_step[0] + o));
+            _mm512_mask_add_epi64(cell[g], step_x, cell[g], _mm512_load_si512(batch.step[0] + o));
         cell[g] =
-            _mm512_mask_add_epi64(cell[g], step_y, cell[g], _mm512_load_si512(lane_step[1] + o));
+            _mm512_mask_add_epi64(cell[g], step_y, cell[g], _mm512_load_si512(batch.step[1] + o));
         cell[g] =
-            _mm512_mask_add_epi64(cell[g], step_z, cell[g], _mm512_load_si512(lane_step[2] + o));
+            _mm512_mask_add_epi64(cell[g], step_z, cell[g], _mm512_load_si512(batch.step[2] + o));
         // min(tx, ty, tz) > length, as three comparisons.
-        const __m512d length = _mm512_load_pd(lane_length + o);
-        const __mmask8 done = _mm512_cmpeq_epi64_mask(cell[g], _mm512_load_si512(lane_last + o)) |
+        const __m512d length = _mm512_load_pd(batch.length + o);
+        const __mmask8 done = _mm512_cmpeq_epi64_mask(cell[g], _mm512_load_si512(batch.last + o)) |
                               (_mm512_cmp_pd_mask(tx[g], length, _CMP_GT_OQ) &
                                _mm512_cmp_pd_mask(ty[g], length, _CMP_GT_OQ) &
                                _mm512_cmp_pd_mask(tz[g], length, _CMP_GT_OQ));
@@ -184,16 +207,94 @@ __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWal
         unsigned check = active[g] & static_cast<__mmask8>(~repeat);
         if (check != 0) {
           _mm512_store_si512(index, cell[g]);
-          do {
-            const unsigned l = static_cast<unsigned>(__builtin_ctz(check));
-            check &= check - 1;
-            if (!IsMarked(marks, index[l])) {
-              Mark(marks, index[l]);
-              touched.push_back(index[l]);
-            }
-          } while (check != 0);
+          VisitLanes(check, index, marks, touched);
         }
         visits += static_cast<std::size_t>(__builtin_popcount(active[g]));
+      }
+      if (any == 0) break;
+    }
+  }
+  return visits;
+}
+
+// Four 64-bit integers from 32-byte aligned memory.
+__attribute__((target("avx2"), always_inline)) inline __m256i LoadLanes(const std::int64_t* p) {
+  return _mm256_load_si256(reinterpret_cast<const __m256i*>(p));
+}
+
+// The AVX2 kernel, for processors without AVX-512: WalkAvx512's steps on four 64-bit lanes,
+// its masks held as vector lanes of all ones (compares, and, andnot) and the masked additions
+// as blends (doubles: the same sum or the same value, bit for bit) or additions of a step
+// and-ed with the mask (integers).
+__attribute__((target("avx2"))) std::size_t WalkAvx2(std::span<const RayWalk> walks, const Box& box,
+                                                     std::uint64_t* marks,
+                                                     std::vector<std::uint64_t>& touched) {
+  constexpr std::size_t kLanes4 = 4;  // 64-bit lanes of an AVX2 vector
+  constexpr std::size_t kGroups = 4;
+  constexpr std::size_t kBatch = kGroups * kLanes4;
+  std::size_t visits = 0;
+  WalkLanes<kBatch> batch;
+  alignas(32) std::uint64_t index[kLanes4];
+  for (std::size_t first = 0; first < walks.size(); first += kBatch) {
+    const std::size_t count = batch.Fill(walks, first, box);
+    // Every walk starts by visiting the origin's cell.
+    Visit(marks, touched, static_cast<std::uint64_t>(batch.cell[0]));
+    visits += count;
+    __m256d tx[kGroups], ty[kGroups], tz[kGroups];
+    __m256i cell[kGroups];
+    __m256d active[kGroups];
+    for (std::size_t g = 0; g < kGroups; ++g) {
+      tx[g] = _mm256_load_pd(batch.t[0] + g * kLanes4);
+      ty[g] = _mm256_load_pd(batch.t[1] + g * kLanes4);
+      tz[g] = _mm256_load_pd(batch.t[2] + g * kLanes4);
+      cell[g] = LoadLanes(batch.cell + g * kLanes4);
+      const std::size_t lanes = std::min(kLanes4, count - std::min(count, g * kLanes4));
+      const __m256i lane_number = _mm256_set_epi64x(3, 2, 1, 0);
+      active[g] = _mm256_castsi256_pd(
+          _mm256_cmpgt_epi64(_mm256_set1_epi64x(static_cast<std::int64_t>(lanes)), lane_number));
+    }
+    for (;;) {
+      unsigned any = 0;
+#pragma GCC unroll 4
+      for (std::size_t g = 0; g < kGroups; ++g) {
+        const std::size_t o = g * kLanes4;
+        const __m256d x_first = _mm256_cmp_pd(tx[g], ty[g], _CMP_LT_OQ);
+        const __m256d step_x = _mm256_and_pd(_mm256_and_pd(active[g], x_first),
+                                             _mm256_cmp_pd(tx[g], tz[g], _CMP_LT_OQ));
+        const __m256d step_y = _mm256_and_pd(_mm256_andnot_pd(x_first, active[g]),
+                                             _mm256_cmp_pd(ty[g], tz[g], _CMP_LT_OQ));
+        const __m256d step_z = _mm256_andnot_pd(_mm256_or_pd(step_x, step_y), active[g]);
+        tx[g] = _mm256_blendv_pd(tx[g], _mm256_add_pd(tx[g], _mm256_load_pd(batch.delta[0] + o)),
+                                 step_x);
+        ty[g] = _mm256_blendv_pd(ty[g], _mm256_add_pd(ty[g], _mm256_load_pd(batch.delta[1] + o)),
+                                 step_y);
+        tz[g] = _mm256_blendv_pd(tz[g], _mm256_add_pd(tz[g], _mm256_load_pd(batch.delta[2] + o)),
+                                 step_z);
+        cell[g] = _mm256_add_epi64(
+            cell[g], _mm256_and_si256(_mm256_castpd_si256(step_x), LoadLanes(batch.step[0] + o)));
+        cell[g] = _mm256_add_epi64(
+            cell[g], _mm256_and_si256(_mm256_castpd_si256(step_y), LoadLanes(batch.step[1] + o)));
+        cell[g] = _mm256_add_epi64(
+            cell[g], _mm256_and_si256(_mm256_castpd_si256(step_z), LoadLanes(batch.step[2] + o)));
+        const __m256d length = _mm256_load_pd(batch.length + o);
+        const __m256d done = _mm256_or_pd(
+            _mm256_castsi256_pd(_mm256_cmpeq_epi64(cell[g], LoadLanes(batch.last + o))),
+            _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(tx[g], length, _CMP_GT_OQ),
+                                        _mm256_cmp_pd(ty[g], length, _CMP_GT_OQ)),
+                          _mm256_cmp_pd(tz[g], length, _CMP_GT_OQ)));
+        active[g] = _mm256_andnot_pd(done, active[g]);
+        const auto bits = static_cast<unsigned>(_mm256_movemask_pd(active[g]));
+        any |= bits;
+        // Lane l against lane l - 1 (lane 0 against lane 3, which the mask leaves out).
+        const __m256i before = _mm256_permute4x64_epi64(cell[g], _MM_SHUFFLE(2, 1, 0, 3));
+        const auto repeat = static_cast<unsigned>(
+            _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(cell[g], before))));
+        unsigned check = bits & ~(repeat & bits & (bits << 1));
+        if (check != 0) {
+          _mm256_store_si256(reinterpret_cast<__m256i*>(index), cell[g]);
+          VisitLanes(check, index, marks, touched);
+        }
+        visits += static_cast<std::size_t>(__builtin_popcount(bits));
       }
       if (any == 0) break;
     }
@@ -325,6 +426,14 @@ bool BeamRaster::HasVectorKernel() {
 #endif
 }
 
+bool BeamRaster::HasAvx2Kernel() {
+#ifdef SONARBENCH_HAVE_AVX512_KERNEL
+  return __builtin_cpu_supports("avx2") != 0;
+#else
+  return false;
+#endif
+}
+
 std::size_t BeamRaster::Trace(const octomap::OcTree& tree, const octomap::point3d& origin,
                               std::span<const octomap::point3d> ends,
                               std::vector<std::uint64_t>& free_keys) {
@@ -349,6 +458,8 @@ std::size_t BeamRaster::Trace(const octomap::OcTree& tree, const octomap::point3
 #ifdef SONARBENCH_HAVE_AVX512_KERNEL
   if (kernel_ == Kernel::kFastest && HasVectorKernel()) {
     visits = WalkAvx512(walks_, box, marks, touched_);
+  } else if (kernel_ != Kernel::kPortable && HasAvx2Kernel()) {
+    visits = WalkAvx2(walks_, box, marks, touched_);
   } else {
     visits = WalkPortable(walks_, box, marks, touched_);
   }

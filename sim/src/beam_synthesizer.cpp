@@ -116,7 +116,8 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
                              pattern_k_v_);
 
   // The standard normal's quantile at u, by bisection on its distribution Φ(z) = ½ erfc(-z/√2):
-  // 64 halvings of [-8, 8] leave it exact to the last bit.
+  // 64 halvings of [-8, 8] leave an interval under a double's spacing, so z is as exact as
+  // erfc.
   if (a.level_jitter_db > 0.0) {
     const auto quantile = [](double u) {
       double low = -8.0;

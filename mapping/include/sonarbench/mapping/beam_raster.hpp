@@ -28,19 +28,23 @@ void StartRayWalks(const octomap::OcTree& tree, const octomap::point3d& origin,
 /// distinct cell of a beam in the real tank log): the marks absorb those repeats, and only a beam's
 /// distinct cells go on to the key set. On processors with AVX-512 the walks run eight at a
 /// time, one per vector lane, with masks instead of branches (the same arithmetic, so the same
-/// cells); elsewhere one after another. A beam whose box would exceed kMaxBoxCells (long range
+/// cells); on those with AVX2 only, four at a time; elsewhere one after another. A beam whose box would exceed kMaxBoxCells (long range
 /// at fine resolution) is walked into a hash set instead; the cells are the same.
 ///
 /// One BeamRaster per thread: it keeps its buffers between beams.
 class BeamRaster {
  public:
-  /// kFastest uses the vector kernel where the processor has it; kPortable never does (tests
-  /// compare the two).
-  enum class Kernel { kFastest, kPortable };
+  /// kFastest uses the AVX-512 kernel where the processor has it, else the AVX2 walk where it
+  /// has that; kAvx2 the AVX2 walk where the processor has it (tests); kPortable neither (tests
+  /// compare them).
+  enum class Kernel { kFastest, kAvx2, kPortable };
   explicit BeamRaster(Kernel kernel = Kernel::kFastest) : kernel_(kernel) {}
 
   /// Whether this processor runs the AVX-512 kernel.
   [[nodiscard]] static bool HasVectorKernel();
+  /// Whether this processor runs the AVX2 walk (the walk only: the walks' set-up is then one
+  /// ray at a time).
+  [[nodiscard]] static bool HasAvx2Kernel();
 
   /// The largest box [cells] the marks cover (one bit per cell: 8 MiB).
   static constexpr std::uint64_t kMaxBoxCells = std::uint64_t{1} << 26;
