@@ -28,8 +28,9 @@ void StartRayWalks(const octomap::OcTree& tree, const octomap::point3d& origin,
 /// distinct cell of a beam in the real tank log): the marks absorb those repeats, and only a beam's
 /// distinct cells go on to the key set. On processors with AVX-512 the walks run eight at a
 /// time, one per vector lane, with masks instead of branches (the same arithmetic, so the same
-/// cells); on those with AVX2 only, four at a time; elsewhere one after another. A beam whose box would exceed kMaxBoxCells (long range
-/// at fine resolution) is walked into a hash set instead; the cells are the same.
+/// cells); on those with AVX2 only, four at a time; elsewhere one after another. A beam whose
+/// box would exceed kMaxBoxCells (long range at fine resolution) is walked into a hash set
+/// instead; the cells are the same.
 ///
 /// One BeamRaster per thread: it keeps its buffers between beams.
 class BeamRaster {
