@@ -1028,15 +1028,8 @@ TEST(BeamSynthesis, LevelJitterIsTheReceiversPerBinAndPerPing) {
   variance /= n - 1.0;
   double table_variance = 0.0;
   for (int i = 0; i < BeamSynthesizer::kLevelJitters; ++i) {
-    const double u = (i + 0.5) / BeamSynthesizer::kLevelJitters;
-    // The quantile by bisection, as the synthesizer tables it.
-    double low = -8.0;
-    double high = 8.0;
-    for (int j = 0; j < 64; ++j) {
-      const double mid = 0.5 * (low + high);
-      (0.5 * std::erfc(-mid / std::numbers::sqrt2) < u ? low : high) = mid;
-    }
-    table_variance += std::pow(0.5 * (low + high), 2) / BeamSynthesizer::kLevelJitters;
+    const double z = BeamSynthesizer::NormalQuantile((i + 0.5) / BeamSynthesizer::kLevelJitters);
+    table_variance += z * z / BeamSynthesizer::kLevelJitters;
   }
   const double expected = sigma * sigma * table_variance + step * step / 12.0;
   EXPECT_NEAR(mean, 0.0, 5.0 * std::sqrt(expected / n));

@@ -75,36 +75,28 @@ def percentile(sorted_values, q):
 
 def sweep_spreads(beams):
     """Per bin: [sum of the standard deviations over head angles, their count]."""
-    by_angle = {}
-    for angle, size, b in beams:
-        by_angle.setdefault(round(math.degrees(angle) % 360.0, 1) % 360.0, []).append((size, b))
     spreads = {}
-    for group in by_angle.values():
-        if len(group) < 2:
-            continue
-        size = group[0][0]
-        for k in range(min(len(b) for _, b in group)):
-            values = [b[k] for _, b in group]
-            mean = sum(values) / len(values)
-            sd = math.sqrt(sum((v - mean) ** 2 for v in values) / (len(values) - 1))
+    for size, means, deviations in cell_deviations(beams, first=0):
+        for k in range(len(means)):
+            sd = math.sqrt(sum(d[k] ** 2 for d in deviations) / (len(deviations) - 1))
             cell = spreads.setdefault((size, k), [0.0, 0])
             cell[0] += sd
             cell[1] += 1
     return spreads
 
 
-def cell_deviations(with_angles):
-    """Per head angle (to 0.1 degree) seen twice or more, from bin FIRST_SPREAD_BIN to the
-    shortest beam's end: (the cells' means, each beam's deviations from them)."""
+def cell_deviations(with_angles, first=FIRST_SPREAD_BIN):
+    """Per head angle (to 0.1 degree) seen twice or more, from bin `first` to the shortest
+    beam's end: (the bin size, the cells' means, each beam's deviations from them)."""
     by_angle = {}
-    for angle, _, b in with_angles:
-        by_angle.setdefault(round(math.degrees(angle) % 360.0, 1) % 360.0, []).append(b)
+    for angle, size, b in with_angles:
+        by_angle.setdefault(round(math.degrees(angle) % 360.0, 1) % 360.0, []).append((size, b))
     for group in by_angle.values():
         if len(group) < 2:
             continue
-        bins = range(FIRST_SPREAD_BIN, min(len(b) for b in group))
-        means = [sum(b[k] for b in group) / len(group) for k in bins]
-        yield means, [[b[k] - m for k, m in zip(bins, means)] for b in group]
+        bins = range(first, min(len(b) for _, b in group))
+        means = [sum(b[k] for _, b in group) / len(group) for k in bins]
+        yield group[0][0], means, [[b[k] - m for k, m in zip(bins, means)] for _, b in group]
 
 
 def spread_by_mean(with_angles):
@@ -113,7 +105,7 @@ def spread_by_mean(with_angles):
     cells' means over the pairs of cells both of mean CORRELATED_MEAN or more (None if none)."""
     spreads = {band: [] for band in SPREAD_BY_MEAN}
     products = squares_a = squares_b = 0.0
-    for means, deviations in cell_deviations(with_angles):
+    for _, means, deviations in cell_deviations(with_angles):
         for k, mean in enumerate(means):
             sd = math.sqrt(sum(d[k] ** 2 for d in deviations) / (len(deviations) - 1))
             for band in SPREAD_BY_MEAN:

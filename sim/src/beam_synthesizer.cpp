@@ -115,22 +115,10 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
   vertical_slots_ = tabulate(a.rays_vertical, a.aperture_scale_vertical * g.beam_width_vertical_rad,
                              pattern_k_v_);
 
-  // The standard normal's quantile at u, by bisection on its distribution Φ(z) = ½ erfc(-z/√2):
-  // 64 halvings of [-8, 8] leave an interval under a double's spacing, so z is as exact as
-  // erfc.
   if (a.level_jitter_db > 0.0) {
-    const auto quantile = [](double u) {
-      double low = -8.0;
-      double high = 8.0;
-      for (int i = 0; i < 64; ++i) {
-        const double mid = 0.5 * (low + high);
-        (0.5 * std::erfc(-mid / std::numbers::sqrt2) < u ? low : high) = mid;
-      }
-      return 0.5 * (low + high);
-    };
     level_jitter_factors_.reserve(kLevelJitters);
     for (int i = 0; i < kLevelJitters; ++i) {
-      const double z = quantile((i + 0.5) / kLevelJitters);
+      const double z = NormalQuantile((i + 0.5) / kLevelJitters);
       level_jitter_factors_.push_back(std::pow(10.0, a.level_jitter_db * z / 10.0));
     }
   }
@@ -146,6 +134,16 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
                                    static_cast<float>(radius * std::sin(angle)));
     }
   }
+}
+
+double BeamSynthesizer::NormalQuantile(double u) {
+  double low = -8.0;
+  double high = 8.0;
+  for (int i = 0; i < 64; ++i) {
+    const double mid = 0.5 * (low + high);
+    (0.5 * std::erfc(-mid / std::numbers::sqrt2) < u ? low : high) = mid;
+  }
+  return 0.5 * (low + high);
 }
 
 void BeamSynthesizer::CorrelateSectors() {

@@ -181,6 +181,10 @@ class BeamSynthesizer {
   /// one picked by 12 random bits per bin (five bins per 64-bit draw of the ping's generator).
   static constexpr int kLevelJitters = 4096;
 
+  /// The standard normal's quantile at u in (0, 1), by bisection on Φ(z) = ½ erfc(-z/√2): 64
+  /// halvings of [-8, 8] leave an interval under a double's spacing, so z is as exact as erfc.
+  [[nodiscard]] static double NormalQuantile(double u);
+
   /// Jitter positions per stratum and direction.
   static constexpr int kJitterSlots = 32;
 
