@@ -72,6 +72,20 @@ double KsDistance(std::vector<double> sample, Cdf cdf) {
   return d;
 }
 
+// Pearson correlation of two equally long sequences.
+double Correlation(const std::vector<double>& a, const std::vector<double>& b) {
+  const auto n = static_cast<double>(a.size());
+  const double ma = std::accumulate(a.begin(), a.end(), 0.0) / n;
+  const double mb = std::accumulate(b.begin(), b.end(), 0.0) / n;
+  double ab = 0.0, aa = 0.0, bb = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    ab += (a[k] - ma) * (b[k] - mb);
+    aa += (a[k] - ma) * (a[k] - ma);
+    bb += (b[k] - mb) * (b[k] - mb);
+  }
+  return ab / std::sqrt(aa * bb);
+}
+
 SynthesizedBeam Ping(const SensorModel& sensor, const std::vector<TriangleMesh>& meshes,
                      std::uint64_t seed = 11) {
   const RayTracer tracer(meshes);
@@ -1266,15 +1280,7 @@ TEST(BeamSynthesis, NeighbouringBeamsShareTheirSectorsSpeckle) {
     BeamSynthesizer::SectorSpeckle(a, kWindow, w, std::span(seeds).first(w.size()));
     BeamSynthesizer::SectorSpeckle(b, kWindow, w, std::span(seeds).subspan(1));
     for (std::size_t k = 0; k < kLength; k += 4 * kWindow) independent.push_back(a[k]);
-    const double ma = std::accumulate(a.begin(), a.end(), 0.0) / kLength;
-    const double mb = std::accumulate(b.begin(), b.end(), 0.0) / kLength;
-    double ab = 0.0, aa = 0.0, bb = 0.0;
-    for (std::size_t k = 0; k < kLength; ++k) {
-      ab += (a[k] - ma) * (b[k] - mb);
-      aa += (a[k] - ma) * (a[k] - ma);
-      bb += (b[k] - mb) * (b[k] - mb);
-    }
-    correlations.push_back(ab / std::sqrt(aa * bb));
+    correlations.push_back(Correlation(a, b));
   }
   const auto n = static_cast<double>(independent.size());
   EXPECT_LT(KsDistance(independent, [](double v) { return 1.0 - std::exp(-v); }),
@@ -1284,6 +1290,102 @@ TEST(BeamSynthesis, NeighbouringBeamsShareTheirSectorsSpeckle) {
   for (double c : correlations) sd += (c - mean) * (c - mean);
   sd = std::sqrt(sd / (kPairs - 1));
   EXPECT_NEAR(mean, rho * rho, 5.0 * sd / std::sqrt(kPairs) + 4.0 / kLength);
+}
+
+// Speckle of N looks (Acoustics::speckle_looks, N = 3 here) is the mean of N independent looks:
+//  - SectorSpeckle's is exactly the mean of look 0 (the one-look factors for the sectors'
+//    seeds) and looks 1 .. N-1 (the one-look factors for DeriveSeed(seed, l));
+//  - its factors are gamma-distributed of mean 1 and shape N: KS on factors a window apart
+//    against 1 - e^(-Nx) Σ_{i<N} (Nx)^i / i!, at a 0.1% false-alarm rate (1.949/√n), plus
+//    N/1024 for the tabled phases (each look's factor moves by less than one phase step);
+//  - they correlate along range by (1 - m/L)², as one look does (averaging independent looks
+//    scales covariance and variance alike): the mean estimate over 64 sequences within 5
+//    standard errors plus 4/n (a false alarm under 1e-5 per lag);
+//  - two beams one sector apart still correlate by ρ², as in the test above.
+TEST(BeamSynthesis, SpeckleLooksAreIndependentLooksAveraged) {
+  constexpr int kWindow = 4;
+  constexpr int kLooks = 3;
+  const auto gamma_cdf = [](double x) {
+    const double t = kLooks * x;
+    return 1.0 - std::exp(-t) * (1.0 + t + 0.5 * t * t);
+  };
+
+  const std::array<std::uint64_t, 2> seeds = {11, 12};
+  const std::array<double, 2> weights = {0.6, 0.8};
+  std::vector<double> averaged(300);
+  BeamSynthesizer::SectorSpeckle(averaged, kWindow, weights, seeds, kLooks);
+  std::vector<double> sum(300);
+  std::vector<double> look(300);
+  BeamSynthesizer::SectorSpeckle(sum, kWindow, weights, seeds);
+  for (std::uint64_t l = 1; l < kLooks; ++l) {
+    const std::array<std::uint64_t, 2> look_seeds = {DeriveSeed(11, l), DeriveSeed(12, l)};
+    BeamSynthesizer::SectorSpeckle(look, kWindow, weights, look_seeds);
+    for (std::size_t k = 0; k < sum.size(); ++k) sum[k] += look[k];
+  }
+  for (std::size_t k = 0; k < sum.size(); ++k) {
+    EXPECT_EQ(averaged[k], sum[k] * (1.0 / kLooks)) << "bin " << k;
+  }
+
+  Rng rng(2025);
+  constexpr int kSequences = 64;
+  constexpr std::size_t kLength = 16384;
+  std::array<std::vector<double>, 7> estimates;
+  std::vector<double> independent;
+  std::vector<double> x(kLength);
+  for (int b = 0; b < kSequences; ++b) {
+    BeamSynthesizer::CorrelatedSpeckle(x, kWindow, rng, kLooks);
+    for (std::size_t k = 0; k < kLength; k += kWindow) independent.push_back(x[k]);
+    const double mean = std::accumulate(x.begin(), x.end(), 0.0) / kLength;
+    double variance = 0.0;
+    for (double v : x) variance += (v - mean) * (v - mean);
+    for (std::size_t m = 1; m < estimates.size(); ++m) {
+      double covariance = 0.0;
+      for (std::size_t k = 0; k + m < kLength; ++k) covariance += (x[k] - mean) * (x[k + m] - mean);
+      estimates[m].push_back(covariance / variance);
+    }
+  }
+  const auto n = static_cast<double>(independent.size());
+  EXPECT_LT(KsDistance(independent, gamma_cdf),
+            1.949 / std::sqrt(n) + static_cast<double>(kLooks) / BeamSynthesizer::kSpecklePhases);
+  for (std::size_t m = 1; m < estimates.size(); ++m) {
+    const std::vector<double>& e = estimates[m];
+    const double mean = std::accumulate(e.begin(), e.end(), 0.0) / kSequences;
+    double sd = 0.0;
+    for (double v : e) sd += (v - mean) * (v - mean);
+    sd = std::sqrt(sd / (kSequences - 1));
+    const double lag = static_cast<double>(m) / kWindow;
+    const double expected = m < kWindow ? (1.0 - lag) * (1.0 - lag) : 0.0;
+    EXPECT_NEAR(mean, expected, 5.0 * sd / std::sqrt(kSequences) + 4.0 / kLength) << "lag " << m;
+  }
+
+  const SensorModel micron = QuietSensor();
+  const std::vector<TriangleMesh> none;
+  const RayTracer tracer(none);
+  const BeamSynthesizer synthesizer(micron, tracer, {Material{}});
+  const std::vector<double>& w = synthesizer.SectorWeights();
+  double rho = 0.0;
+  for (std::size_t d = 0; d + 1 < w.size(); ++d) rho += w[d] * w[d + 1];
+  std::vector<double> a(kLength);
+  std::vector<double> b(kLength);
+  std::vector<double> correlations;
+  std::vector<double> sector_independent;
+  for (int pair = 0; pair < kSequences; ++pair) {
+    std::vector<std::uint64_t> place;
+    for (std::size_t d = 0; d < w.size() + 1; ++d) place.push_back(DeriveSeed(5000 + pair, d));
+    BeamSynthesizer::SectorSpeckle(a, kWindow, w, std::span(place).first(w.size()), kLooks);
+    BeamSynthesizer::SectorSpeckle(b, kWindow, w, std::span(place).subspan(1), kLooks);
+    for (std::size_t k = 0; k < kLength; k += 4 * kWindow) sector_independent.push_back(a[k]);
+    correlations.push_back(Correlation(a, b));
+  }
+  const auto sector_n = static_cast<double>(sector_independent.size());
+  EXPECT_LT(
+      KsDistance(sector_independent, gamma_cdf),
+      1.949 / std::sqrt(sector_n) + static_cast<double>(kLooks) / BeamSynthesizer::kSpecklePhases);
+  const double mean = std::accumulate(correlations.begin(), correlations.end(), 0.0) / kSequences;
+  double sd = 0.0;
+  for (double c : correlations) sd += (c - mean) * (c - mean);
+  sd = std::sqrt(sd / (kSequences - 1));
+  EXPECT_NEAR(mean, rho * rho, 5.0 * sd / std::sqrt(kSequences) + 4.0 / kLength);
 }
 
 TEST(BeamSynthesis, NoiseFloorMatchesItsConfiguredDistribution) {

@@ -148,11 +148,11 @@ TEST(SceneFile, SonarAcousticsOverrideTheModelsKeysItNames) {
   const sim::SensorModel model =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
-  EXPECT_EQ(scene.sensor.acoustics.gain_db, 6.0);
+  EXPECT_EQ(scene.sensor.acoustics.gain_db, 5.0);
   EXPECT_EQ(scene.sensor.acoustics.max_bounces, 8);
   EXPECT_EQ(scene.sensor.acoustics.speckle_correlation_m, 0.05);
   EXPECT_EQ(model.acoustics.speckle_correlation_m, 0.0);
-  EXPECT_NE(model.acoustics.gain_db, 6.0);
+  EXPECT_NE(model.acoustics.gain_db, 5.0);
   EXPECT_EQ(scene.sensor.acoustics.rays_vertical, model.acoustics.rays_vertical);
   EXPECT_EQ(scene.sensor.acoustics.self_reflection_db, model.acoustics.self_reflection_db);
   // The water surface is traced but not scored.
@@ -252,7 +252,38 @@ TEST(SceneFile, AngularCorrelationNeedsThePlacesSpeckle) {
         << extra;
   }
   const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
-  EXPECT_EQ(tank.sensor.acoustics.speckle_angular_correlation_deg, 7.2);
+  EXPECT_EQ(tank.sensor.acoustics.speckle_angular_correlation_deg, 3.0);
+}
+
+// The speckle's looks and window are the tank's (the sensor model keeps one look over the
+// range response); looks without speckle, or out of 1..16, are refused with the key and line.
+TEST(SceneFile, SpeckleLooksAndWindowAreTheTanks) {
+  const sim::SensorModel micron =
+      sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
+  EXPECT_EQ(micron.acoustics.speckle_looks, 1);
+  EXPECT_EQ(micron.acoustics.speckle_window_m, 0.0);
+  const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  EXPECT_EQ(tank.sensor.acoustics.speckle_looks, 3);
+  EXPECT_EQ(tank.sensor.acoustics.speckle_window_m, 0.063);
+  const std::pair<std::string, std::vector<std::string>> cases[] = {
+      {"  speckle_looks: 2\n  speckle: false\n",
+       {"'sonar_acoustics.speckle_looks'", "speckle: true", "got speckle: false"}},
+      {"  speckle_looks: 0\n", {"'sonar_acoustics.speckle_looks'", "'0'"}},
+      {"  speckle_looks: 2.5\n", {"'sonar_acoustics.speckle_looks'", "'2.5'"}},
+      {"  speckle_window_m: -0.1\n", {"'sonar_acoustics.speckle_window_m'", "'-0.1'"}}};
+  for (const auto& [acoustics, expected] : cases) {
+    test::TempDir dir;
+    const std::string path = (dir.path() / "bad.yaml").string();
+    std::ofstream(path)
+        << "name: x\nsensor_model: " << test::SourcePath("sensor-models/shad-micron.yaml")
+        << "\nsweeps: 1\nsonar_acoustics:\n"
+        << acoustics << "materials:\n  - {name: rock, reflectivity: 0.5}\n"
+        << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
+        << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+    std::vector<std::string> parts = {"bad.yaml:5:"};
+    parts.insert(parts.end(), expected.begin(), expected.end());
+    EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, parts)) << acoustics;
+  }
 }
 
 // The scenes built on the fitted tank (the two that must fail, and the crate) extend it: they

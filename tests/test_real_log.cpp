@@ -405,6 +405,40 @@ TEST(Fidelity, BeamCorrelationPairsBeamsByHeadStep) {
   }
 }
 
+// The fine texture: the same alternating 50, 150 less each bin's mean over the bins within 15
+// of it. A window of n bins (31 inside the beam, 16-30 at its end) holds one more bin of one
+// value than of the other, or as many, so every deviation is ±50 (1 ± 1/n) or ±50, within
+// 50 · [15/16, 17/16], its sign alternating bin by bin: lag-m correlations are at least
+// (15/17)² in size, negative at odd m, and the contrast (rms over the mean, 100) lies in
+// 0.5 · [15/16, 17/16]. Shifted by one bin on odd beams, odd head steps anti-correlate alike.
+TEST(Fidelity, FineTextureIsTheDeviationFromTheLocalMean) {
+  const mapping::SensorGeometry sensor;
+  const double bound = (15.0 / 17.0) * (15.0 / 17.0);
+  const std::vector<mapping::Beam> along =
+      TwoSweeps(sensor, [](int, int k) -> std::uint8_t { return k % 2 == 0 ? 50 : 150; });
+  const auto report = sim::CompareWithLog(along, along, sensor, 1.6);
+  ASSERT_EQ(report.sim_local_range_correlation.size(), 9u);
+  for (std::size_t m = 1; m < report.sim_local_range_correlation.size(); ++m) {
+    const double c = report.sim_local_range_correlation[m];
+    if (m % 2 == 1) {
+      EXPECT_LT(c, -bound) << "lag " << m;
+    } else {
+      EXPECT_GT(c, bound) << "lag " << m;
+    }
+  }
+  EXPECT_GE(report.sim_local_contrast, 0.5 * 15.0 / 16.0);
+  EXPECT_LE(report.sim_local_contrast, 0.5 * 17.0 / 16.0);
+  EXPECT_EQ(report.real_local_contrast, report.sim_local_contrast);
+
+  const std::vector<mapping::Beam> across =
+      TwoSweeps(sensor, [](int b, int k) -> std::uint8_t { return (k + b) % 2 == 0 ? 50 : 150; });
+  const auto shifted = sim::CompareWithLog(across, across, sensor, 1.6);
+  ASSERT_EQ(shifted.sim_local_beam_correlation.size(), 4u);
+  EXPECT_LT(shifted.sim_local_beam_correlation[1], -bound);
+  EXPECT_GT(shifted.sim_local_beam_correlation[2], bound);
+  EXPECT_LT(shifted.sim_local_beam_correlation[3], -bound);
+}
+
 // The sweep-to-sweep spread: two identical sweeps spread 0; a second sweep brighter by d in
 // every bin spreads d/√2 in every cell (the sample standard deviation of {v, v + d}).
 TEST(Fidelity, SweepSpreadIsTheStandardDeviationAcrossSweepsPerAngleAndBin) {

@@ -213,6 +213,18 @@ int Fidelity(const FidelityArgs& args) {
             << report.sim_beam_correlation[1] << "/" << report.sim_beam_correlation[2] << "/"
             << report.sim_beam_correlation[3] << ", real " << report.real_beam_correlation[1] << "/"
             << report.real_beam_correlation[2] << "/" << report.real_beam_correlation[3] << "\n"
+            << "fine texture (less each bin's mean over +-" << sim::FidelityReport::kLocalReach
+            << " bins): range correlation at 1/2/3 bins sim "
+            << report.sim_local_range_correlation[1] << "/" << report.sim_local_range_correlation[2]
+            << "/" << report.sim_local_range_correlation[3] << ", real "
+            << report.real_local_range_correlation[1] << "/"
+            << report.real_local_range_correlation[2] << "/"
+            << report.real_local_range_correlation[3] << "; across 1/2/3 head steps sim "
+            << report.sim_local_beam_correlation[1] << "/" << report.sim_local_beam_correlation[2]
+            << "/" << report.sim_local_beam_correlation[3] << ", real "
+            << report.real_local_beam_correlation[1] << "/" << report.real_local_beam_correlation[2]
+            << "/" << report.real_local_beam_correlation[3] << "; contrast sim "
+            << report.sim_local_contrast << ", real " << report.real_local_contrast << "\n"
             << "sweep-to-sweep spread per head angle and bin: sim " << report.sim_sweep_spread
             << ", real " << report.real_sweep_spread << "\n"
             << "wrote " << args.out << "/fidelity.json\n";

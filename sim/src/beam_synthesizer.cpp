@@ -24,11 +24,14 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
         return m.specular > 0.0 && m.specular_spread_rad > 0.0;
       })) {
   // A bin's speckle is the coherent sum of the scatterers its range response covers: the pulse
-  // and, with skirts, one e-folding of each.
+  // and, with skirts, one e-folding of each; or the range a scene sets.
   const Acoustics& acoustics = sensor_.acoustics;
-  speckle_window_ = static_cast<int>(
-      std::max(1L, std::lround((acoustics.pulse_length_m + 2.0 * acoustics.pulse_skirt_length_m) /
-                               sensor_.geometry.bin_size_m)));
+  const double speckle_range_m =
+      acoustics.speckle_window_m > 0.0
+          ? acoustics.speckle_window_m
+          : acoustics.pulse_length_m + 2.0 * acoustics.pulse_skirt_length_m;
+  speckle_window_ =
+      static_cast<int>(std::max(1L, std::lround(speckle_range_m / sensor_.geometry.bin_size_m)));
   // Sector d's share of the two-way horizontal pattern exp(-θ²/2σ²), σ = w_h / √(8 ln 2): the
   // normal distribution's mass over [(d - ½) Δ, (d + ½) Δ], Δ the head step.
   {
@@ -290,18 +293,37 @@ void WindowPower(std::span<const std::complex<double>> amplitudes, std::size_t w
   }
 }
 
+// The mean of `looks` independent looks' factors, each drawn by `look(factors, l)`; look 0
+// alone written straight into `factors`.
+template <typename Look>
+void AverageLooks(std::span<double> factors, int looks, Look look) {
+  look(factors, 0);
+  if (looks <= 1) return;
+  thread_local std::vector<double> further;
+  further.resize(factors.size());
+  for (int l = 1; l < looks; ++l) {
+    look(std::span(further), l);
+    for (std::size_t k = 0; k < factors.size(); ++k) factors[k] += further[k];
+  }
+  const double per_look = 1.0 / looks;
+  for (double& f : factors) f *= per_look;
+}
+
 }  // namespace
 
-void BeamSynthesizer::CorrelatedSpeckle(std::span<double> factors, int window, Rng& rng) {
-  if (window <= 1) {
-    for (double& f : factors) f = rng.Exponential();
-    return;
-  }
-  const auto size = static_cast<std::size_t>(window);
-  thread_local std::vector<std::complex<double>> amplitudes;
-  amplitudes.resize(factors.size() + size - 1);
-  for (auto& a : amplitudes) a = DrawPhasor(rng);
-  WindowPower(amplitudes, size, factors);
+void BeamSynthesizer::CorrelatedSpeckle(std::span<double> factors, int window, Rng& rng,
+                                        int looks) {
+  AverageLooks(factors, looks, [&](std::span<double> out, int) {
+    if (window <= 1) {
+      for (double& f : out) f = rng.Exponential();
+      return;
+    }
+    const auto size = static_cast<std::size_t>(window);
+    thread_local std::vector<std::complex<double>> amplitudes;
+    amplitudes.resize(out.size() + size - 1);
+    for (auto& a : amplitudes) a = DrawPhasor(rng);
+    WindowPower(amplitudes, size, out);
+  });
 }
 
 namespace {
@@ -317,27 +339,41 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void AddScaled(
 
 }  // namespace
 
-void BeamSynthesizer::SectorSpeckle(std::span<double> factors, int window,
-                                    std::span<const double> amplitude_weights,
-                                    std::span<const std::uint64_t> sector_seeds) {
+namespace {
+
+// SectorSpeckle's look `look` alone.
+void SectorSpeckleLook(std::span<double> factors, int window,
+                       std::span<const double> amplitude_weights,
+                       std::span<const std::uint64_t> sector_seeds, int look) {
   const auto size = static_cast<std::size_t>(std::max(window, 1));
   const std::size_t length = factors.size() + size - 1;
-  // A sector's phasors, kept per thread for the next beams: a static sonar's neighbouring beams
-  // share all but one of their sectors. Keyed by seed and length, so what a beam gets does not
-  // depend on which beams the thread did before.
+  // A sector's phasors, kept per thread and look for the next beams: a static sonar's
+  // neighbouring beams share all but one of their sectors. Keyed by seed and length, so what a
+  // beam gets does not depend on which beams the thread did before.
   struct Sector {
     std::uint64_t seed = 0;
     std::vector<std::complex<double>> phasors;
   };
-  thread_local std::vector<Sector> cache;
-  thread_local std::size_t next_slot = 0;
-  if (cache.size() < amplitude_weights.size() + 1) cache.resize(amplitude_weights.size() + 1);
-  const auto phasors_of = [&](std::uint64_t seed) -> const std::vector<std::complex<double>>& {
-    for (const Sector& sector : cache) {
+  struct Cache {
+    std::vector<Sector> sectors;
+    std::size_t next_slot = 0;
+  };
+  thread_local std::vector<Cache> caches;
+  if (caches.size() <= static_cast<std::size_t>(look))
+    caches.resize(static_cast<std::size_t>(look) + 1);
+  Cache& cache = caches[static_cast<std::size_t>(look)];
+  if (cache.sectors.size() < amplitude_weights.size() + 1) {
+    cache.sectors.resize(amplitude_weights.size() + 1);
+  }
+  const auto phasors_of =
+      [&](std::uint64_t sector_seed) -> const std::vector<std::complex<double>>& {
+    const std::uint64_t seed =
+        look == 0 ? sector_seed : DeriveSeed(sector_seed, static_cast<std::uint64_t>(look));
+    for (const Sector& sector : cache.sectors) {
       if (sector.seed == seed && sector.phasors.size() == length) return sector.phasors;
     }
-    Sector& sector = cache[next_slot];
-    next_slot = (next_slot + 1) % cache.size();
+    Sector& sector = cache.sectors[cache.next_slot];
+    cache.next_slot = (cache.next_slot + 1) % cache.sectors.size();
     sector.seed = seed;
     sector.phasors.resize(length);
     Rng rng(seed);
@@ -355,6 +391,16 @@ void BeamSynthesizer::SectorSpeckle(std::span<double> factors, int window,
               std::span(reinterpret_cast<const double*>(z.data()), 2 * length), w);
   }
   WindowPower(amplitudes, size, factors);
+}
+
+}  // namespace
+
+void BeamSynthesizer::SectorSpeckle(std::span<double> factors, int window,
+                                    std::span<const double> amplitude_weights,
+                                    std::span<const std::uint64_t> sector_seeds, int looks) {
+  AverageLooks(factors, looks, [&](std::span<double> out, int look) {
+    SectorSpeckleLook(out, window, amplitude_weights, sector_seeds, look);
+  });
 }
 
 void BeamSynthesizer::AddPulseSkirts(std::vector<double>& echo_power) const {
@@ -871,9 +917,10 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
   if (a_.speckle) {
     speckle.resize(bins_);
     if (place_rng_) {
-      SectorSpeckle(speckle, s_.speckle_window_, s_.sector_weights_, scratch_.sector_seeds);
+      SectorSpeckle(speckle, s_.speckle_window_, s_.sector_weights_, scratch_.sector_seeds,
+                    a_.speckle_looks);
     } else {
-      CorrelatedSpeckle(speckle, s_.speckle_window_, *echo_rng_);
+      CorrelatedSpeckle(speckle, s_.speckle_window_, *echo_rng_, a_.speckle_looks);
     }
   }
   s_.AddReverberation(echo);

@@ -132,6 +132,46 @@ std::vector<std::vector<double>> CentredRows(std::span<const mapping::Beam> beam
   return rows;
 }
 
+// Each beam's bins [first, bins) (fewer for a short beam), less the beam's mean over the bins
+// within FidelityReport::kLocalReach of each (from the whole beam, fewer at its ends).
+std::vector<std::vector<double>> LocallyCentredRows(std::span<const mapping::Beam> beams,
+                                                    std::size_t first, std::size_t bins) {
+  const auto reach = static_cast<std::size_t>(FidelityReport::kLocalReach);
+  std::vector<std::vector<double>> rows(beams.size());
+  std::vector<double> prefix;
+  for (std::size_t i = 0; i < beams.size(); ++i) {
+    const auto& v = beams[i].intensities;
+    const std::size_t end = std::min(bins, v.size());
+    if (end <= first) continue;
+    prefix.assign(1, 0.0);
+    for (const std::uint8_t x : v) prefix.push_back(prefix.back() + x);
+    rows[i].reserve(end - first);
+    for (std::size_t k = first; k < end; ++k) {
+      const std::size_t lo = k > reach ? k - reach : 0;
+      const std::size_t hi = std::min(v.size(), k + reach + 1);
+      rows[i].push_back(v[k] - (prefix[hi] - prefix[lo]) / static_cast<double>(hi - lo));
+    }
+  }
+  return rows;
+}
+
+// FidelityReport::sim_local_contrast from the beams' locally centred rows of bins [first, ...).
+double LocalContrast(std::span<const mapping::Beam> beams,
+                     const std::vector<std::vector<double>>& rows, std::size_t first) {
+  double squares = 0.0;
+  double intensity = 0.0;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < beams.size(); ++i) {
+    for (std::size_t k = 0; k < rows[i].size(); ++k) {
+      squares += rows[i][k] * rows[i][k];
+      intensity += beams[i].intensities[first + k];
+    }
+    count += rows[i].size();
+  }
+  if (count == 0 || intensity <= 0.0) return 0.0;
+  return std::sqrt(squares / static_cast<double>(count)) / (intensity / static_cast<double>(count));
+}
+
 // FidelityReport::sim_range_correlation from the beams' centred rows.
 std::vector<double> RangeCorrelation(const std::vector<std::vector<double>>& rows) {
   const auto lags = static_cast<std::size_t>(FidelityReport::kTextureLags);
@@ -411,6 +451,14 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   r.real_range_correlation = RangeCorrelation(real_rows);
   r.sim_beam_correlation = BeamCorrelation(sim, sim_rows, sensor);
   r.real_beam_correlation = BeamCorrelation(real, real_rows, sensor);
+  const auto sim_local_rows = LocallyCentredRows(sim, far_half, bins);
+  const auto real_local_rows = LocallyCentredRows(real, far_half, bins);
+  r.sim_local_range_correlation = RangeCorrelation(sim_local_rows);
+  r.real_local_range_correlation = RangeCorrelation(real_local_rows);
+  r.sim_local_beam_correlation = BeamCorrelation(sim, sim_local_rows, sensor);
+  r.real_local_beam_correlation = BeamCorrelation(real, real_local_rows, sensor);
+  r.sim_local_contrast = LocalContrast(sim, sim_local_rows, far_half);
+  r.real_local_contrast = LocalContrast(real, real_local_rows, far_half);
   r.sim_histogram = Histogram(sim, first);
   r.real_histogram = Histogram(real, first);
   for (std::size_t v = 0; v < 256; ++v) {
@@ -511,6 +559,12 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"range_correlation_by_lag_real", r.real_range_correlation},
                  {"beam_correlation_by_step_sim", r.sim_beam_correlation},
                  {"beam_correlation_by_step_real", r.real_beam_correlation},
+                 {"local_range_correlation_by_lag_sim", r.sim_local_range_correlation},
+                 {"local_range_correlation_by_lag_real", r.real_local_range_correlation},
+                 {"local_beam_correlation_by_step_sim", r.sim_local_beam_correlation},
+                 {"local_beam_correlation_by_step_real", r.real_local_beam_correlation},
+                 {"local_contrast_sim", r.sim_local_contrast},
+                 {"local_contrast_real", r.real_local_contrast},
                  {"sweep_spread_sim", r.sim_sweep_spread},
                  {"sweep_spread_real", r.real_sweep_spread},
                  {"outputs",

@@ -80,6 +80,8 @@ nlohmann::json SensorJson(const SensorModel& s) {
             {"level_jitter_db", a.level_jitter_db},
             {"max_bounces", a.max_bounces},
             {"speckle", a.speckle},
+            {"speckle_looks", a.speckle_looks},
+            {"speckle_window_m", a.speckle_window_m},
             {"speckle_correlation_m", a.speckle_correlation_m},
             {"speckle_angular_correlation_deg", a.speckle_angular_correlation_deg},
             {"reverberation_length_m", a.reverberation_length_m},

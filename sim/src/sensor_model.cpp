@@ -18,6 +18,8 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("level_jitter_db", a.level_jitter_db, InRange(0.0, 20.0));
   node.Optional("max_bounces", a.max_bounces, IntInRange(0, 16));
   node.Optional("speckle", a.speckle);
+  node.Optional("speckle_looks", a.speckle_looks, IntInRange(1, 16));
+  node.Optional("speckle_window_m", a.speckle_window_m, InRange(0.0, 10.0));
   node.Optional("speckle_correlation_m", a.speckle_correlation_m, InRange(0.0, 1000.0));
   node.Optional("speckle_angular_correlation_deg", a.speckle_angular_correlation_deg,
                 InRange(0.0, 30.0));
@@ -30,6 +32,10 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
 }
 
 void CheckAcoustics(YamlReader& node, const Acoustics& merged) {
+  if (merged.speckle_looks > 1 && !merged.speckle) {
+    node.Fail("speckle_looks",
+              "speckle: true (looks of a speckle that is off), got speckle: false");
+  }
   if (merged.speckle_angular_correlation_deg > 0.0 &&
       !(merged.speckle && merged.speckle_correlation_m > 0.0)) {
     node.Fail("speckle_angular_correlation_deg",

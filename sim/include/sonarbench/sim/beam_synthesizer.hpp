@@ -141,8 +141,10 @@ class BeamSynthesizer {
   /// is the coherent sum of the scatterers the pulse covers, so each factor is exponential of
   /// mean 1 (Rayleigh amplitude) and the factors of bins m apart share L - m of their
   /// scatterers: their correlation is (1 - m/L)² for m < L, 0 beyond. L = 1 draws one
-  /// exponential per bin. `window` (L) ≥ 1; the first factor's window is drawn in full.
-  static void CorrelatedSpeckle(std::span<double> factors, int window, Rng& rng);
+  /// exponential per bin. `window` (L) ≥ 1; the first factor's window is drawn in full. With
+  /// `looks` N > 1 (Acoustics::speckle_looks), the mean of N such factors drawn one look after
+  /// the other: gamma-distributed of mean 1 and shape N, correlated in range as one look is.
+  static void CorrelatedSpeckle(std::span<double> factors, int window, Rng& rng, int looks = 1);
 
   /// The same for a beam whose scatterers lie in several azimuth sectors, each sector's own
   /// complex Gaussians drawn, bin by bin, by Rng(sector_seeds[d]) as CorrelatedSpeckle draws
@@ -151,10 +153,14 @@ class BeamSynthesizer {
   /// With Σ_d weights² = 1 each factor is exponential of mean 1; two beams that share sectors
   /// (a static sonar's neighbouring beams: the sectors are the world's, keyed by head step)
   /// correlate by (Σ_d w_d w'_d)² bin for bin. One sector of weight 1 gives exactly
-  /// CorrelatedSpeckle's factors for Rng(sector_seeds[0]) when L > 1.
+  /// CorrelatedSpeckle's factors for Rng(sector_seeds[0]) when L > 1. With `looks` N > 1
+  /// (Acoustics::speckle_looks), the mean of N such factors, look l > 0 drawn from each
+  /// sector's own l-th set of complex Gaussians, by Rng(DeriveSeed(sector_seeds[d], l)): each
+  /// factor gamma-distributed of mean 1 and shape N, correlated across beams and range as one
+  /// look is.
   static void SectorSpeckle(std::span<double> factors, int window,
                             std::span<const double> amplitude_weights,
-                            std::span<const std::uint64_t> sector_seeds);
+                            std::span<const std::uint64_t> sector_seeds, int looks = 1);
 
   /// Amplitude weights of the head-step-wide azimuth sectors around a beam's own (an odd count
   /// 2R + 1: index R is the beam's; d steps off it, R + d), their squares summing to 1: the
@@ -168,7 +174,8 @@ class BeamSynthesizer {
 
   /// The speckle's correlation window L in bins (CorrelatedSpeckle, SectorSpeckle): the range
   /// response's extent, the pulse length plus one e-folding of each of its skirts
-  /// (pulse_length_m + 2 pulse_skirt_length_m), rounded, at least 1.
+  /// (pulse_length_m + 2 pulse_skirt_length_m), or Acoustics::speckle_window_m when that is
+  /// set, rounded, at least 1.
   [[nodiscard]] int SpeckleWindow() const { return speckle_window_; }
   /// Sectors on each side of a beam's own that its pattern's weights cover.
   static constexpr int kPatternReach = 4;

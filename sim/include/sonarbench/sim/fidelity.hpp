@@ -103,6 +103,22 @@ struct FidelityReport {
   std::vector<double> sim_beam_correlation;
   std::vector<double> real_beam_correlation;
   static constexpr int kBeamLags = 3;
+  /// The fine texture alone: as the two correlations above, but each bin's intensity less its
+  /// beam's mean over the bins within kLocalReach of it (fewer at the beam's ends), so structure
+  /// wider than that window (walls' arcs, ghost bands, the fall with range) no longer holds the
+  /// correlations up; what is left is the speckle's own grain. The correlations above mix the
+  /// two: a log with fine, low-contrast speckle on broad structure and one with coarse speckle
+  /// on little structure can give the same ones.
+  std::vector<double> sim_local_range_correlation;
+  std::vector<double> real_local_range_correlation;
+  std::vector<double> sim_local_beam_correlation;
+  std::vector<double> real_local_beam_correlation;
+  /// The fine texture's contrast: the root mean square of those deviations over the mean
+  /// intensity, in the same bins. Fully developed speckle (an exponential power) shows about
+  /// 5.6 dB of spread in a log detector's levels; fewer deep fades, less.
+  double sim_local_contrast = 0.0;
+  double real_local_contrast = 0.0;
+  static constexpr int kLocalReach = 15;
   /// Intensity histograms (fractions of all usable bins), and their intersection Σ min(p, q):
   /// 1 for identical distributions, 0 for disjoint ones.
   std::array<double, 256> sim_histogram{};

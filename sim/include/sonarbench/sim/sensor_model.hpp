@@ -62,6 +62,19 @@ struct Acoustics {
   /// only the background noise varies; a moving one decorrelates cell by cell. The speckle is
   /// then drawn per head-step azimuth sector and shared by the beams whose pattern covers it.
   double speckle_correlation_m = 0.0;
+  /// Independent looks averaged in each bin's speckle factor (1, the default: one). A bin's
+  /// power is then the mean of this many independent speckle factors, each as the one look is
+  /// (same correlation in range and across beams), so the factor is gamma-distributed of mean
+  /// 1 and shape `speckle_looks`: fewer deep fades, the level's spread in dB down from 5.6 dB
+  /// (one look) to 3.5 (two), 2.7 (three), 2.3 (four). Where a receiver's bin averages echoes
+  /// that fade independently (frequencies across a chirp's band, samples more than a
+  /// resolution cell apart); the tank's scene fits it. Needs speckle: true.
+  int speckle_looks = 1;
+  /// The range [m] over which a bin's speckle is one coherent sum (BeamSynthesizer::
+  /// SpeckleWindow: bins that far apart share no scatterers). 0, the default: the range
+  /// response's extent, the pulse and one e-folding of each of its skirts. A scene sets it where
+  /// its log's fine texture says otherwise.
+  double speckle_window_m = 0.0;
   /// With the place's speckle (speckle_correlation_m > 0), how far across azimuth [deg] the
   /// place's scattering stays alike: neighbouring head-step sectors' scatterers are correlated,
   /// sector amplitudes d steps apart by exp(-|d| · step / this) (each sector a sum of
@@ -106,7 +119,7 @@ struct SensorModel {
 void ReadAcoustics(YamlReader& node, Acoustics& a);
 /// Reports on `node` (an acoustics mapping) a key that `merged`, the settings in force once that
 /// mapping is applied, sets without what it needs: speckle_angular_correlation_deg without the
-/// place's speckle.
+/// place's speckle, speckle_looks over 1 without speckle.
 void CheckAcoustics(YamlReader& node, const Acoustics& merged);
 /// Reads a sensor model from an already-open reader (the root of a sensor model file).
 [[nodiscard]] SensorModel ReadSensorModel(YamlReader& root);
