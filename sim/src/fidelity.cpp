@@ -516,19 +516,16 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
   }
   WriteText((dir / "histogram.csv").string(), hist.str());
 
-  // The two mean profiles against range: sim orange, real white, 2 px per bin, 0..255 up.
-  const int width = 2 * static_cast<int>(r.sim_mean.size());
-  cv::Mat plot(300, width, CV_8UC3, cv::Scalar(30, 30, 30));
-  auto draw = [&](const std::vector<double>& profile_values, const cv::Scalar& colour) {
-    for (std::size_t k = 1; k < profile_values.size(); ++k) {
-      cv::line(plot, {2 * static_cast<int>(k - 1), 280 - static_cast<int>(profile_values[k - 1])},
-               {2 * static_cast<int>(k), 280 - static_cast<int>(profile_values[k])}, colour, 1,
-               cv::LINE_AA);
-    }
-  };
-  draw(r.real_mean, cv::Scalar(255, 255, 255));
-  draw(r.sim_mean, cv::Scalar(0, 140, 255));
-  WritePng((dir / "profile.png").string(), plot);
+  // The two mean profiles against range: sim orange, real black.
+  PlotSeries real_profile{"real log", cv::Scalar(0, 0, 0), {}, r.real_mean};
+  PlotSeries sim_profile{"simulated", cv::Scalar(0, 140, 255), {}, r.sim_mean};
+  for (std::size_t k = 0; k < r.sim_mean.size(); ++k) {
+    real_profile.x.push_back((static_cast<double>(k) + 0.5) * sensor.bin_size_m);
+  }
+  sim_profile.x = real_profile.x;
+  WritePng((dir / "profile.png").string(),
+           RenderLinePlot("Mean intensity against range", "range [m]", "mean intensity",
+                          {real_profile, sim_profile}, false, 0.0));
 
   WritePng((dir / "polar.png").string(),
            SideBySide(RenderPolarImage(sim_sweep), RenderPolarImage(real_sweep)));

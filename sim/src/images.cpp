@@ -160,6 +160,8 @@ cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
                        const std::string& y_label, const std::vector<PlotSeries>& series,
                        bool log2_x, double y_min, std::optional<double> y_max) {
   constexpr int kWidth = 720, kHeight = 460, kLeft = 80, kRight = 20, kTop = 40, kBottom = 60;
+  constexpr std::size_t kMaxValueTicks = 16;  // more x values: round ticks
+  constexpr std::size_t kMaxMarkers = 64;     // a longer series: a line alone
   cv::Mat img(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
   std::vector<double> xs;
   double top = y_max.value_or(y_min);
@@ -186,7 +188,20 @@ cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
   };
   const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
   const int font = cv::FONT_HERSHEY_SIMPLEX;
-  for (double x : xs) {
+  // Ticks at the series' x values, or for long series (a profile) at about ten round steps.
+  std::vector<double> ticks = xs;
+  if (!log2_x && xs.size() > kMaxValueTicks) {
+    const double raw = (xs.back() - xs.front()) / 10.0;
+    const double decade = std::pow(10.0, std::floor(std::log10(raw)));
+    const double step = raw / decade < 2.0   ? 2.0 * decade
+                        : raw / decade < 5.0 ? 5.0 * decade
+                                             : 10.0 * decade;
+    ticks.clear();
+    for (double t = std::ceil(xs.front() / step) * step; t <= xs.back(); t += step) {
+      ticks.push_back(t);
+    }
+  }
+  for (double x : ticks) {
     const int u = px(x).x;
     cv::line(img, {u, kTop}, {u, kHeight - kBottom}, grey, 1);
     char text[32];
@@ -209,7 +224,7 @@ cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
   for (const auto& s : series) {
     for (std::size_t i = 0; i < s.x.size(); ++i) {
       const cv::Point p(px(s.x[i]).x, py(s.y[i]));
-      cv::circle(img, p, 3, s.colour, cv::FILLED, cv::LINE_AA);
+      if (s.x.size() <= kMaxMarkers) cv::circle(img, p, 3, s.colour, cv::FILLED, cv::LINE_AA);
       if (i > 0) cv::line(img, {px(s.x[i - 1]).x, py(s.y[i - 1])}, p, s.colour, 2, cv::LINE_AA);
     }
     cv::line(img, {kWidth - 250, legend_y - 4}, {kWidth - 225, legend_y - 4}, s.colour, 2);

@@ -54,8 +54,9 @@ struct PlotSeries {
   std::vector<double> y;
 };
 /// Renders a line plot with axes, ticks at the x values of the series (log2 scale when
-/// `log2_x`), five y ticks from `y_min` to the data's maximum (or `y_max` when it is set), a
-/// title, axis labels and a legend.
+/// `log2_x`; over 16 x values on a linear scale, about ten round ticks), a marker at each point
+/// of a series of up to 64, five y ticks from `y_min` to the data's maximum (or `y_max` when it is
+/// set), a title, axis labels and a legend.
 [[nodiscard]] cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
                                      const std::string& y_label,
                                      const std::vector<PlotSeries>& series, bool log2_x,
