@@ -359,8 +359,9 @@ void SectorSpeckleLook(std::span<double> factors, int window,
     std::size_t next_slot = 0;
   };
   thread_local std::vector<Cache> caches;
-  if (caches.size() <= static_cast<std::size_t>(look))
+  if (caches.size() <= static_cast<std::size_t>(look)) {
     caches.resize(static_cast<std::size_t>(look) + 1);
+  }
   Cache& cache = caches[static_cast<std::size_t>(look)];
   if (cache.sectors.size() < amplitude_weights.size() + 1) {
     cache.sectors.resize(amplitude_weights.size() + 1);

@@ -216,9 +216,9 @@ cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
     cv::putText(img, text, {8, py(y) + 4}, font, 0.42, black, 1, cv::LINE_AA);
   }
   cv::rectangle(img, {kLeft, kTop}, {kWidth - kRight, kHeight - kBottom}, black, 1);
-  cv::putText(img, title, {kLeft, 26}, font, 0.55, black, 1, cv::LINE_AA);
+  cv::putText(img, title, {kLeft, 18}, font, 0.55, black, 1, cv::LINE_AA);
   cv::putText(img, x_label, {kLeft + 180, kHeight - 18}, font, 0.5, black, 1, cv::LINE_AA);
-  cv::putText(img, y_label, {8, kTop - 8}, font, 0.45, black, 1, cv::LINE_AA);
+  cv::putText(img, y_label, {8, kTop - 6}, font, 0.45, black, 1, cv::LINE_AA);
   // The legend sits in the lower right, where coverage-like curves that rise to 1 leave room.
   int legend_y = kHeight - kBottom - 12 - 18 * (static_cast<int>(series.size()) - 1);
   for (const auto& s : series) {
