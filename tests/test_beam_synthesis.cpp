@@ -86,6 +86,39 @@ double Correlation(const std::vector<double>& a, const std::vector<double>& b) {
   return ab / std::sqrt(aa * bb);
 }
 
+// Speckle factors from `draw` (which fills a sequence) correlate along range by (1 - m/L)² at
+// lag m < L = `window`, 0 from m = L: estimated on 64 independent sequences of 16384, the mean
+// estimate within 5 standard errors of the 64 (a false alarm under 1e-5 per lag) plus 4/n for
+// the estimator's O(1/n) bias, lags 1-6.
+template <typename Draw>
+void ExpectCorrelatedOverTheWindow(int window, Draw draw) {
+  constexpr int kSequences = 64;
+  constexpr std::size_t kLength = 16384;
+  std::array<std::vector<double>, 7> estimates;
+  std::vector<double> x(kLength);
+  for (int b = 0; b < kSequences; ++b) {
+    draw(x);
+    const double mean = std::accumulate(x.begin(), x.end(), 0.0) / kLength;
+    double variance = 0.0;
+    for (double v : x) variance += (v - mean) * (v - mean);
+    for (std::size_t m = 1; m < estimates.size(); ++m) {
+      double covariance = 0.0;
+      for (std::size_t k = 0; k + m < kLength; ++k) covariance += (x[k] - mean) * (x[k + m] - mean);
+      estimates[m].push_back(covariance / variance);
+    }
+  }
+  for (std::size_t m = 1; m < estimates.size(); ++m) {
+    const std::vector<double>& e = estimates[m];
+    const double mean = std::accumulate(e.begin(), e.end(), 0.0) / kSequences;
+    double sd = 0.0;
+    for (double v : e) sd += (v - mean) * (v - mean);
+    sd = std::sqrt(sd / (kSequences - 1));
+    const double lag = static_cast<double>(m) / window;
+    const double expected = m < static_cast<std::size_t>(window) ? (1.0 - lag) * (1.0 - lag) : 0.0;
+    EXPECT_NEAR(mean, expected, 5.0 * sd / std::sqrt(kSequences) + 4.0 / kLength) << "lag " << m;
+  }
+}
+
 SynthesizedBeam Ping(const SensorModel& sensor, const std::vector<TriangleMesh>& meshes,
                      std::uint64_t seed = 11) {
   const RayTracer tracer(meshes);
@@ -1129,31 +1162,9 @@ TEST(BeamSynthesis, SpeckleIsExponentialAndCorrelatedOverThePulse) {
   }
   EXPECT_NEAR(first / kFresh, 1.0, 5.0 / std::sqrt(static_cast<double>(kFresh)));
 
-  constexpr int kSequences = 64;
-  constexpr std::size_t kLength = 16384;
-  std::array<std::vector<double>, 7> estimates;
-  std::vector<double> x(kLength);
-  for (int b = 0; b < kSequences; ++b) {
+  ExpectCorrelatedOverTheWindow(kWindow, [&](std::vector<double>& x) {
     BeamSynthesizer::CorrelatedSpeckle(x, kWindow, rng);
-    const double mean = std::accumulate(x.begin(), x.end(), 0.0) / kLength;
-    double variance = 0.0;
-    for (double v : x) variance += (v - mean) * (v - mean);
-    for (std::size_t m = 1; m < estimates.size(); ++m) {
-      double covariance = 0.0;
-      for (std::size_t k = 0; k + m < kLength; ++k) covariance += (x[k] - mean) * (x[k + m] - mean);
-      estimates[m].push_back(covariance / variance);
-    }
-  }
-  for (std::size_t m = 1; m < estimates.size(); ++m) {
-    const std::vector<double>& e = estimates[m];
-    const double mean = std::accumulate(e.begin(), e.end(), 0.0) / kSequences;
-    double sd = 0.0;
-    for (double v : e) sd += (v - mean) * (v - mean);
-    sd = std::sqrt(sd / (kSequences - 1));
-    const double lag = static_cast<double>(m) / kWindow;
-    const double expected = m < kWindow ? (1.0 - lag) * (1.0 - lag) : 0.0;
-    EXPECT_NEAR(mean, expected, 5.0 * sd / std::sqrt(kSequences) + 4.0 / kLength) << "lag " << m;
-  }
+  });
 
   Rng a(7);
   Rng b(7);
@@ -1327,36 +1338,16 @@ TEST(BeamSynthesis, SpeckleLooksAreIndependentLooksAveraged) {
   }
 
   Rng rng(2025);
-  constexpr int kSequences = 64;
-  constexpr std::size_t kLength = 16384;
-  std::array<std::vector<double>, 7> estimates;
   std::vector<double> independent;
-  std::vector<double> x(kLength);
-  for (int b = 0; b < kSequences; ++b) {
+  ExpectCorrelatedOverTheWindow(kWindow, [&](std::vector<double>& x) {
     BeamSynthesizer::CorrelatedSpeckle(x, kWindow, rng, kLooks);
-    for (std::size_t k = 0; k < kLength; k += kWindow) independent.push_back(x[k]);
-    const double mean = std::accumulate(x.begin(), x.end(), 0.0) / kLength;
-    double variance = 0.0;
-    for (double v : x) variance += (v - mean) * (v - mean);
-    for (std::size_t m = 1; m < estimates.size(); ++m) {
-      double covariance = 0.0;
-      for (std::size_t k = 0; k + m < kLength; ++k) covariance += (x[k] - mean) * (x[k + m] - mean);
-      estimates[m].push_back(covariance / variance);
-    }
-  }
+    for (std::size_t k = 0; k < x.size(); k += kWindow) independent.push_back(x[k]);
+  });
   const auto n = static_cast<double>(independent.size());
   EXPECT_LT(KsDistance(independent, gamma_cdf),
             1.949 / std::sqrt(n) + static_cast<double>(kLooks) / BeamSynthesizer::kSpecklePhases);
-  for (std::size_t m = 1; m < estimates.size(); ++m) {
-    const std::vector<double>& e = estimates[m];
-    const double mean = std::accumulate(e.begin(), e.end(), 0.0) / kSequences;
-    double sd = 0.0;
-    for (double v : e) sd += (v - mean) * (v - mean);
-    sd = std::sqrt(sd / (kSequences - 1));
-    const double lag = static_cast<double>(m) / kWindow;
-    const double expected = m < kWindow ? (1.0 - lag) * (1.0 - lag) : 0.0;
-    EXPECT_NEAR(mean, expected, 5.0 * sd / std::sqrt(kSequences) + 4.0 / kLength) << "lag " << m;
-  }
+  constexpr int kSequences = 64;
+  constexpr std::size_t kLength = 16384;
 
   const SensorModel micron = QuietSensor();
   const std::vector<TriangleMesh> none;
