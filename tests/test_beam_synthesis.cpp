@@ -119,6 +119,39 @@ void ExpectCorrelatedOverTheWindow(int window, Draw draw) {
   }
 }
 
+// Beams one head step apart share all but one sector: over 64 pairs of sequences of 16384
+// (sectors 0 .. 2R+1 of a place seeded from seed_base + pair; beam A hears 0 .. 2R, beam B
+// 1 .. 2R+1), their factors correlate by ρ², ρ = Σ w_d w_{d+1}, bin for bin: the mean within 5
+// standard errors plus 4/n (a false alarm under 1e-5). Returns beam A's factors 4 windows apart
+// (independent), for a test of their distribution.
+std::vector<double> ExpectNeighboursShareSectors(const std::vector<double>& w, int window,
+                                                 int looks, std::uint64_t seed_base) {
+  double rho = 0.0;
+  for (std::size_t d = 0; d + 1 < w.size(); ++d) rho += w[d] * w[d + 1];
+  constexpr int kPairs = 64;
+  constexpr std::size_t kLength = 16384;
+  std::vector<double> a(kLength);
+  std::vector<double> b(kLength);
+  std::vector<double> correlations;
+  std::vector<double> independent;
+  for (int pair = 0; pair < kPairs; ++pair) {
+    std::vector<std::uint64_t> place;
+    for (std::size_t d = 0; d < w.size() + 1; ++d) place.push_back(DeriveSeed(seed_base + pair, d));
+    BeamSynthesizer::SectorSpeckle(a, window, w, std::span(place).first(w.size()), looks);
+    BeamSynthesizer::SectorSpeckle(b, window, w, std::span(place).subspan(1), looks);
+    for (std::size_t k = 0; k < kLength; k += 4 * static_cast<std::size_t>(window)) {
+      independent.push_back(a[k]);
+    }
+    correlations.push_back(Correlation(a, b));
+  }
+  const double mean = std::accumulate(correlations.begin(), correlations.end(), 0.0) / kPairs;
+  double sd = 0.0;
+  for (double c : correlations) sd += (c - mean) * (c - mean);
+  sd = std::sqrt(sd / (kPairs - 1));
+  EXPECT_NEAR(mean, rho * rho, 5.0 * sd / std::sqrt(kPairs) + 4.0 / kLength);
+  return independent;
+}
+
 SynthesizedBeam Ping(const SensorModel& sensor, const std::vector<TriangleMesh>& meshes,
                      std::uint64_t seed = 11) {
   const RayTracer tracer(meshes);
@@ -1278,29 +1311,10 @@ TEST(BeamSynthesis, NeighbouringBeamsShareTheirSectorsSpeckle) {
   BeamSynthesizer::SectorSpeckle(sector, kWindow, one, seed);
   EXPECT_EQ(direct, sector);
 
-  constexpr int kPairs = 64;
-  constexpr std::size_t kLength = 16384;
-  std::vector<double> a(kLength);
-  std::vector<double> b(kLength);
-  std::vector<double> correlations;
-  std::vector<double> independent;
-  for (int pair = 0; pair < kPairs; ++pair) {
-    // Sectors 0 .. 2R+1 of the place; beam A hears 0 .. 2R, beam B, one step on, 1 .. 2R+1.
-    std::vector<std::uint64_t> seeds;
-    for (std::size_t d = 0; d < w.size() + 1; ++d) seeds.push_back(DeriveSeed(1000 + pair, d));
-    BeamSynthesizer::SectorSpeckle(a, kWindow, w, std::span(seeds).first(w.size()));
-    BeamSynthesizer::SectorSpeckle(b, kWindow, w, std::span(seeds).subspan(1));
-    for (std::size_t k = 0; k < kLength; k += 4 * kWindow) independent.push_back(a[k]);
-    correlations.push_back(Correlation(a, b));
-  }
+  const std::vector<double> independent = ExpectNeighboursShareSectors(w, kWindow, 1, 1000);
   const auto n = static_cast<double>(independent.size());
   EXPECT_LT(KsDistance(independent, [](double v) { return 1.0 - std::exp(-v); }),
             1.949 / std::sqrt(n) + 1.0 / BeamSynthesizer::kSpecklePhases);
-  const double mean = std::accumulate(correlations.begin(), correlations.end(), 0.0) / kPairs;
-  double sd = 0.0;
-  for (double c : correlations) sd += (c - mean) * (c - mean);
-  sd = std::sqrt(sd / (kPairs - 1));
-  EXPECT_NEAR(mean, rho * rho, 5.0 * sd / std::sqrt(kPairs) + 4.0 / kLength);
 }
 
 // Speckle of N looks (Acoustics::speckle_looks, N = 3 here) is the mean of N independent looks:
@@ -1319,6 +1333,11 @@ TEST(BeamSynthesis, SpeckleLooksAreIndependentLooksAveraged) {
   const auto gamma_cdf = [](double x) {
     const double t = kLooks * x;
     return 1.0 - std::exp(-t) * (1.0 + t + 0.5 * t * t);
+  };
+  const auto expect_gamma = [&](const std::vector<double>& sample) {
+    EXPECT_LT(KsDistance(sample, gamma_cdf),
+              1.949 / std::sqrt(static_cast<double>(sample.size())) +
+                  static_cast<double>(kLooks) / BeamSynthesizer::kSpecklePhases);
   };
 
   const std::array<std::uint64_t, 2> seeds = {11, 12};
@@ -1343,40 +1362,14 @@ TEST(BeamSynthesis, SpeckleLooksAreIndependentLooksAveraged) {
     BeamSynthesizer::CorrelatedSpeckle(x, kWindow, rng, kLooks);
     for (std::size_t k = 0; k < x.size(); k += kWindow) independent.push_back(x[k]);
   });
-  const auto n = static_cast<double>(independent.size());
-  EXPECT_LT(KsDistance(independent, gamma_cdf),
-            1.949 / std::sqrt(n) + static_cast<double>(kLooks) / BeamSynthesizer::kSpecklePhases);
-  constexpr int kSequences = 64;
-  constexpr std::size_t kLength = 16384;
+  expect_gamma(independent);
 
   const SensorModel micron = QuietSensor();
   const std::vector<TriangleMesh> none;
   const RayTracer tracer(none);
   const BeamSynthesizer synthesizer(micron, tracer, {Material{}});
   const std::vector<double>& w = synthesizer.SectorWeights();
-  double rho = 0.0;
-  for (std::size_t d = 0; d + 1 < w.size(); ++d) rho += w[d] * w[d + 1];
-  std::vector<double> a(kLength);
-  std::vector<double> b(kLength);
-  std::vector<double> correlations;
-  std::vector<double> sector_independent;
-  for (int pair = 0; pair < kSequences; ++pair) {
-    std::vector<std::uint64_t> place;
-    for (std::size_t d = 0; d < w.size() + 1; ++d) place.push_back(DeriveSeed(5000 + pair, d));
-    BeamSynthesizer::SectorSpeckle(a, kWindow, w, std::span(place).first(w.size()), kLooks);
-    BeamSynthesizer::SectorSpeckle(b, kWindow, w, std::span(place).subspan(1), kLooks);
-    for (std::size_t k = 0; k < kLength; k += 4 * kWindow) sector_independent.push_back(a[k]);
-    correlations.push_back(Correlation(a, b));
-  }
-  const auto sector_n = static_cast<double>(sector_independent.size());
-  EXPECT_LT(
-      KsDistance(sector_independent, gamma_cdf),
-      1.949 / std::sqrt(sector_n) + static_cast<double>(kLooks) / BeamSynthesizer::kSpecklePhases);
-  const double mean = std::accumulate(correlations.begin(), correlations.end(), 0.0) / kSequences;
-  double sd = 0.0;
-  for (double c : correlations) sd += (c - mean) * (c - mean);
-  sd = std::sqrt(sd / (kSequences - 1));
-  EXPECT_NEAR(mean, rho * rho, 5.0 * sd / std::sqrt(kSequences) + 4.0 / kLength);
+  expect_gamma(ExpectNeighboursShareSectors(w, kWindow, kLooks, 5000));
 }
 
 TEST(BeamSynthesis, NoiseFloorMatchesItsConfiguredDistribution) {
