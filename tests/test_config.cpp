@@ -255,6 +255,23 @@ TEST(SceneFile, AngularCorrelationNeedsThePlacesSpeckle) {
   EXPECT_EQ(tank.sensor.acoustics.speckle_angular_correlation_deg, 3.0);
 }
 
+// A scene on the Micron whose sonar_acoustics (from line 5) are `acoustics` is refused, the
+// message naming line 5 of the file and each of `expected`.
+void ExpectSonarAcousticsRefused(const std::string& acoustics,
+                                 const std::vector<std::string>& expected) {
+  test::TempDir dir;
+  const std::string path = (dir.path() / "bad.yaml").string();
+  std::ofstream(path) << "name: x\nsensor_model: "
+                      << test::SourcePath("sensor-models/shad-micron.yaml")
+                      << "\nsweeps: 1\nsonar_acoustics:\n"
+                      << acoustics << "materials:\n  - {name: rock, reflectivity: 0.5}\n"
+                      << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
+                      << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+  std::vector<std::string> parts = {"bad.yaml:5:"};
+  parts.insert(parts.end(), expected.begin(), expected.end());
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, parts)) << acoustics;
+}
+
 // The speckle's looks and window are the tank's (the sensor model keeps one look over the
 // range response); looks without speckle, or out of 1..16, are refused with the key and line.
 TEST(SceneFile, SpeckleLooksAndWindowAreTheTanks) {
@@ -271,19 +288,33 @@ TEST(SceneFile, SpeckleLooksAndWindowAreTheTanks) {
       {"  speckle_looks: 0\n", {"'sonar_acoustics.speckle_looks'", "'0'"}},
       {"  speckle_looks: 2.5\n", {"'sonar_acoustics.speckle_looks'", "'2.5'"}},
       {"  speckle_window_m: -0.1\n", {"'sonar_acoustics.speckle_window_m'", "'-0.1'"}}};
-  for (const auto& [acoustics, expected] : cases) {
-    test::TempDir dir;
-    const std::string path = (dir.path() / "bad.yaml").string();
-    std::ofstream(path)
-        << "name: x\nsensor_model: " << test::SourcePath("sensor-models/shad-micron.yaml")
-        << "\nsweeps: 1\nsonar_acoustics:\n"
-        << acoustics << "materials:\n  - {name: rock, reflectivity: 0.5}\n"
-        << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
-        << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
-    std::vector<std::string> parts = {"bad.yaml:5:"};
-    parts.insert(parts.end(), expected.begin(), expected.end());
-    EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, parts)) << acoustics;
-  }
+  for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
+}
+
+// The self-reflection's spreads are the sensor model's (the sonar's own, fitted to the real
+// log); a spread with no profile to vary, a correlation or ringing range with no spread to
+// shape, or a spread out of 0..10 dB, is refused with the key and line.
+TEST(SceneFile, SelfReflectionSpreadsAreTheSonars) {
+  const sim::SensorModel micron =
+      sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
+  EXPECT_EQ(micron.acoustics.self_reflection_ping_spread_db, 0.97);
+  EXPECT_EQ(micron.acoustics.self_reflection_ringing_range_m, 0.35);
+  EXPECT_EQ(micron.acoustics.self_reflection_angle_spread_db, 1.6);
+  EXPECT_EQ(micron.acoustics.self_reflection_angle_correlation_deg, 5.0);
+  EXPECT_EQ(micron.acoustics.self_reflection_db.size(), 66u);
+  const std::pair<std::string, std::vector<std::string>> cases[] = {
+      {"  self_reflection_db: []\n",
+       {"'sonar_acoustics.self_reflection_ping_spread_db'", "a self-reflection profile"}},
+      {"  self_reflection_angle_spread_db: 0\n",
+       {"'sonar_acoustics.self_reflection_angle_correlation_deg'",
+        "self_reflection_angle_spread_db > 0", "got 0"}},
+      {"  self_reflection_ping_spread_db: 0\n",
+       {"'sonar_acoustics.self_reflection_ringing_range_m'", "self_reflection_ping_spread_db > 0"}},
+      {"  self_reflection_ping_spread_db: 11\n",
+       {"'sonar_acoustics.self_reflection_ping_spread_db'", "'11'"}},
+      {"  self_reflection_angle_spread_db: -1\n",
+       {"'sonar_acoustics.self_reflection_angle_spread_db'", "'-1'"}}};
+  for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
 }
 
 // The scenes built on the fitted tank (the two that must fail, and the crate) extend it: they

@@ -456,5 +456,34 @@ TEST(Fidelity, SweepSpreadIsTheStandardDeviationAcrossSweepsPerAngleAndBin) {
   EXPECT_NEAR(report.real_sweep_spread, 6.0 / std::sqrt(2.0), 1e-9);
 }
 
+// The self-reflection's statistics over its bins: the real log's mean is 0 but in bins 5-22
+// (before the usable bins from 28), where it is 100 + 10 at even head steps and - 10 at odd
+// ones, 3 lower in the first sweep and 3 higher in the second; plus a step of 60 at bin 4 in the
+// simulated run alone (not a ringing bin: the bins are the real log's). So bins 5-22, mean 100
+// (real; the simulated one too, bin 4 left out), from ping to ping the two sweeps' standard
+// deviation 6/√2, across head angles the ±10's, 10 √(200/199), and neighbouring head steps, or
+// five apart, correlating by -1.
+TEST(Fidelity, SelfReflectionIsMeasuredOverItsBinsPerHeadAngleAndSweep) {
+  const mapping::SensorGeometry sensor;
+  const int steps = sensor.BeamsPerSweep();
+  const auto ringing = [steps](int b, int k) -> std::uint8_t {
+    if (k < 5 || k > 22) return 0;
+    return static_cast<std::uint8_t>(100 + (b % 2 == 0 ? 10 : -10) + (b < steps ? -3 : 3));
+  };
+  const std::vector<mapping::Beam> real = TwoSweeps(sensor, ringing);
+  const std::vector<mapping::Beam> sim =
+      TwoSweeps(sensor, [&](int b, int k) -> std::uint8_t { return k == 4 ? 60 : ringing(b, k); });
+  const auto report = sim::CompareWithLog(sim, real, sensor, 1.6);
+  for (const auto* r : {&report.sim_ringing, &report.real_ringing}) {
+    EXPECT_EQ(r->first_bin, 5u);
+    EXPECT_EQ(r->last_bin, 22u);
+    EXPECT_DOUBLE_EQ(r->mean, 100.0);
+    EXPECT_NEAR(r->ping_spread, 6.0 / std::sqrt(2.0), 1e-9);
+    EXPECT_NEAR(r->angle_spread, 10.0 * std::sqrt(200.0 / 199.0), 1e-9);
+    EXPECT_NEAR(r->angle_correlation[0], -1.0, 1e-9);
+    EXPECT_NEAR(r->angle_correlation[1], -1.0, 1e-9);
+  }
+}
+
 }  // namespace
 }  // namespace sonarbench

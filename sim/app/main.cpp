@@ -227,6 +227,17 @@ int Fidelity(const FidelityArgs& args) {
             << report.sim_local_contrast << ", real " << report.real_local_contrast << "\n"
             << "sweep-to-sweep spread per head angle and bin: sim " << report.sim_sweep_spread
             << ", real " << report.real_sweep_spread << "\n"
+            << "self-reflection (bins " << report.real_ringing.first_bin << "-"
+            << report.real_ringing.last_bin << "): mean sim " << report.sim_ringing.mean
+            << ", real " << report.real_ringing.mean << "; ping to ping sim "
+            << report.sim_ringing.ping_spread << ", real " << report.real_ringing.ping_spread
+            << "; across head angles sim " << report.sim_ringing.angle_spread << ", real "
+            << report.real_ringing.angle_spread << ", correlated at 1/"
+            << sim::FidelityReport::kRingingFarStep << " head steps sim "
+            << report.sim_ringing.angle_correlation[0] << "/"
+            << report.sim_ringing.angle_correlation[1] << ", real "
+            << report.real_ringing.angle_correlation[0] << "/"
+            << report.real_ringing.angle_correlation[1] << "\n"
             << "wrote " << args.out << "/fidelity.json\n";
   return 0;
 }

@@ -58,9 +58,7 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
       untvg_at_bin_.push_back(1.0 / tvg_at_bin_.back());
     }
   }
-  for (const double db : sensor_.acoustics.self_reflection_db) {
-    self_reflection_power_.push_back(std::pow(10.0, db / 10.0));
-  }
+  TabulateSelfReflection(run_seed);
   // Quantise rounds half up: step q begins where the level reaches q - 0.5 AD steps.
   const Acoustics& a = sensor_.acoustics;
   ad_thresholds_[0] = 0.0;
@@ -136,6 +134,101 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
       spread_offsets_.emplace_back(static_cast<float>(radius * std::cos(angle)),
                                    static_cast<float>(radius * std::sin(angle)));
     }
+  }
+}
+
+void BeamSynthesizer::TabulateSelfReflection(std::uint64_t run_seed) {
+  const Acoustics& a = sensor_.acoustics;
+  const std::size_t n = a.self_reflection_db.size();
+  const double sigma_a = a.self_reflection_angle_spread_db;
+  const double sigma_p = a.self_reflection_ping_spread_db;
+  // The ping's spread covers the ringing's bins: those whose centre lies within its range.
+  self_reflection_ringing_bins_ = n;
+  if (a.self_reflection_ringing_range_m > 0.0) {
+    self_reflection_ringing_bins_ = std::min(
+        n, static_cast<std::size_t>(std::max(
+               0.0,
+               std::ceil(a.self_reflection_ringing_range_m / sensor_.geometry.bin_size_m - 0.5))));
+  }
+  // E[10^(σ z / 10)] = exp(½ (σ ln 10 / 10)²) for z standard normal: divided out, so the
+  // profile stays the mean power.
+  const auto mean_factor = [&](std::size_t k) {
+    const double sigma_k = k < self_reflection_ringing_bins_ ? sigma_p : 0.0;
+    return std::exp(0.5 * kNepersPerDecibel * kNepersPerDecibel *
+                    (sigma_a * sigma_a + sigma_k * sigma_k));
+  };
+  self_reflection_turn_ =
+      sigma_a > 0.0
+          ? static_cast<int>(std::llround(2.0 * std::numbers::pi / sensor_.geometry.step_angle_rad))
+          : 1;
+  const auto turn = static_cast<std::size_t>(self_reflection_turn_);
+  self_reflection_by_head_.assign(turn * n, 0.0);
+  for (std::size_t j = 0; j < turn; ++j) {
+    for (std::size_t k = 0; k < n; ++k) {
+      self_reflection_by_head_[j * n + k] =
+          std::pow(10.0, a.self_reflection_db[k] / 10.0) / mean_factor(k);
+    }
+  }
+  if (sigma_a <= 0.0 || n == 0) return;
+
+  // Head step j's draw in bin k: u_jk = (z_jk + z_j,k+1) / √2, the z independent standard normals
+  // of Rng(DeriveSeed(seed, j)); then A_jk = Σ_e c_e u_(j+e mod turn),k, c_e ∝ exp(-|e| Δ / θ)
+  // with Σ c² = 1, cut at half a turn or where what is left holds under 1e-12 of its power.
+  const std::uint64_t seed = DeriveSeed(run_seed, 0x72696e67ULL);  // "ring"
+  std::vector<double> u(turn * n);
+  for (std::size_t j = 0; j < turn; ++j) {
+    Rng rng(DeriveSeed(seed, j));
+    double z = rng.Normal();
+    for (std::size_t k = 0; k < n; ++k) {
+      const double next = rng.Normal();
+      u[j * n + k] = (z + next) / std::numbers::sqrt2;
+      z = next;
+    }
+  }
+  std::vector<double> kernel{1.0};
+  if (a.self_reflection_angle_correlation_deg > 0.0) {
+    const double steps = a.self_reflection_angle_correlation_deg * std::numbers::pi / 180.0 /
+                         sensor_.geometry.step_angle_rad;
+    const int reach = std::min(static_cast<int>(std::ceil(steps * std::log(1e12) / 2.0)),
+                               (self_reflection_turn_ - 1) / 2);
+    kernel.assign(2 * static_cast<std::size_t>(reach) + 1, 0.0);
+    double squares = 0.0;
+    for (int e = -reach; e <= reach; ++e) {
+      const double c = std::exp(-std::abs(e) / steps);
+      kernel[static_cast<std::size_t>(e + reach)] = c;
+      squares += c * c;
+    }
+    for (double& c : kernel) c /= std::sqrt(squares);
+  }
+  const int reach = static_cast<int>(kernel.size() / 2);
+  for (std::size_t j = 0; j < turn; ++j) {
+    for (std::size_t k = 0; k < n; ++k) {
+      double level = 0.0;
+      for (int e = -reach; e <= reach; ++e) {
+        const auto from = static_cast<std::size_t>(
+            (static_cast<int>(j) + e + self_reflection_turn_) % self_reflection_turn_);
+        level += kernel[static_cast<std::size_t>(e + reach)] * u[from * n + k];
+      }
+      self_reflection_by_head_[j * n + k] *= std::exp(kNepersPerDecibel * sigma_a * level);
+    }
+  }
+}
+
+void BeamSynthesizer::SelfReflection(double head_angle_rad, Rng& ping_rng,
+                                     std::vector<double>& power) const {
+  const std::size_t n = sensor_.acoustics.self_reflection_db.size();
+  const long long turn = self_reflection_turn_;
+  const long long step = std::llround(head_angle_rad / sensor_.geometry.step_angle_rad);
+  const auto j = static_cast<std::size_t>(((step % turn) + turn) % turn);
+  power.assign(self_reflection_by_head_.begin() + static_cast<std::ptrdiff_t>(j * n),
+               self_reflection_by_head_.begin() + static_cast<std::ptrdiff_t>((j + 1) * n));
+  const double sigma_p = sensor_.acoustics.self_reflection_ping_spread_db;
+  if (sigma_p <= 0.0 || n == 0) return;
+  double z = ping_rng.Normal();
+  for (std::size_t k = 0; k < self_reflection_ringing_bins_; ++k) {
+    const double next = ping_rng.Normal();
+    power[k] *= std::exp(kNepersPerDecibel * sigma_p * (z + next) / std::numbers::sqrt2);
+    z = next;
   }
 }
 
@@ -654,6 +747,7 @@ struct BeamSynthesizer::Scratch {
   std::vector<double> impulse_power;  // the second trip's: each echo over one bin
   std::vector<double> speckle;
   std::vector<double> powers;
+  std::vector<double> self_reflection;
   std::vector<std::uint64_t> sector_seeds;
 };
 
@@ -669,6 +763,7 @@ class BeamSynthesizer::BeamJob {
         a_(synthesizer.sensor_.acoustics),
         bins_(static_cast<std::size_t>(g_.num_bins)),
         max_range_(g_.MaxRangeM()),
+        head_angle_rad_(head_angle_rad),
         rng_(seed),
         scratch_(scratch),
         out_(out),
@@ -712,6 +807,7 @@ class BeamSynthesizer::BeamJob {
   const Acoustics& a_;
   std::size_t bins_;
   double max_range_;
+  double head_angle_rad_;
   Rng rng_;
   Scratch& scratch_;
   SynthesizedBeam& out_;
@@ -926,13 +1022,15 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
   }
   s_.AddReverberation(echo);
   // The powers first, then their levels: no 8-bit store inside the loop that draws the noise.
+  // The self-reflection is the sonar's own, not the place's: added after the speckle.
+  std::vector<double>& self_reflection = scratch_.self_reflection;
+  s_.SelfReflection(head_angle_rad_, rng_, self_reflection);
   std::vector<double>& powers = scratch_.powers;
   powers.resize(bins_);
-  const std::vector<double>& self_reflection = s_.self_reflection_power_;
   for (std::size_t k = 0; k < bins_; ++k) {
     double signal = gain * echo[k];
-    if (k < self_reflection.size()) signal += self_reflection[k];
     if (a_.speckle) signal *= speckle[k];
+    if (k < self_reflection.size()) signal += self_reflection[k];
     powers[k] = signal + noise_power * rng_.Exponential();
   }
   // The receiver's level jitter, the ping's whatever the echoes are: five 12-bit picks per draw.

@@ -284,6 +284,94 @@ double SweepSpread(std::span<const mapping::Beam> beams, const mapping::SensorGe
   return counted > 0.0 ? spread / counted : 0.0;
 }
 
+// FidelityReport::Ringing over bins [first, last] (last < bins).
+FidelityReport::Ringing RingingStats(std::span<const mapping::Beam> beams,
+                                     const mapping::SensorGeometry& sensor, std::size_t first,
+                                     std::size_t last) {
+  FidelityReport::Ringing out;
+  out.first_bin = first;
+  out.last_bin = last;
+  const std::size_t width = last + 1 - first;
+  const auto steps = static_cast<std::size_t>(sensor.BeamsPerSweep());
+  std::vector<double> n(steps * width, 0.0), sum(steps * width, 0.0), sum_sq(steps * width, 0.0);
+  double total = 0.0;
+  double count = 0.0;
+  for (const auto& beam : beams) {
+    if (beam.intensities.size() <= last) continue;
+    const std::size_t row = StepIndex(beam, sensor) * width;
+    for (std::size_t k = 0; k < width; ++k) {
+      const double v = beam.intensities[first + k];
+      n[row + k] += 1.0;
+      sum[row + k] += v;
+      sum_sq[row + k] += v * v;
+      total += v;
+      count += 1.0;
+    }
+  }
+  if (count == 0.0) return out;
+  out.mean = total / count;
+  double spread = 0.0;
+  double cells = 0.0;
+  for (std::size_t c = 0; c < n.size(); ++c) {
+    if (n[c] < 2.0) continue;
+    const double mean = sum[c] / n[c];
+    spread += std::sqrt(std::max(0.0, (sum_sq[c] - n[c] * mean * mean) / (n[c] - 1.0)));
+    cells += 1.0;
+  }
+  out.ping_spread = cells > 0.0 ? spread / cells : 0.0;
+  // Per bin, the cells' means over the head steps seen twice or more, around the turn.
+  double bins_counted = 0.0;
+  for (std::size_t k = 0; k < width; ++k) {
+    std::vector<double> means(steps, 0.0);
+    std::vector<bool> seen(steps, false);
+    for (std::size_t j = 0; j < steps; ++j) {
+      const std::size_t c = j * width + k;
+      if (n[c] < 2.0) continue;
+      means[j] = sum[c] / n[c];
+      seen[j] = true;
+    }
+    std::vector<double> a;
+    std::vector<double> b_near;
+    std::vector<double> a_far;
+    std::vector<double> b_far;
+    std::vector<double> all;
+    for (std::size_t j = 0; j < steps; ++j) {
+      if (!seen[j]) continue;
+      all.push_back(means[j]);
+      if (const std::size_t next = (j + 1) % steps; seen[next]) {
+        a.push_back(means[j]);
+        b_near.push_back(means[next]);
+      }
+      const std::size_t far = (j + FidelityReport::kRingingFarStep) % steps;
+      if (seen[far]) {
+        a_far.push_back(means[j]);
+        b_far.push_back(means[far]);
+      }
+    }
+    if (all.size() < 2) continue;
+    const double mean =
+        std::accumulate(all.begin(), all.end(), 0.0) / static_cast<double>(all.size());
+    double squares = 0.0;
+    for (const double m : all) squares += (m - mean) * (m - mean);
+    out.angle_spread += std::sqrt(squares / static_cast<double>(all.size() - 1));
+    out.angle_correlation[0] += PearsonCorrelation(a, b_near);
+    out.angle_correlation[1] += PearsonCorrelation(a_far, b_far);
+    bins_counted += 1.0;
+  }
+  if (bins_counted > 0.0) {
+    out.angle_spread /= bins_counted;
+    for (double& c : out.angle_correlation) c /= bins_counted;
+  }
+  return out;
+}
+
+nlohmann::json RingingJson(const FidelityReport::Ringing& ringing) {
+  return {{"mean", ringing.mean},
+          {"ping_spread", ringing.ping_spread},
+          {"angle_spread", ringing.angle_spread},
+          {"angle_correlation_1_and_5_steps", ringing.angle_correlation}};
+}
+
 std::array<double, 256> Histogram(std::span<const mapping::Beam> beams, std::size_t first) {
   std::array<double, 256> h{};
   double total = 0.0;
@@ -459,6 +547,21 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   r.real_local_beam_correlation = BeamCorrelation(real, real_local_rows, sensor);
   r.sim_local_contrast = LocalContrast(sim, sim_local_rows, far_half);
   r.real_local_contrast = LocalContrast(real, real_local_rows, far_half);
+  {
+    // The ringing bins: before the usable ones, where the real mean is half its largest there.
+    const std::span<const double> own = std::span(r.real_mean).first(usable);
+    if (!own.empty()) {
+      const double half = 0.5 * *std::max_element(own.begin(), own.end());
+      std::size_t low = 0;
+      while (low < own.size() && own[low] < half) ++low;
+      std::size_t high = own.size() - 1;
+      while (high > low && own[high] < half) --high;
+      if (low < own.size() && half > 0.0) {
+        r.sim_ringing = RingingStats(sim, sensor, low, high);
+        r.real_ringing = RingingStats(real, sensor, low, high);
+      }
+    }
+  }
   r.sim_histogram = Histogram(sim, first);
   r.real_histogram = Histogram(real, first);
   for (std::size_t v = 0; v < 256; ++v) {
@@ -562,6 +665,10 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"local_beam_correlation_by_step_real", r.real_local_beam_correlation},
                  {"local_contrast_sim", r.sim_local_contrast},
                  {"local_contrast_real", r.real_local_contrast},
+                 {"self_reflection",
+                  {{"bins", {r.real_ringing.first_bin, r.real_ringing.last_bin}},
+                   {"sim", RingingJson(r.sim_ringing)},
+                   {"real", RingingJson(r.real_ringing)}}},
                  {"sweep_spread_sim", r.sim_sweep_spread},
                  {"sweep_spread_real", r.real_sweep_spread},
                  {"outputs",

@@ -89,7 +89,11 @@ nlohmann::json SensorJson(const SensorModel& s) {
             {"second_trip_db", a.second_trip_db},
             {"ad_low_db", a.ad_low_db},
             {"ad_span_db", a.ad_span_db},
-            {"self_reflection_db", a.self_reflection_db}}}};
+            {"self_reflection_db", a.self_reflection_db},
+            {"self_reflection_ping_spread_db", a.self_reflection_ping_spread_db},
+            {"self_reflection_ringing_range_m", a.self_reflection_ringing_range_m},
+            {"self_reflection_angle_spread_db", a.self_reflection_angle_spread_db},
+            {"self_reflection_angle_correlation_deg", a.self_reflection_angle_correlation_deg}}}};
 }
 
 nlohmann::json BoundJson(const std::optional<double>& bound) {

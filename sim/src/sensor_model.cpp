@@ -29,6 +29,14 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("ad_low_db", a.ad_low_db, InRange(-300.0, 100.0));
   node.Optional("ad_span_db", a.ad_span_db, InRange(1.0, 200.0));
   node.Optional("self_reflection_db", a.self_reflection_db);
+  node.Optional("self_reflection_ping_spread_db", a.self_reflection_ping_spread_db,
+                InRange(0.0, 10.0));
+  node.Optional("self_reflection_ringing_range_m", a.self_reflection_ringing_range_m,
+                InRange(0.0, 100.0));
+  node.Optional("self_reflection_angle_spread_db", a.self_reflection_angle_spread_db,
+                InRange(0.0, 10.0));
+  node.Optional("self_reflection_angle_correlation_deg", a.self_reflection_angle_correlation_deg,
+                InRange(0.0, 90.0));
 }
 
 void CheckAcoustics(YamlReader& node, const Acoustics& merged) {
@@ -42,6 +50,23 @@ void CheckAcoustics(YamlReader& node, const Acoustics& merged) {
               std::string("the place's speckle to correlate (speckle: true and "
                           "speckle_correlation_m > 0), got ") +
                   (merged.speckle ? "speckle_correlation_m 0" : "speckle: false"));
+  }
+  for (const auto& [key, spread] :
+       {std::pair{"self_reflection_ping_spread_db", merged.self_reflection_ping_spread_db},
+        std::pair{"self_reflection_angle_spread_db", merged.self_reflection_angle_spread_db}}) {
+    if (spread > 0.0 && merged.self_reflection_db.empty()) {
+      node.Fail(key, "a self-reflection profile to vary (self_reflection_db), got none");
+    }
+  }
+  if (merged.self_reflection_ringing_range_m > 0.0 &&
+      merged.self_reflection_ping_spread_db <= 0.0) {
+    node.Fail("self_reflection_ringing_range_m",
+              "self_reflection_ping_spread_db > 0 (the spread it bounds), got 0");
+  }
+  if (merged.self_reflection_angle_correlation_deg > 0.0 &&
+      merged.self_reflection_angle_spread_db <= 0.0) {
+    node.Fail("self_reflection_angle_correlation_deg",
+              "self_reflection_angle_spread_db > 0 (a spread to correlate), got 0");
   }
 }
 

@@ -188,6 +188,20 @@ class BeamSynthesizer {
   /// one picked by 12 random bits per bin (five bins per 64-bit draw of the ping's generator).
   static constexpr int kLevelJitters = 4096;
 
+  /// The self-reflection's power per bin (Acoustics::self_reflection_db, one entry per bin of
+  /// the profile) for a ping at `head_angle_rad`: bin k's profile power P_k times
+  ///     10^((σ_a A_jk + σ_p (y_k + y_k+1) / √2) / 10) / exp(½ (ln 10 / 10)² (σ_a² + σ_p²)),
+  /// σ_a and σ_p the angle and ping spreads, A_jk the head step j's own draw (tabled at
+  /// construction from the run seed: the same for every ping at that head step; see
+  /// TabulateSelfReflection) and the y_k standard normals drawn from `ping_rng` (r + 1 of them
+  /// for the r ringing bins, whose centres lie within self_reflection_ringing_range_m; none
+  /// when σ_p is 0). Past the ringing bins σ_p is 0. The divisor keeps P_k the mean power over
+  /// head steps and pings.
+  void SelfReflection(double head_angle_rad, Rng& ping_rng, std::vector<double>& power) const;
+
+  /// Decibels to nepers of power: 10^(x/10) = exp(x · this).
+  static constexpr double kNepersPerDecibel = 0.23025850929940458;
+
   /// The standard normal's quantile at u in (0, 1), by bisection on Φ(z) = ½ erfc(-z/√2): 64
   /// halvings of [-8, 8] leave an interval under a double's spacing, so z is as exact as erfc.
   [[nodiscard]] static double NormalQuantile(double u);
@@ -238,8 +252,19 @@ class BeamSynthesizer {
   std::vector<double> untvg_at_bin_;
   /// kLevelJitters power factors of the receiver's level jitter; empty when it has none.
   std::vector<double> level_jitter_factors_;
-  /// The self-reflection profile as linear power per bin.
-  std::vector<double> self_reflection_power_;
+  /// The self-reflection's mean power per head step and bin (row j: head step j of a turn, one
+  /// row when it has no angle spread), the angle spread and the mean's divisor applied.
+  std::vector<double> self_reflection_by_head_;
+  int self_reflection_turn_ = 1;
+  /// The profile's bins that the ping's spread covers (SelfReflection).
+  std::size_t self_reflection_ringing_bins_ = 0;
+  /// Fills self_reflection_by_head_: per head step j and bin k, A_jk = Σ_e c_e u_(j+e),k, the
+  /// u_jk = (z_jk + z_j,k+1) / √2 from independent standard normals z drawn per head step from
+  /// the run seed, c_e ∝ exp(-|e| Δ / θ) (θ the angle correlation, Δ the head step; c = [1]
+  /// without one) with Σ c² = 1, cut at half a turn or under 1e-12 of its power left: a
+  /// standard normal per head step and bin, neighbouring bins' correlating by ½ and head steps
+  /// m apart by Σ_e c_e c_e+m.
+  void TabulateSelfReflection(std::uint64_t run_seed);
   /// SpeckleWindow().
   int speckle_window_ = 1;
   /// SectorWeights().

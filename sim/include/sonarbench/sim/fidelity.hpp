@@ -119,6 +119,26 @@ struct FidelityReport {
   double sim_local_contrast = 0.0;
   double real_local_contrast = 0.0;
   static constexpr int kLocalReach = 15;
+  /// The self-reflection (the sonar's own ringing), over the ringing bins: the bins before the
+  /// usable ones whose real mean intensity is at least half the largest there (the Micron's
+  /// bins 5-22), the same bins for both. Per head-angle step and bin, the intensity's mean and
+  /// standard deviation over the sweeps (cells seen twice or more); then `mean`: the mean
+  /// intensity; `ping_spread`: the standard deviation within a cell, averaged over the cells
+  /// (how much it changes from ping to ping); `angle_spread`: per bin, the standard deviation of
+  /// the cells' means over head steps, averaged over the bins (how much it changes with head
+  /// angle, sweep after sweep alike); `angle_correlation`: per bin, the correlation of the cells'
+  /// means 1 and kRingingFarStep head steps apart (around the turn), averaged over the bins.
+  struct Ringing {
+    std::size_t first_bin = 0;
+    std::size_t last_bin = 0;
+    double mean = 0.0;
+    double ping_spread = 0.0;
+    double angle_spread = 0.0;
+    std::array<double, 2> angle_correlation{};
+  };
+  Ringing sim_ringing;
+  Ringing real_ringing;
+  static constexpr int kRingingFarStep = 5;
   /// Intensity histograms (fractions of all usable bins), and their intersection Σ min(p, q):
   /// 1 for identical distributions, 0 for disjoint ones.
   std::array<double, 256> sim_histogram{};

@@ -99,8 +99,25 @@ struct Acoustics {
   double ad_low_db = -40.0;
   double ad_span_db = 40.0;
   /// Mean self-reflection (vehicle body and transducer ringing) power per bin from bin 0, at the
-  /// receiver output [dB]; bins past the end of the list get none.
+  /// receiver output [dB]; bins past the end of the list get none. It is the sonar's own: not
+  /// the place's, so no speckle multiplies it, but it varies by these (BeamSynthesizer::
+  /// SelfReflectionFactors), each bin's level by a normal draw in dB, averaged with the next
+  /// bin's (neighbouring bins' draws correlate by ½), its mean power kept:
+  ///  - `self_reflection_ping_spread_db` [dB, standard deviation]: from ping to ping, in the
+  ///    bins whose centre lies within `self_reflection_ringing_range_m` [m] (the transducer's
+  ///    ringing; 0, the default: the whole profile); past it the profile is the vehicle's own
+  ///    echoes, static;
+  ///  - `self_reflection_angle_spread_db` [dB, standard deviation]: from head angle to head angle,
+  ///    the same every sweep (the head's and the vehicle's own, in the sonar's frame), alike over
+  ///    `self_reflection_angle_correlation_deg` [deg] of head angle (each head step's draw a sum of
+  ///    independent ones with weights e-folding over that angle, as
+  ///    speckle_angular_correlation_deg; 0: independent steps).
+  /// 0, the defaults: the profile as it is, every ping.
   std::vector<double> self_reflection_db;
+  double self_reflection_ping_spread_db = 0.0;
+  double self_reflection_ringing_range_m = 0.0;
+  double self_reflection_angle_spread_db = 0.0;
+  double self_reflection_angle_correlation_deg = 0.0;
 
   bool operator==(const Acoustics&) const = default;
 };
@@ -119,7 +136,8 @@ struct SensorModel {
 void ReadAcoustics(YamlReader& node, Acoustics& a);
 /// Reports on `node` (an acoustics mapping) a key that `merged`, the settings in force once that
 /// mapping is applied, sets without what it needs: speckle_angular_correlation_deg without the
-/// place's speckle, speckle_looks over 1 without speckle.
+/// place's speckle, speckle_looks over 1 without speckle, a self-reflection spread without a
+/// self-reflection profile, self_reflection_angle_correlation_deg without its spread.
 void CheckAcoustics(YamlReader& node, const Acoustics& merged);
 /// Reads a sensor model from an already-open reader (the root of a sensor model file).
 [[nodiscard]] SensorModel ReadSensorModel(YamlReader& root);
