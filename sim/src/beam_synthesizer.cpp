@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <vector>
@@ -13,6 +14,21 @@
 #include "sonarbench/sim/random.hpp"
 
 namespace sonarbench::sim {
+namespace {
+
+// c_e = exp(-|e| / steps) for |e| up to `max_reach` or to where what is left holds under 1e-12
+// of the power, whichever is nearer (entry e + reach): the kernel that makes draws e-fold their
+// correlation over `steps` head steps.
+std::vector<double> ExponentialKernel(double steps, int max_reach) {
+  const int reach = std::min(static_cast<int>(std::ceil(steps * std::log(1e12) / 2.0)), max_reach);
+  std::vector<double> kernel(2 * static_cast<std::size_t>(reach) + 1);
+  for (int e = -reach; e <= reach; ++e) {
+    kernel[static_cast<std::size_t>(e + reach)] = std::exp(-std::abs(e) / steps);
+  }
+  return kernel;
+}
+
+}  // namespace
 
 BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tracer,
                                  std::vector<Material> materials_by_mesh, std::uint64_t run_seed)
@@ -189,15 +205,9 @@ void BeamSynthesizer::TabulateSelfReflection(std::uint64_t run_seed) {
   if (a.self_reflection_angle_correlation_deg > 0.0) {
     const double steps = a.self_reflection_angle_correlation_deg * std::numbers::pi / 180.0 /
                          sensor_.geometry.step_angle_rad;
-    const int reach = std::min(static_cast<int>(std::ceil(steps * std::log(1e12) / 2.0)),
-                               (self_reflection_turn_ - 1) / 2);
-    kernel.assign(2 * static_cast<std::size_t>(reach) + 1, 0.0);
+    kernel = ExponentialKernel(steps, (self_reflection_turn_ - 1) / 2);
     double squares = 0.0;
-    for (int e = -reach; e <= reach; ++e) {
-      const double c = std::exp(-std::abs(e) / steps);
-      kernel[static_cast<std::size_t>(e + reach)] = c;
-      squares += c * c;
-    }
+    for (const double c : kernel) squares += c * c;
     for (double& c : kernel) c /= std::sqrt(squares);
   }
   const int reach = static_cast<int>(kernel.size() / 2);
@@ -250,11 +260,8 @@ void BeamSynthesizer::CorrelateSectors() {
   // convolved with c.
   const double steps = sensor_.acoustics.speckle_angular_correlation_deg * std::numbers::pi /
                        180.0 / g.step_angle_rad;
-  const int kernel_reach = static_cast<int>(std::ceil(steps * std::log(1e12) / 2.0));
-  std::vector<double> kernel(2 * static_cast<std::size_t>(kernel_reach) + 1);
-  for (int e = -kernel_reach; e <= kernel_reach; ++e) {
-    kernel[static_cast<std::size_t>(e + kernel_reach)] = std::exp(-std::abs(e) / steps);
-  }
+  const std::vector<double> kernel = ExponentialKernel(steps, std::numeric_limits<int>::max());
+  const int kernel_reach = static_cast<int>(kernel.size() / 2);
   const int reach = kPatternReach + kernel_reach;
   std::vector<double> weights(2 * static_cast<std::size_t>(reach) + 1, 0.0);
   for (int d = -kPatternReach; d <= kPatternReach; ++d) {
