@@ -14,7 +14,12 @@ mean lies in 30-69, 70-99 and 100-255 (bright cells show a receiver's own noise,
 background noise cannot reach there), and how neighbouring bins' deviations from their cells'
 means correlate, pooled over the pairs of cells of mean 60 or more; and the ringing tail: each beam's largest 5-bin moving average over bins 30-63
 (0.38-0.79 m, past the self-reflection the mapper drops), as percentiles over beams and the
-share of beams whose tail reaches 60. With --crossing T --from R, where a threshold detector
+share of beams whose tail reaches 60; and the fine texture, as `sonarbench fidelity` measures
+it (FidelityReport, its own implementation here): over the far half of the bins past the
+manifest's self_reflection_range_m, each bin less its beam's mean over the bins within 15 of it,
+the correlation of those 1, 2 and 3 bins apart along a beam and 1, 2 and 3 head steps apart
+across beams (the beams that many apart in time order, at consecutive head steps), and their
+contrast (root mean square over the mean intensity). With --crossing T --from R, where a threshold detector
 meets the first echo along each side (the walls of a tank): for the beams within 20° of head
 angle 0°, 90°, 180° and 270°, the first bin from R metres on whose 5-bin mean (the mapper's
 smoothing) reaches T, its centre's range times the cosine of the beam's angle off the side's
@@ -30,6 +35,7 @@ tilted one's earlier on one side and later on the other. Standard library only.
 """
 import argparse
 import glob
+import json
 import math
 import os
 import struct
@@ -179,7 +185,63 @@ def lit_rows(with_angles, first, last):
     return rows
 
 
+def fine_texture(with_angles, first, step_rad, reach=15, lags=3):
+    """([correlation along range at 1..lags bins], [across 1..lags head steps], contrast) of the
+    beams' bins from `first` on, each less its beam's mean over the bins within `reach` of it."""
+    rows = []
+    for _, _, b in with_angles:
+        prefix = [0]
+        for v in b:
+            prefix.append(prefix[-1] + v)
+        rows.append([b[k] - (prefix[min(len(b), k + reach + 1)] - prefix[max(0, k - reach)]) /
+                     (min(len(b), k + reach + 1) - max(0, k - reach)) for k in range(first, len(b))])
+    covariance = [0.0] * (lags + 1)
+    for row in rows:
+        if len(row) <= 8:  # as FidelityReport::kTextureLags
+            continue
+        for m in range(lags + 1):
+            covariance[m] += sum(row[k] * row[k + m] for k in range(len(row) - m)) / (len(row) - m)
+    along = [c / covariance[0] for c in covariance[1:]] if covariance[0] > 0 else [0.0] * lags
+    steps = round(2 * math.pi / step_rad)
+    index = [round(angle / step_rad) % steps for angle, _, _ in with_angles]
+    across = []
+    for m in range(1, lags + 1):
+        products = spread = 0.0
+        for i in range(len(rows) - m):
+            if (index[i] + m) % steps != index[i + m]:
+                continue
+            a, b = rows[i], rows[i + m]
+            n = min(len(a), len(b))
+            products += sum(a[k] * b[k] for k in range(n))
+            spread += math.sqrt(sum(x * x for x in a[:n]) * sum(x * x for x in b[:n]))
+        across.append(products / spread if spread > 0 else 0.0)
+    count = sum(len(r) for r in rows)
+    intensity = sum(sum(b[first:]) for _, _, b in with_angles)
+    squares = sum(x * x for r in rows for x in r)
+    contrast = math.sqrt(squares / count) / (intensity / count) if count and intensity else 0.0
+    return along, across, contrast
+
+
+def manifest_sensor(directory):
+    """(the first usable bin's far half start, the head step [rad]) from the manifest's sensor."""
+    path = os.path.join(directory, "manifest.json")
+    try:
+        with open(path) as f:
+            sensor = json.load(f)["sensor"]
+        size = float(sensor["bin_size_m"])
+        usable = math.ceil(float(sensor["self_reflection_range_m"]) / size - 1e-9)
+        return (usable + int(sensor["num_bins"])) // 2, math.radians(float(sensor["step_angle_deg"]))
+    except OSError as e:
+        sys.exit(f"{path}: cannot read it ({e.strerror})")
+    except json.JSONDecodeError as e:
+        sys.exit(f"{path}: not JSON (line {e.lineno}: {e.msg})")
+    except (KeyError, TypeError, ValueError, ZeroDivisionError):
+        sys.exit(f"{path}: expected sensor.bin_size_m (> 0), .self_reflection_range_m, .num_bins "
+                 "and .step_angle_deg as numbers")
+
+
 def report(directory, crossing=None, from_m=None, bins=None, lit=None):
+    far_half, step_rad = manifest_sensor(directory)
     with_angles = load_beams(directory, with_angles=True)
     beams = [(size, b) for _, size, b in with_angles]
     spreads = sweep_spreads(with_angles)
@@ -215,6 +277,10 @@ def report(directory, crossing=None, from_m=None, bins=None, lit=None):
               f"median {percentile(tails, 0.5):.0f}, p90 {percentile(tails, 0.9):.0f}, "
               f"p99 {percentile(tails, 0.99):.0f}, max {tails[-1]:.0f}; "
               f"{100 * sum(t >= 60 for t in tails) / len(tails):.1f}% of beams reach 60")
+    along, across, contrast = fine_texture(with_angles, far_half, step_rad)
+    print(f"  fine texture (bins {far_half}-, less each bin's mean over +-15 bins): along range "
+          + " / ".join(f"{c:.3f}" for c in along) + ", across head steps "
+          + " / ".join(f"{c:.3f}" for c in across) + f", contrast {contrast:.3f}")
     if crossing is not None:
         sides = side_crossings(with_angles, crossing, from_m)
         print(f"  first 5-bin mean at {crossing:g} or more from {from_m:g} m, median per side: " +

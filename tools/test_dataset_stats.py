@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
-"""ctest for dataset_stats.py: a dataset of known intensities gives the shares and tail it must,
-and a truncated beams file is refused, naming the file."""
+"""ctest for dataset_stats.py: a dataset of known intensities gives the shares, tail and fine
+texture it must, and a missing manifest or a truncated beams file is refused, naming the file."""
+import json
 import math
 import os
+import re
 import struct
 import subprocess
 import sys
@@ -14,6 +16,12 @@ BINS = 399
 
 
 def write_beams(path, beams, angles=None):
+    """Writes a beams file and, beside its beams/ folder, the manifest's sensor if none is there."""
+    manifest = os.path.join(os.path.dirname(os.path.dirname(path)), "manifest.json")
+    if not os.path.exists(manifest):
+        with open(manifest, "w") as f:
+            json.dump({"sensor": {"bin_size_m": BIN_M, "num_bins": BINS,
+                                  "self_reflection_range_m": 0.35, "step_angle_deg": 1.8}}, f)
     with open(path, "wb") as f:
         f.write(b"SBBEAMS1" + struct.pack("<I", len(beams)))
         for i, intensities in enumerate(beams):
@@ -140,6 +148,37 @@ def main():
         assert result.returncode != 0 and "expected 0 <= FIRST < LAST" in result.stderr, \
             result.stderr
 
+        # The fine texture: ten beams at consecutive head steps, beam b's bin k 100 + 10 (-1)^(k+b).
+        # Each bin less its mean over the 31 bins around it is ±(10 + 10/31) (the window's odd one
+        # out has the neighbours' sign), ±10 or so near the beam's end where the window is cut: along range the signs alternate (lag 1 and 3 near
+        # -1, lag 2 near +1; the per-lag normalisation, over n - m pairs, takes the magnitude a
+        # little past 1), from beam to beam too; the contrast is their rms over the mean 100.
+        # Bins from 213: the far half of those past 0.35 m (28 bins of 0.0125 m) in the manifest.
+        os.makedirs(os.path.join(tmp, "fine", "beams"))
+        write_beams(os.path.join(tmp, "fine", "beams", "sweep_0000.bin"),
+                    [[100 + 10 * (-1) ** (k + b) for k in range(BINS)] for b in range(10)],
+                    [b * math.radians(1.8) for b in range(10)])
+        result = run(os.path.join(tmp, "fine"))
+        assert result.returncode == 0, result.stderr
+        match = re.search(r"fine texture \(bins 213-, [^)]*\): along range (\S+) / (\S+) / (\S+), "
+                          r"across head steps (\S+) / (\S+) / (\S+), contrast (\S+)", result.stdout)
+        assert match, result.stdout
+        values = [float(v) for v in match.groups()]
+        for value, expected in zip(values[:6], [-1, 1, -1, -1, 1, -1]):
+            assert abs(value - expected) < 0.02, result.stdout
+        assert 0.1 < values[6] < 0.1033, result.stdout
+
+        # A dataset without its manifest, or whose manifest lacks the sensor, is refused.
+        os.remove(os.path.join(tmp, "fine", "manifest.json"))
+        result = run(os.path.join(tmp, "fine"))
+        assert result.returncode != 0 and "manifest.json: cannot read it" in result.stderr, \
+            result.stderr
+        with open(os.path.join(tmp, "fine", "manifest.json"), "w") as f:
+            json.dump({"sensor": {"bin_size_m": BIN_M}}, f)
+        result = run(os.path.join(tmp, "fine"))
+        assert result.returncode != 0 and "expected sensor.bin_size_m" in result.stderr, \
+            result.stderr
+
         os.makedirs(os.path.join(tmp, "bad", "beams"))
         path = os.path.join(tmp, "bad", "beams", "sweep_0000.bin")
         write_beams(path, [beam])
@@ -148,7 +187,8 @@ def main():
         result = run(os.path.join(tmp, "bad"))
         assert result.returncode != 0, "a truncated file was accepted"
         assert "sweep_0000.bin: beam 0 truncated" in result.stderr, result.stderr
-    print("dataset_stats.py: shares, spreads, tail and a truncated file as expected")
+    print("dataset_stats.py: shares, spreads, tail, fine texture, a missing manifest and a "
+          "truncated file as expected")
 
 
 if __name__ == "__main__":
