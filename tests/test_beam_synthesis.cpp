@@ -590,6 +590,98 @@ TEST(BeamSynthesis, MultipathOffAMirrorFloorLiesWithinItsMirrorPaths) {
   EXPECT_GT(past_direct, 0.0);
 }
 
+// A rough mirror's glint, g exp(-α²/2σ²) with α the angle between its mirror direction and the
+// way back to the sonar. A wall at normal incidence, the aperture narrowed to 0.3° × 3.5° so
+// that every ray meets it within 1.76° of the normal (α ≤ 3.51°): with σ = 20° each ray's glint
+// lies between g exp(-(3.51/20)²/2) = 0.9847 g and g, so the echo lies between 0.9847 and 1
+// times that of a plain reflector of reflectivity g and exponent 0 (the same rays, the same
+// weights). At 30° incidence, with σ = 2°, α ≥ 56.5° and the glint is nothing (e^-399).
+TEST(BeamSynthesis, GlintIsTheMirrorLobeTowardsTheSonar) {
+  SensorModel sensor = QuietSensor();
+  sensor.acoustics.aperture_scale_horizontal = 0.1;
+  sensor.acoustics.aperture_scale_vertical = 0.1;
+  Material plain;
+  plain.reflectivity = 0.2;
+  plain.backscatter_exponent = 0.0;
+  Material glint;
+  glint.reflectivity = 0.0;
+  glint.glint = 0.2;
+  const auto echo = [&](double incidence_rad, const Material& m) {
+    const std::vector<TriangleMesh> meshes = Wall(2.0, incidence_rad);
+    const RayTracer tracer(meshes);
+    return TotalPower(BeamSynthesizer(sensor, tracer, {m})
+                          .Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 4));
+  };
+  glint.specular_spread_rad = 20.0 * kDegToRad;
+  const double reference = echo(0.0, plain);
+  ASSERT_GT(reference, 0.0);
+  EXPECT_GE(echo(0.0, glint), 0.9847 * reference);
+  EXPECT_LE(echo(0.0, glint), reference * (1.0 + 1e-12));
+  glint.specular_spread_rad = 2.0 * kDegToRad;
+  const double oblique = echo(30.0 * kDegToRad, plain);
+  ASSERT_GT(oblique, 0.0);
+  EXPECT_LT(echo(30.0 * kDegToRad, glint), 1e-100 * oblique);
+}
+
+// A corner of two walls square to each other (a dihedral, its edge vertical, 2 m ahead, each
+// wall 45° off the beam) sends sound straight back: every ray leaves the second wall parallel to
+// the way it came, towards the sonar. With walls that only glint (no diffuse backscatter), the
+// direct echo is nothing (α = 90° at 45° incidence) and the corner is heard through its mirror
+// path alone: from its apex's range, 2 m (out and back the unfolded path is twice it), to that
+// of the rays farthest off the horizontal, 2 m / cos 1.75° in the narrowed fan, plus the pulse;
+// the glint there is of the order of g, where the walls' own (at 45°) is e^-162 g.
+TEST(BeamSynthesis, CornerSendsItsGlintStraightBack) {
+  SensorModel sensor = QuietSensor();
+  sensor.acoustics.aperture_scale_horizontal = 0.1;
+  sensor.acoustics.aperture_scale_vertical = 0.1;
+  std::vector<TriangleMesh> meshes;
+  for (const double turn : {45.0, -45.0}) {
+    MeshSpec wall;
+    wall.type = MeshSpec::Type::kPlane;
+    wall.size_m = {4.0, 4.0, 0.0};
+    // A plane through the apex (2, 0, 0), its normal 45° off -x, half of it behind the other.
+    const Eigen::Vector3d normal(-std::cos(turn * kDegToRad), -std::sin(turn * kDegToRad), 0.0);
+    const Eigen::Vector3d along = Eigen::Vector3d::UnitZ().cross(normal);
+    wall.T_world_mesh = Eigen::Isometry3d::Identity();
+    wall.T_world_mesh.linear().col(0) = along;
+    wall.T_world_mesh.linear().col(1) = Eigen::Vector3d::UnitZ();
+    wall.T_world_mesh.linear().col(2) = along.cross(Eigen::Vector3d::UnitZ());
+    wall.T_world_mesh.translation() =
+        Eigen::Vector3d(2.0, 0.0, 0.0) + 2.0 * along * (turn > 0 ? -1.0 : 1.0);
+    meshes.push_back(BuildMesh(wall, meshes.size()));
+  }
+  const RayTracer tracer(meshes);
+  Material corner;
+  corner.reflectivity = 0.0;
+  corner.specular = 1.0;
+  corner.specular_spread_rad = 5.0 * kDegToRad;
+  corner.glint = 0.2;
+  const auto ping = [&](int bounces) {
+    sensor.acoustics.max_bounces = bounces;
+    return BeamSynthesizer(sensor, tracer, {corner, corner})
+        .Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 6)
+        .echo_power;
+  };
+  const std::vector<double> direct = ping(0);
+  const std::vector<double> back = ping(1);
+  const double bin = sensor.geometry.bin_size_m;
+  const double pulse = sensor.acoustics.pulse_length_m;
+  const auto first = static_cast<std::size_t>(2.0 / bin);
+  const auto last = static_cast<std::size_t>((2.0 / std::cos(1.75 * kDegToRad) + pulse) / bin);
+  double inside = 0.0;
+  for (std::size_t k = 0; k < back.size(); ++k) {
+    EXPECT_LT(direct[k], 1e-30) << "bin " << k;
+    if (k < first || k > last) {
+      EXPECT_EQ(back[k], 0.0) << "bin " << k;
+    } else {
+      inside += back[k];
+    }
+  }
+  // Each ray's straight return brings 2 √pattern · p_rx · g e^-α²/2σ² with α ≤ 3.5° (at least
+  // 0.78 g per unit of pattern): of the order of g in all; without it the walls give e^-162 g.
+  EXPECT_GT(inside, 0.1 * corner.glint);
+}
+
 // A rough mirror tilts a reflected ray off the mirror direction m by atan(σ·|g|), g a standard
 // 2-D Gaussian offset across m, towards g's direction: tan(tilt) / σ is Rayleigh distributed,
 // P(≤ x) = 1 - exp(-x²/2), and the tilt's direction about m uniform. The offsets are tabled, 64

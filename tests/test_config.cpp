@@ -181,21 +181,33 @@ TEST(SceneFile, BadSonarAcousticsAreNamed) {
        "'sonar_acoustics.speckle_correlation_m'", "'-0.1'"}));
 }
 
-// A material's mirror roughness is read in degrees and kept in radians; out of range is named.
+// A material's mirror roughness is read in degrees and kept in radians, its glint as a
+// fraction (none in the tank: tried, not fitted); out of range, or a glint without the spread
+// it falls over, is named.
 TEST(SceneFile, SpecularSpreadIsReadInDegrees) {
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   ASSERT_FALSE(scene.materials.empty());
   EXPECT_NEAR(scene.materials.front().specular_spread_rad, 8.0 * mapping::kDegToRad, 1e-15);
-  test::TempDir dir;
-  const std::string path = (dir.path() / "bad.yaml").string();
-  std::ofstream(path) << "name: x\nsensor_model: "
-                      << test::SourcePath("sensor-models/shad-micron.yaml")
-                      << "\nsweeps: 1\nmaterials:\n"
-                      << "  - {name: rock, reflectivity: 0.5, specular_spread_deg: 45}\n"
-                      << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
-                      << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
-  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
-                                   {"bad.yaml:5:", "'materials[0].specular_spread_deg'", "'45'"}));
+  for (const sim::Material& m : scene.materials) EXPECT_EQ(m.glint, 0.0) << m.name;
+  const std::pair<std::string, std::vector<std::string>> cases[] = {
+      {"reflectivity: 0.5, specular_spread_deg: 45",
+       {"'materials[0].specular_spread_deg'", "'45'"}},
+      {"reflectivity: 0.5, specular_spread_deg: 4, glint: 1.5", {"'materials[0].glint'", "'1.5'"}},
+      {"reflectivity: 0.5, glint: 0.1",
+       {"'materials[0].glint'", "specular_spread_deg > 0", "got 0"}}};
+  for (const auto& [material, expected] : cases) {
+    test::TempDir dir;
+    const std::string path = (dir.path() / "bad.yaml").string();
+    std::ofstream(path)
+        << "name: x\nsensor_model: " << test::SourcePath("sensor-models/shad-micron.yaml")
+        << "\nsweeps: 1\nmaterials:\n"
+        << "  - {name: rock, " << material << "}\n"
+        << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
+        << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+    std::vector<std::string> parts = {"bad.yaml:5:"};
+    parts.insert(parts.end(), expected.begin(), expected.end());
+    EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, parts)) << material;
+  }
 }
 
 // The tank's reverberation, second trip, pulse skirts and level jitter are the scene's (the

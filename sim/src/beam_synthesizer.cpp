@@ -605,6 +605,15 @@ double CosPower(double c, double n) {
   return std::pow(c, n);
 }
 
+// A rough mirror's glint towards a receiver whose direction makes cos_alpha with the mirror
+// direction (Material::glint): g exp(-α²/2σ²); 0 without one.
+double Glint(const Material& m, double cos_alpha) {
+  if (m.glint <= 0.0) return 0.0;
+  const double alpha = std::acos(std::clamp(cos_alpha, -1.0, 1.0));
+  const double z = alpha / m.specular_spread_rad;
+  return m.glint * std::exp(-0.5 * z * z);
+}
+
 }  // namespace
 
 std::uint8_t BeamSynthesizer::Quantise(double level_db) const {
@@ -883,8 +892,10 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
     }
     const Material& material = s_.materials_by_mesh_[hit->mesh];
     const double cos_incidence = std::abs(hit->normal.dot(direction));
+    // Straight back: the mirror direction makes 2θ with it, cos 2θ = 2 cos²θ - 1.
     deposit(range, pattern * material.reflectivity *
-                       CosPower(cos_incidence, material.backscatter_exponent));
+                           CosPower(cos_incidence, material.backscatter_exponent) +
+                       pattern * Glint(material, 2.0 * cos_incidence * cos_incidence - 1.0));
     if (a_.max_bounces > 0 && material.specular > 0.0) {
       paths.push_back({.from = origin_,
                        .direction = direction,
@@ -973,8 +984,9 @@ void BeamSynthesizer::BeamJob::TraceMultipath() {
       const Material& m = s_.materials_by_mesh_[p.hit.mesh];
       const double cos_in = std::abs(p.hit.normal.dot(p.direction));
       if (p.path <= max_range) {
-        deposit(p.path, return_pattern(p) * p.specular * p.specular * m.reflectivity *
-                            CosPower(cos_in, m.backscatter_exponent));
+        const double way = return_pattern(p) * p.specular * p.specular;
+        deposit(p.path, way * m.reflectivity * CosPower(cos_in, m.backscatter_exponent) +
+                            way * Glint(m, 2.0 * cos_in * cos_in - 1.0));
       }
       const Eigen::Vector3f at = p.from + p.hit.distance * p.direction;
       const Eigen::Vector3d back = sonar - at.cast<double>();
@@ -982,12 +994,17 @@ void BeamSynthesizer::BeamJob::TraceMultipath() {
       const double range = 0.5 * (p.path + d);
       if (range > max_range || d < g_.bin_size_m) continue;
       const double receive = one_way_pattern(-back / d);
-      const double weight = 2.0 * std::sqrt(p.pattern) * receive * p.specular * m.reflectivity;
-      if (weight < kNegligibleWeight) continue;
+      // Culled on the largest its law can give: ρ for the diffuse part, g for the glint.
+      const double weight = 2.0 * std::sqrt(p.pattern) * receive * p.specular;
+      if (weight * std::max(m.reflectivity, m.glint) < kNegligibleWeight) continue;
       const Eigen::Vector3f to_sonar = (back / d).cast<float>();
       const double cos_out = std::abs(p.hit.normal.dot(to_sonar));
+      const Eigen::Vector3f mirror =
+          p.direction - 2.0f * p.direction.dot(p.hit.normal) * p.hit.normal;
       stream.push_back({at + 1e-4f * to_sonar, to_sonar, static_cast<float>(d) - 2e-4f});
-      returns.push_back({range, weight * CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) *
+      returns.push_back({range, (weight * m.reflectivity *
+                                     CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) +
+                                 weight * Glint(m, static_cast<double>(mirror.dot(to_sonar)))) *
                                     std::pow(range / d, spreading_db / 10.0)});
     }
     s_.tracer_.OccludedStream(stream, scratch_.occluded);

@@ -188,6 +188,10 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
       double spread_deg = 0.0;
       item.Optional("specular_spread_deg", spread_deg, InRange(0.0, 30.0));
       m.specular_spread_rad = spread_deg * kDegToRad;
+      item.Optional("glint", m.glint, InRange(0.0, 1.0));
+      if (m.glint > 0.0 && m.specular_spread_rad <= 0.0) {
+        item.Fail("glint", "specular_spread_deg > 0 (the lobe the glint falls over), got 0");
+      }
       item.RejectUnknownKeys();
       const auto same = std::find_if(scene.materials.begin(), scene.materials.end(),
                                      [&](const Material& b) { return b.name == m.name; });
