@@ -999,12 +999,16 @@ void BeamSynthesizer::BeamJob::TraceMultipath() {
       if (weight * std::max(m.reflectivity, m.glint) < kNegligibleWeight) continue;
       const Eigen::Vector3f to_sonar = (back / d).cast<float>();
       const double cos_out = std::abs(p.hit.normal.dot(to_sonar));
-      const Eigen::Vector3f mirror =
-          p.direction - 2.0f * p.direction.dot(p.hit.normal) * p.hit.normal;
+      double glint = 0.0;  // towards the sonar from the mirror direction, if m glints
+      if (m.glint > 0.0) {
+        const Eigen::Vector3f mirror =
+            p.direction - 2.0f * p.direction.dot(p.hit.normal) * p.hit.normal;
+        glint = Glint(m, static_cast<double>(mirror.dot(to_sonar)));
+      }
       stream.push_back({at + 1e-4f * to_sonar, to_sonar, static_cast<float>(d) - 2e-4f});
       returns.push_back({range, (weight * m.reflectivity *
                                      CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) +
-                                 weight * Glint(m, static_cast<double>(mirror.dot(to_sonar)))) *
+                                 weight * glint) *
                                     std::pow(range / d, spreading_db / 10.0)});
     }
     s_.tracer_.OccludedStream(stream, scratch_.occluded);
