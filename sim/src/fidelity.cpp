@@ -258,30 +258,52 @@ std::vector<std::optional<double>> WallPeaksByAngle(std::span<const mapping::Bea
   });
 }
 
-double SweepSpread(std::span<const mapping::Beam> beams, const mapping::SensorGeometry& sensor) {
-  const auto bins = static_cast<std::size_t>(sensor.num_bins);
-  const auto first = static_cast<std::size_t>(sensor.FirstUsableBin());
-  const auto cells = static_cast<std::size_t>(sensor.BeamsPerSweep()) * bins;
-  std::vector<double> n(cells, 0.0), sum(cells, 0.0), sum_sq(cells, 0.0);
+// Per head-angle step and bin of [first, end): the count, sum and sum of squares of the
+// intensity over the beams that hold the bin (cell c = step · width + bin - first).
+struct CellSums {
+  std::size_t width = 0;
+  std::vector<double> n, sum, sum_sq;
+
+  // The intensity's standard deviation over the sweeps, averaged over the cells seen twice or
+  // more (0 if none is).
+  [[nodiscard]] double MeanSpread() const {
+    double spread = 0.0;
+    double counted = 0.0;
+    for (std::size_t c = 0; c < n.size(); ++c) {
+      if (n[c] < 2.0) continue;
+      const double mean = sum[c] / n[c];
+      const double variance = std::max(0.0, (sum_sq[c] - n[c] * mean * mean) / (n[c] - 1.0));
+      spread += std::sqrt(variance);
+      counted += 1.0;
+    }
+    return counted > 0.0 ? spread / counted : 0.0;
+  }
+};
+
+CellSums SumCells(std::span<const mapping::Beam> beams, const mapping::SensorGeometry& sensor,
+                  std::size_t first, std::size_t end) {
+  CellSums out;
+  out.width = end > first ? end - first : 0;
+  const std::size_t cells = static_cast<std::size_t>(sensor.BeamsPerSweep()) * out.width;
+  out.n.assign(cells, 0.0);
+  out.sum.assign(cells, 0.0);
+  out.sum_sq.assign(cells, 0.0);
   for (const auto& beam : beams) {
-    const std::size_t row = StepIndex(beam, sensor) * bins;
-    for (std::size_t k = first; k < std::min(bins, beam.intensities.size()); ++k) {
+    const std::size_t row = StepIndex(beam, sensor) * out.width;
+    for (std::size_t k = first; k < std::min(end, beam.intensities.size()); ++k) {
       const double v = beam.intensities[k];
-      n[row + k] += 1.0;
-      sum[row + k] += v;
-      sum_sq[row + k] += v * v;
+      out.n[row + k - first] += 1.0;
+      out.sum[row + k - first] += v;
+      out.sum_sq[row + k - first] += v * v;
     }
   }
-  double spread = 0.0;
-  double counted = 0.0;
-  for (std::size_t c = 0; c < cells; ++c) {
-    if (n[c] < 2.0) continue;
-    const double mean = sum[c] / n[c];
-    const double variance = std::max(0.0, (sum_sq[c] - n[c] * mean * mean) / (n[c] - 1.0));
-    spread += std::sqrt(variance);
-    counted += 1.0;
-  }
-  return counted > 0.0 ? spread / counted : 0.0;
+  return out;
+}
+
+double SweepSpread(std::span<const mapping::Beam> beams, const mapping::SensorGeometry& sensor) {
+  return SumCells(beams, sensor, static_cast<std::size_t>(sensor.FirstUsableBin()),
+                  static_cast<std::size_t>(sensor.num_bins))
+      .MeanSpread();
 }
 
 // FidelityReport::Ringing over bins [first, last] (last < bins).
@@ -291,34 +313,15 @@ FidelityReport::Ringing RingingStats(std::span<const mapping::Beam> beams,
   FidelityReport::Ringing out;
   out.first_bin = first;
   out.last_bin = last;
-  const std::size_t width = last + 1 - first;
+  const CellSums cells = SumCells(beams, sensor, first, last + 1);
+  const std::size_t width = cells.width;
   const auto steps = static_cast<std::size_t>(sensor.BeamsPerSweep());
-  std::vector<double> n(steps * width, 0.0), sum(steps * width, 0.0), sum_sq(steps * width, 0.0);
-  double total = 0.0;
-  double count = 0.0;
-  for (const auto& beam : beams) {
-    if (beam.intensities.size() <= last) continue;
-    const std::size_t row = StepIndex(beam, sensor) * width;
-    for (std::size_t k = 0; k < width; ++k) {
-      const double v = beam.intensities[first + k];
-      n[row + k] += 1.0;
-      sum[row + k] += v;
-      sum_sq[row + k] += v * v;
-      total += v;
-      count += 1.0;
-    }
-  }
+  const std::vector<double>& n = cells.n;
+  const std::vector<double>& sum = cells.sum;
+  const double count = std::accumulate(n.begin(), n.end(), 0.0);
   if (count == 0.0) return out;
-  out.mean = total / count;
-  double spread = 0.0;
-  double cells = 0.0;
-  for (std::size_t c = 0; c < n.size(); ++c) {
-    if (n[c] < 2.0) continue;
-    const double mean = sum[c] / n[c];
-    spread += std::sqrt(std::max(0.0, (sum_sq[c] - n[c] * mean * mean) / (n[c] - 1.0)));
-    cells += 1.0;
-  }
-  out.ping_spread = cells > 0.0 ? spread / cells : 0.0;
+  out.mean = std::accumulate(sum.begin(), sum.end(), 0.0) / count;
+  out.ping_spread = cells.MeanSpread();
   // Per bin, the cells' means over the head steps seen twice or more, around the turn.
   double bins_counted = 0.0;
   for (std::size_t k = 0; k < width; ++k) {
