@@ -101,7 +101,7 @@ struct Acoustics {
   /// Mean self-reflection (vehicle body and transducer ringing) power per bin from bin 0, at the
   /// receiver output [dB]; bins past the end of the list get none. It is the sonar's own: not
   /// the place's, so no speckle multiplies it, but it varies by these (BeamSynthesizer::
-  /// SelfReflectionFactors), each bin's level by a normal draw in dB, averaged with the next
+  /// SelfReflection), each bin's level by a normal draw in dB, averaged with the next
   /// bin's (neighbouring bins' draws correlate by ½), its mean power kept:
   ///  - `self_reflection_ping_spread_db` [dB, standard deviation]: from ping to ping, in the
   ///    bins whose centre lies within `self_reflection_ringing_range_m` [m] (the transducer's
