@@ -3,7 +3,7 @@
 simulated run with a real log bin by bin where `sonarbench fidelity` gives only summaries.
 
     python3 tools/dataset_stats.py DIR [DIR ...] [--crossing T --from R] [--bins FIRST LAST]
-                                   [--lit FIRST LAST]
+                                   [--lit FIRST LAST] [--arc HEAD_DEG BIN]
 
 DIR is what `sonarbench simulate SCENE --out DIR` or `sonarbench import LOG.mat --out DIR`
 wrote. For each, per range band: the mean intensity, the share of bins at 0 and at 150 or
@@ -31,7 +31,12 @@ floor's or a water surface's, where the fan's edge meets it) begins: the first b
 up to LAST, at which the share of beams at 0 falls to half or less, interpolated linearly from
 the bin before (so 122.5 is halfway between bins 122 and 123), over all beams and per octant of
 head angle ([0°, 45°), [45°, 90°), ...): a level sonar's ring begins at one range all round, a
-tilted one's earlier on one side and later on the other. Standard library only.
+tilted one's earlier on one side and later on the other. With --arc HEAD_DEG BIN, how a point
+echo at bin BIN (a tank's corner) is heard across head angles: for the head steps within ±12 of
+HEAD_DEG (the manifest's step), each beam's largest intensity within 2 bins of BIN, averaged
+over the beams at that head angle: a beam hears the point at its own range wherever its pattern
+reaches it, so the arc's width is the pattern's, not the beam's nominal width. Standard library
+only.
 """
 import argparse
 import glob
@@ -185,6 +190,24 @@ def lit_rows(with_angles, first, last):
     return rows
 
 
+def arc_row(with_angles, head_deg, bin_index, step_rad, steps=12, reach=2):
+    """[(offset [deg], mean or None)] for the head steps -steps..steps around head_deg: over the
+    beams within half a step of that head angle, the mean of each one's largest intensity within
+    `reach` bins of bin_index (bins past a beam's end left out)."""
+    step_deg = math.degrees(step_rad)
+    rows = []
+    for offset in range(-steps, steps + 1):
+        centre = head_deg + offset * step_deg
+        peaks = []
+        for angle, _, b in with_angles:
+            off = (math.degrees(angle) - centre + 180.0) % 360.0 - 180.0
+            window = b[max(0, bin_index - reach):bin_index + reach + 1]
+            if abs(off) < 0.5 * step_deg and window:
+                peaks.append(max(window))
+        rows.append((offset * step_deg, sum(peaks) / len(peaks) if peaks else None))
+    return rows
+
+
 def fine_texture(with_angles, first, step_rad, reach=15, lags=3):
     """([correlation along range at 1..lags bins], [across 1..lags head steps], contrast) of the
     beams' bins from `first` on, each less its beam's mean over the bins within `reach` of it."""
@@ -240,7 +263,7 @@ def manifest_sensor(directory):
                  "and .step_angle_deg as numbers")
 
 
-def report(directory, crossing=None, from_m=None, bins=None, lit=None):
+def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None):
     far_half, step_rad = manifest_sensor(directory)
     with_angles = load_beams(directory, with_angles=True)
     beams = [(size, b) for _, size, b in with_angles]
@@ -295,6 +318,12 @@ def report(directory, crossing=None, from_m=None, bins=None, lit=None):
         print(f"  half the beams lit from bin (searched {lit[0]}-{lit[1]}): " +
               ", ".join(f"{name}{'' if name == 'all' else '°'} " +
                         (f"{k:.2f}" if k is not None else "none") for name, k in rows))
+    if arc is not None:
+        rows = arc_row(with_angles, arc[0], int(arc[1]), step_rad)
+        print(f"  arc at bin {int(arc[1])} around {arc[0]:g}° (head offset [deg]: mean of the "
+              "largest within 2 bins): " +
+              ", ".join(f"{off:+.1f} " + (f"{m:.0f}" if m is not None else "none")
+                        for off, m in rows))
 
 
 if __name__ == "__main__":
@@ -310,6 +339,8 @@ if __name__ == "__main__":
     parser.add_argument("--lit", type=int, nargs=2, metavar=("FIRST", "LAST"),
                         help="also report where half the beams are lit, from FIRST to LAST, "
                              "over all beams and per octant of head angle")
+    parser.add_argument("--arc", type=float, nargs=2, metavar=("HEAD_DEG", "BIN"),
+                        help="also report bin BIN across the head steps within 12 of HEAD_DEG")
     args = parser.parse_args()
     if (args.crossing is None) != (args.from_m is None):
         parser.error("--crossing and --from go together")
@@ -317,5 +348,7 @@ if __name__ == "__main__":
         parser.error(f"--bins {args.bins[0]} {args.bins[1]}: expected 0 <= FIRST <= LAST")
     if args.lit is not None and not 0 <= args.lit[0] < args.lit[1]:
         parser.error(f"--lit {args.lit[0]} {args.lit[1]}: expected 0 <= FIRST < LAST")
+    if args.arc is not None and (args.arc[1] < 0 or args.arc[1] != int(args.arc[1])):
+        parser.error(f"--arc {args.arc[0]:g} {args.arc[1]:g}: expected BIN a whole number >= 0")
     for d in args.directories:
-        report(d, args.crossing, args.from_m, args.bins, args.lit)
+        report(d, args.crossing, args.from_m, args.bins, args.lit, args.arc)

@@ -148,6 +148,32 @@ def main():
         assert result.returncode != 0 and "expected 0 <= FIRST < LAST" in result.stderr, \
             result.stderr
 
+        # A point echo's arc: beams at head steps 0-10 (1.8° apart), two sweeps; a point at bin
+        # 150 heard at 200 by the beams within two steps of 9° (step 5), the second sweep's at bin
+        # 152 (within the 2 bins searched) and at 100: their means 150. Steps 0-2 and 8-10 hear
+        # nothing there (0; their bins 140 and 160 at 255 lie outside the 2 bins searched), and
+        # there are no beams before step 0 or past step 10 (offsets past ±9°: none).
+        os.makedirs(os.path.join(tmp, "arc", "beams"))
+
+        def point_beam(step, sweep):
+            b = [0] * BINS
+            b[140] = b[160] = 255
+            if abs(step - 5) <= 2:
+                b[150 + 2 * sweep] = 200 if sweep == 0 else 100
+            return b
+        arc_beams = [point_beam(k, s) for s in (0, 1) for k in range(11)]
+        arc_angles = [math.radians(1.8 * k) for s in (0, 1) for k in range(11)]
+        write_beams(os.path.join(tmp, "arc", "beams", "sweep_0000.bin"), arc_beams, arc_angles)
+        result = run(os.path.join(tmp, "arc"), "--arc", "9", "150")
+        assert result.returncode == 0, result.stderr
+        assert "arc at bin 150 around 9° (head offset [deg]: mean of the largest within 2 bins): " \
+            "-21.6 none, " in result.stdout, result.stdout
+        assert "-10.8 none, -9.0 0, -7.2 0, -5.4 0, -3.6 150, -1.8 150, +0.0 150, +1.8 150, " \
+            "+3.6 150, +5.4 0, +7.2 0, +9.0 0, +10.8 none, " in result.stdout, result.stdout
+        result = run(os.path.join(tmp, "arc"), "--arc", "9", "150.5")
+        assert result.returncode != 0 and "expected BIN a whole number" in result.stderr, \
+            result.stderr
+
         # The fine texture: ten beams at consecutive head steps, beam b's bin k 100 + 10 (-1)^(k+b).
         # Each bin less its mean over the 31 bins around it is ±(10 + 10/31) (the window's odd one
         # out has the neighbours' sign), ±10 or so near the beam's end where the window is cut: along range the signs alternate (lag 1 and 3 near
@@ -187,7 +213,7 @@ def main():
         result = run(os.path.join(tmp, "bad"))
         assert result.returncode != 0, "a truncated file was accepted"
         assert "sweep_0000.bin: beam 0 truncated" in result.stderr, result.stderr
-    print("dataset_stats.py: shares, spreads, tail, fine texture, a missing manifest and a "
+    print("dataset_stats.py: shares, spreads, tail, arc, fine texture, a missing manifest and a "
           "truncated file as expected")
 
 
