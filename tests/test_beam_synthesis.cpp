@@ -202,6 +202,134 @@ TEST(BeamSynthesis, WallAtKnownRangeEchoesInItsBin) {
 // plane filling the aperture is ρ·(Σ b d̂)·n̂: turning the plane by φ about the beam's vertical
 // scales it by cos φ, up to the horizontal component of Σ b d̂ (zero for the symmetric pattern;
 // under 1% for the jittered rays, which the same seed keeps identical between the two pings).
+// A plane part of the vehicle, `ahead` metres in front of the sonar along the vehicle's x,
+// facing it (vehicle frame), `size` wide (y) and tall (z), its centre `up` metres above the sonar.
+MeshSpec PartAhead(const SensorModel& sensor, double ahead, double size, double up) {
+  MeshSpec part;
+  part.type = MeshSpec::Type::kPlane;
+  part.size_m = {size, size, 0.0};
+  part.T_world_mesh = Eigen::Translation3d(sensor.geometry.T_vehicle_sonar.translation() +
+                                           Eigen::Vector3d(ahead, 0.0, up)) *
+                      Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitY());
+  return part;
+}
+
+Material Diffuse() {
+  Material m;
+  m.reflectivity = 0.5;
+  m.backscatter_exponent = 1.0;
+  return m;
+}
+
+// A vehicle part 1 m ahead of a sonar mounted 0.2 m forward and 0.1 m up on the vehicle: heard
+// at 1 m (its first bin floor(1 m / bin), as a wall's) by the beam looking at it, the same
+// wherever the vehicle is and however it is turned (the rays are the same in the sonar's frame;
+// their turn into the vehicle's is in floats: 1e-4 of the power), by none looking away; and it
+// is not the scene, so the beam's truth holds no hit (the scene's one wall lies out of range).
+TEST(BeamSynthesis, VehiclePartEchoesAtItsRangeWhereverTheVehicleIs) {
+  SensorModel sensor = QuietSensor();
+  sensor.geometry.T_vehicle_sonar = mapping::PoseFromXyzRpy({0.2, 0.0, 0.1}, {0, 0, 0});
+  const std::vector<TriangleMesh> scene = Wall(50.0, 0.0);
+  const RayTracer tracer(scene);
+  VehicleParts vehicle{.meshes = {BuildMesh(PartAhead(sensor, 1.0, 20.0, 0.0), 0)},
+                       .materials = {Diffuse()}};
+  const BeamSynthesizer synthesizer(sensor, tracer, {Diffuse()}, 0, vehicle);
+  const double bin = sensor.geometry.bin_size_m;
+  std::optional<double> still_power;
+  for (const Eigen::Isometry3d& T_world_vehicle :
+       {Eigen::Isometry3d(Eigen::Isometry3d::Identity()),
+        mapping::PoseFromXyzRpy({3.0, -2.0, 1.0}, {0.1, -0.2, 70.0 * kDegToRad})}) {
+    const Eigen::Isometry3d T_world_sonar = T_world_vehicle * sensor.geometry.T_vehicle_sonar;
+    const SynthesizedBeam beam = synthesizer.Synthesize(0.0, 0.0, T_world_sonar, 11);
+    const auto first = std::find_if(beam.echo_power.begin(), beam.echo_power.end(),
+                                    [](double p) { return p > 0.0; });
+    ASSERT_NE(first, beam.echo_power.end());
+    EXPECT_EQ(first - beam.echo_power.begin(), static_cast<long>(std::floor(1.0 / bin)));
+    EXPECT_FALSE(beam.truth.first_hit_range_m.has_value());
+    if (!still_power) {
+      still_power = TotalPower(beam);
+    } else {
+      EXPECT_NEAR(TotalPower(beam), *still_power, 1e-4 * *still_power);
+    }
+    const SynthesizedBeam away = synthesizer.Synthesize(0.0, std::numbers::pi, T_world_sonar, 11);
+    EXPECT_EQ(TotalPower(away), 0.0);
+  }
+}
+
+// A part 1 m ahead covering the fan's upper half (from the sonar's height up) in front of a
+// wall at 2 m: the rays above the axis end on the part, those below reach the wall. The wall's
+// echo keeps the lower half of the beam's pattern: the vertical strata lie mirrored about the
+// axis, each ray jittered within its 0.22° stratum, so the halves' weights differ by far under
+// 10%; the part echoes at 1 m; and the truth is the wall's, at 2 m within a bin.
+TEST(BeamSynthesis, VehiclePartShadowsTheSceneBehindIt) {
+  const SensorModel sensor = QuietSensor();
+  const std::vector<TriangleMesh> scene = Wall(2.0, 0.0);
+  const RayTracer tracer(scene);
+  const BeamSynthesizer bare(sensor, tracer, {Diffuse()});
+  VehicleParts vehicle{.meshes = {BuildMesh(PartAhead(sensor, 1.0, 20.0, 10.0), 0)},
+                       .materials = {Diffuse()}};
+  const BeamSynthesizer shadowed(sensor, tracer, {Diffuse()}, 0, vehicle);
+  const SynthesizedBeam without = bare.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 11);
+  const SynthesizedBeam with = shadowed.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 11);
+  const double bin = sensor.geometry.bin_size_m;
+  const auto power_from = [&](const SynthesizedBeam& beam, double from_m, double to_m) {
+    double sum = 0.0;
+    for (std::size_t k = 0; k < beam.echo_power.size(); ++k) {
+      if (k * bin >= from_m && k * bin < to_m) sum += beam.echo_power[k];
+    }
+    return sum;
+  };
+  const double wall_without = power_from(without, 1.5, 5.0);
+  ASSERT_GT(wall_without, 0.0);
+  EXPECT_NEAR(power_from(with, 1.5, 5.0) / wall_without, 0.5, 0.05);
+  EXPECT_EQ(power_from(without, 0.0, 1.5), 0.0);
+  EXPECT_GT(power_from(with, 1.0 - bin, 1.5), 0.0);
+  EXPECT_EQ(power_from(with, 0.0, 1.0 - bin), 0.0);
+  ASSERT_TRUE(with.truth.first_hit_range_m.has_value());
+  EXPECT_NEAR(*with.truth.first_hit_range_m, 2.0, bin);
+  EXPECT_EQ(with.truth.first_hit_mesh, 0u);
+}
+
+// The tank's answers to its echoes (skirts around each pulse, the second trip, the
+// reverberation tail) are not the vehicle's: a part 1 m ahead echoes the same bins, bit for bit,
+// with them on as off, while the same plane as the scene's wall gains skirts before 1 m and a
+// tail and second trip after its pulse.
+TEST(BeamSynthesis, VehicleEchoesHaveNoSkirtsSecondTripOrReverberation) {
+  const SensorModel quiet = QuietSensor();
+  SensorModel tank = quiet;
+  tank.acoustics.pulse_skirt_length_m = 0.05;
+  tank.acoustics.pulse_skirt_db = 3.0;
+  tank.acoustics.second_trip_db = 0.0;
+  tank.acoustics.reverberation_length_m = 0.5;
+  tank.acoustics.reverberation_db = -3.0;
+  const MeshSpec plane = PartAhead(quiet, 1.0, 20.0, 0.0);
+  const std::vector<TriangleMesh> far = Wall(50.0, 0.0);
+  const RayTracer far_tracer(far);
+  const VehicleParts vehicle{.meshes = {BuildMesh(plane, 0)}, .materials = {Diffuse()}};
+  const auto part_echo = [&](const SensorModel& sensor) {
+    return BeamSynthesizer(sensor, far_tracer, {Diffuse()}, 0, vehicle)
+        .Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 11)
+        .echo_power;
+  };
+  const std::vector<double> plain = part_echo(quiet);
+  ASSERT_GT(std::accumulate(plain.begin(), plain.end(), 0.0), 0.0);
+  EXPECT_EQ(part_echo(tank), plain);
+
+  const std::vector<TriangleMesh> wall = {BuildMesh(plane, 0)};
+  const RayTracer wall_tracer(wall);
+  const std::vector<double> walled = BeamSynthesizer(tank, wall_tracer, {Diffuse()})
+                                         .Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 11)
+                                         .echo_power;
+  const double bin = quiet.geometry.bin_size_m;
+  const auto first = static_cast<std::size_t>(std::floor(1.0 / bin));
+  const auto after = static_cast<std::size_t>(std::ceil((1.0 + 0.1) / bin));
+  EXPECT_EQ(plain[first - 1], 0.0);
+  EXPECT_GT(walled[first - 1], 0.0);
+  EXPECT_EQ(plain[after], 0.0);
+  EXPECT_GT(walled[after], 0.0);
+  EXPECT_GT(walled[2 * first + 2], 0.0);  // the second trip, at twice the range
+}
+
 TEST(BeamSynthesis, EchoFollowsLambertsLawWithIncidence) {
   const SensorModel sensor = QuietSensor();
   const double normal = TotalPower(Ping(sensor, Wall(2.0, 0.0)));

@@ -148,13 +148,25 @@ TEST(SceneFile, SonarAcousticsOverrideTheModelsKeysItNames) {
   const sim::SensorModel model =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
-  EXPECT_EQ(scene.sensor.acoustics.gain_db, 5.0);
+  EXPECT_EQ(scene.sensor.acoustics.gain_db, 5.5);
   EXPECT_EQ(scene.sensor.acoustics.max_bounces, 8);
   EXPECT_EQ(scene.sensor.acoustics.speckle_correlation_m, 0.05);
   EXPECT_EQ(model.acoustics.speckle_correlation_m, 0.0);
   EXPECT_NE(model.acoustics.gain_db, 5.0);
   EXPECT_EQ(scene.sensor.acoustics.rays_vertical, model.acoustics.rays_vertical);
-  EXPECT_EQ(scene.sensor.acoustics.self_reflection_db, model.acoustics.self_reflection_db);
+  // The tank keeps the model's ringing (bins 0-27) and replaces its tail by its vehicle's parts
+  // and a weaker tail all round.
+  const std::vector<double>& own = scene.sensor.acoustics.self_reflection_db;
+  const std::vector<double>& models = model.acoustics.self_reflection_db;
+  ASSERT_EQ(own.size(), models.size());
+  for (std::size_t k = 0; k < own.size(); ++k) {
+    if (k < 28) {
+      EXPECT_EQ(own[k], models[k]) << k;
+    } else {
+      EXPECT_LT(own[k], models[k]) << k;
+    }
+  }
+  EXPECT_FALSE(scene.vehicle.empty());
   // The water surface is traced but not scored.
   bool surface_found = false;
   for (const sim::MeshSpec& mesh : scene.meshes) {
@@ -182,13 +194,20 @@ TEST(SceneFile, BadSonarAcousticsAreNamed) {
 }
 
 // A material's mirror roughness is read in degrees and kept in radians, its glint as a
-// fraction (none in the tank: tried, not fitted); out of range, or a glint without the spread
-// it falls over, is named.
+// fraction (none on the tank's walls: tried, not fitted; the vehicle's nose glints); out of
+// range, or a glint without the spread it falls over, is named.
 TEST(SceneFile, SpecularSpreadIsReadInDegrees) {
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   ASSERT_FALSE(scene.materials.empty());
   EXPECT_NEAR(scene.materials.front().specular_spread_rad, 8.0 * mapping::kDegToRad, 1e-15);
-  for (const sim::Material& m : scene.materials) EXPECT_EQ(m.glint, 0.0) << m.name;
+  for (const sim::Material& m : scene.materials) {
+    if (m.name == "vehicle_nose") {
+      EXPECT_EQ(m.glint, 0.05);
+      EXPECT_NEAR(m.specular_spread_rad, 3.0 * mapping::kDegToRad, 1e-15);
+    } else {
+      EXPECT_EQ(m.glint, 0.0) << m.name;
+    }
+  }
   const std::pair<std::string, std::vector<std::string>> cases[] = {
       {"reflectivity: 0.5, specular_spread_deg: 45",
        {"'materials[0].specular_spread_deg'", "'45'"}},
@@ -341,6 +360,10 @@ TEST(SceneFile, TankScenesShareTheFittedTank) {
     const sim::Scene scene = sim::LoadScene(test::SourcePath(name));
     EXPECT_EQ(scene.sensor.acoustics, tank.sensor.acoustics);
     EXPECT_EQ(scene.mapping.detection, tank.mapping.detection);
+    ASSERT_EQ(scene.vehicle.size(), tank.vehicle.size());
+    for (std::size_t i = 0; i < tank.vehicle.size(); ++i) {
+      EXPECT_EQ(scene.vehicle[i].name, tank.vehicle[i].name);
+    }
     for (const sim::Material& material : tank.materials) {
       const auto same = std::ranges::find(scene.materials, material.name, &sim::Material::name);
       ASSERT_NE(same, scene.materials.end()) << material.name;
@@ -483,6 +506,59 @@ TEST(SceneFile, ExtendsRefusesWhatItCannotMean) {
   const std::string on_broken = write("on_broken.yaml", "name: x\nextends: broken.yaml\n");
   EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(on_broken); },
                                    {"broken.yaml:3:", "'sweeps'"}));
+}
+
+// The vehicle's parts are meshes in the vehicle's frame, with their own names and diffuse
+// materials, never truth; a derived scene adds to the base's.
+TEST(SceneFile, VehiclePartsAreReadAndRefusedWithReasons) {
+  test::TempDir dir;
+  const std::string model = test::SourcePath("sensor-models/shad-micron.yaml");
+  const std::string head = "name: x\nsensor_model: " + model +
+                           "\nsweeps: 1\nmaterials:\n  - {name: hull, reflectivity: 0.3}\n"
+                           "  - {name: glass, reflectivity: 0.1, specular: 0.5}\n"
+                           "meshes: [{name: bed, type: plane, size_m: [9, 9, 0], material: hull}]\n"
+                           "trajectory: {type: static, position_m: [0, 0, 1]}\n";
+  const std::string good =
+      WriteText(dir, "good.yaml",
+                head +
+                    "vehicle:\n  - {name: skid, type: box, size_m: [0.4, 0.1, 0.1], "
+                    "position_m: [0.5, 0.2, -0.1], material: hull}\n");
+  const sim::Scene scene = sim::LoadScene(good);
+  ASSERT_EQ(scene.vehicle.size(), 1u);
+  EXPECT_EQ(scene.vehicle[0].name, "skid");
+  EXPECT_FALSE(scene.vehicle[0].truth);
+  EXPECT_EQ(scene.vehicle[0].material, 0u);
+  EXPECT_NEAR(scene.vehicle[0].T_world_mesh.translation().x(), 0.5, 1e-12);
+  EXPECT_EQ(scene.meshes.size(), 1u);
+  const std::string derived =
+      WriteText(dir, "derived.yaml",
+                "name: y\nextends: good.yaml\nvehicle:\n  - {name: fin, type: plane, "
+                "size_m: [0.1, 0.1, 0], material: hull}\n");
+  EXPECT_EQ(sim::LoadScene(derived).vehicle.size(), 2u);
+
+  // A part from a mesh file: the dataset's configuration hash covers the file's bytes.
+  const std::string obj = WriteText(dir, "fin.obj", "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n");
+  const std::string with_file =
+      WriteText(dir, "with_file.yaml",
+                head + "vehicle:\n  - {name: fin, type: file, file: fin.obj, material: hull}\n");
+  const std::string hash = sim::SceneConfigHash(sim::LoadScene(with_file), 1);
+  WriteText(dir, "fin.obj", "v 0 0 0\nv 0.2 0 0\nv 0 0.1 0\nf 1 2 3\n");
+  EXPECT_NE(sim::SceneConfigHash(sim::LoadScene(with_file), 1), hash);
+
+  const auto refused = [&](const std::string& name, const std::string& part,
+                           const std::vector<std::string>& parts) {
+    const std::string path = WriteText(dir, name, head + "vehicle:\n  - " + part + "\n");
+    return ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, parts);
+  };
+  EXPECT_TRUE(refused("mirror.yaml", "{name: p, type: plane, size_m: [1, 1, 0], material: glass}",
+                      {"mirror.yaml:10:", "'vehicle[0].material'", "specular 0", "'glass'"}));
+  EXPECT_TRUE(refused("truth.yaml",
+                      "{name: p, type: plane, size_m: [1, 1, 0], material: hull, truth: true}",
+                      {"truth.yaml:10:", "'vehicle[0].truth'", "never ground truth"}));
+  EXPECT_TRUE(refused("clash.yaml", "{name: bed, type: plane, size_m: [1, 1, 0], material: hull}",
+                      {"clash.yaml:10:", "'vehicle[0].name'", "not used before", "'bed'"}));
+  EXPECT_TRUE(refused("mud.yaml", "{name: p, type: plane, size_m: [1, 1, 0], material: mud}",
+                      {"mud.yaml:10:", "'vehicle[0].material'", "'mud'"}));
 }
 
 TEST(SceneFile, MissingFileIsAnInputError) {

@@ -500,6 +500,8 @@ struct RealTank {
   static constexpr double kFineContrast = 0.299;
   static constexpr double kSweepSpread = 2.265;
   static constexpr double kWallPeakMedian = 157.0;
+  static constexpr double kNearRangeMean = 16.46;  // bins 28-63: the vehicle's echoes
+  static constexpr double kNearRangeAngleSpread = 23.46;
   // Mean intensity over the bins whose centres lie in [0.4, 1.5), [1.5, 2), [2, 2.5), [2.5, 3),
   // [3, 4) and [4, 4.5) m (the far range past 4.5 m, 59.5, is a ring the model lacks).
   static constexpr std::array<std::array<double, 3>, 6> kBands = {{{0.4, 1.5, 7.21},
@@ -526,12 +528,14 @@ double BandMean(const std::vector<double>& profile, double bin_size_m, double fr
 // The fidelity guard: the tank scene, simulated as the main job does (its seed, 27 sweeps), stays
 // near the real log's recorded statistics. Seeds 1-5 gave: the self-reflection's mean 95.5-97.6,
 // its spreads 6.19-6.22 from ping to ping and 9.41-10.18 across head angles; the fine texture's
-// range correlation 0.59-0.61 and contrast 0.337-0.346; the sweep-to-sweep spread 2.11-2.13; the
-// walls' median strongest echo 147-149; the bands within 5.8 of the real ones, 1.6-2.3 on average.
-// Each bound sits outside that spread and inside what a lost piece of the model gives (README,
+// range correlation 0.589-0.603 and contrast 0.338-0.349; the sweep-to-sweep spread 2.14-2.15;
+// the walls' median strongest echo 146-149; the bands within 5.7 of the real ones, 2.2-2.8 on
+// average; the near range's mean 15.4-16.0 and spread across head angles 15.1-15.9. Each bound
+// sits outside that spread and inside what a lost piece of the model gives (README,
 // "Fidelity"): the self-reflection under the speckle (mean 120, ping spread 1.2), one look of
 // speckle (0.70 and contrast 0.51), no receiver jitter (spread 1.6), no skirts (median 167), the
-// gain 2 dB off (every band ≈ 13 units).
+// gain 2 dB off (every band ≈ 13 units), no vehicle parts (the near range's mean 6.4 without
+// them and their tail all round; 8.3 across head angles with the model's mean tail instead).
 TEST(Fidelity, SimulatedTankStaysNearTheRealLogsRecordedStatistics) {
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   const auto meshes = sim::BuildSceneMeshes(scene);
@@ -551,6 +555,8 @@ TEST(Fidelity, SimulatedTankStaysNearTheRealLogsRecordedStatistics) {
   EXPECT_LT(r.sim_local_contrast, RealTank::kFineContrast + 0.1);
   EXPECT_NEAR(r.sim_sweep_spread / RealTank::kSweepSpread, 1.0, 0.2);
   EXPECT_NEAR(r.sim_wall_peak[1], RealTank::kWallPeakMedian, 15.0);
+  EXPECT_NEAR(r.sim_near_range.mean, RealTank::kNearRangeMean, 5.0);
+  EXPECT_GT(r.sim_near_range.angle_spread, 0.5 * RealTank::kNearRangeAngleSpread);
   double total = 0.0;
   for (const auto& [from, to, real] : RealTank::kBands) {
     const double simulated = BandMean(r.sim_mean, g.bin_size_m, from, to);
@@ -575,6 +581,10 @@ TEST(Fidelity, RecordedRealLogStatisticsAreTheLogs) {
   EXPECT_NEAR(r.real_local_contrast, RealTank::kFineContrast, 0.0005);
   EXPECT_NEAR(r.real_sweep_spread, RealTank::kSweepSpread, 0.0005);
   EXPECT_EQ(r.real_wall_peak[1], RealTank::kWallPeakMedian);
+  EXPECT_EQ(r.real_near_range.first_bin, 28u);
+  EXPECT_EQ(r.real_near_range.last_bin, 63u);
+  EXPECT_NEAR(r.real_near_range.mean, RealTank::kNearRangeMean, 0.005);
+  EXPECT_NEAR(r.real_near_range.angle_spread, RealTank::kNearRangeAngleSpread, 0.005);
   for (const auto& [from, to, real] : RealTank::kBands) {
     EXPECT_NEAR(BandMean(r.real_mean, g.bin_size_m, from, to), real, 0.005) << from << " m";
   }

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include "sonarbench/mapping/atomic_file.hpp"
@@ -164,6 +165,21 @@ struct FidelityArgs {
   double wall_min_range_m = 1.6;
 };
 
+// One line of `sonarbench fidelity`'s summary: FidelityReport::HeadAngleCells of both runs.
+std::string HeadAngleLine(const std::string& what,
+                          const sonarbench::sim::FidelityReport::HeadAngleCells& simulated,
+                          const sonarbench::sim::FidelityReport::HeadAngleCells& real) {
+  std::ostringstream line;
+  line << what << " (bins " << real.first_bin << "-" << real.last_bin << "): mean sim "
+       << simulated.mean << ", real " << real.mean << "; ping to ping sim " << simulated.ping_spread
+       << ", real " << real.ping_spread << "; across head angles sim " << simulated.angle_spread
+       << ", real " << real.angle_spread << ", correlated at 1/"
+       << sonarbench::sim::FidelityReport::kRingingFarStep << " head steps sim "
+       << simulated.angle_correlation[0] << "/" << simulated.angle_correlation[1] << ", real "
+       << real.angle_correlation[0] << "/" << real.angle_correlation[1] << "\n";
+  return line.str();
+}
+
 int Fidelity(const FidelityArgs& args) {
   namespace sim = sonarbench::sim;
   const sim::Scene scene = sim::LoadScene(args.scene);
@@ -227,17 +243,8 @@ int Fidelity(const FidelityArgs& args) {
             << report.sim_local_contrast << ", real " << report.real_local_contrast << "\n"
             << "sweep-to-sweep spread per head angle and bin: sim " << report.sim_sweep_spread
             << ", real " << report.real_sweep_spread << "\n"
-            << "self-reflection (bins " << report.real_ringing.first_bin << "-"
-            << report.real_ringing.last_bin << "): mean sim " << report.sim_ringing.mean
-            << ", real " << report.real_ringing.mean << "; ping to ping sim "
-            << report.sim_ringing.ping_spread << ", real " << report.real_ringing.ping_spread
-            << "; across head angles sim " << report.sim_ringing.angle_spread << ", real "
-            << report.real_ringing.angle_spread << ", correlated at 1/"
-            << sim::FidelityReport::kRingingFarStep << " head steps sim "
-            << report.sim_ringing.angle_correlation[0] << "/"
-            << report.sim_ringing.angle_correlation[1] << ", real "
-            << report.real_ringing.angle_correlation[0] << "/"
-            << report.real_ringing.angle_correlation[1] << "\n"
+            << HeadAngleLine("self-reflection", report.sim_ringing, report.real_ringing)
+            << HeadAngleLine("near range past it", report.sim_near_range, report.real_near_range)
             << "wrote " << args.out << "/fidelity.json\n";
   return 0;
 }

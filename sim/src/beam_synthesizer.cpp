@@ -6,8 +6,11 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "sonarbench/sim/pulse_spreader.hpp"
@@ -31,14 +34,26 @@ std::vector<double> ExponentialKernel(double steps, int max_reach) {
 }  // namespace
 
 BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tracer,
-                                 std::vector<Material> materials_by_mesh, std::uint64_t run_seed)
+                                 std::vector<Material> materials_by_mesh, std::uint64_t run_seed,
+                                 const VehicleParts& vehicle)
     : sensor_(sensor),
       tracer_(tracer),
       materials_by_mesh_(std::move(materials_by_mesh)),
+      vehicle_first_mesh_(static_cast<std::uint32_t>(materials_by_mesh_.size())),
       place_seed_(DeriveSeed(run_seed, 0x706c616365ULL)),
       rough_mirrors_(std::ranges::any_of(materials_by_mesh_, [](const Material& m) {
         return m.specular > 0.0 && m.specular_spread_rad > 0.0;
       })) {
+  if (vehicle.meshes.size() != vehicle.materials.size()) {
+    throw std::invalid_argument("BeamSynthesizer: " + std::to_string(vehicle.meshes.size()) +
+                                " vehicle meshes but " + std::to_string(vehicle.materials.size()) +
+                                " materials");
+  }
+  if (!vehicle.meshes.empty()) {
+    vehicle_tracer_ = std::make_shared<const RayTracer>(vehicle.meshes);
+    materials_by_mesh_.insert(materials_by_mesh_.end(), vehicle.materials.begin(),
+                              vehicle.materials.end());
+  }
   // A bin's speckle is the coherent sum of the scatterers its range response covers: the pulse
   // and, with skirts, one e-folding of each; or the range a scene sets.
   const Acoustics& acoustics = sensor_.acoustics;
@@ -751,6 +766,8 @@ struct OneWayPattern {
 // output.
 struct BeamSynthesizer::Scratch {
   std::vector<Eigen::Vector3f> directions;
+  std::vector<Eigen::Vector3f> vehicle_directions;  // the same in the vehicle's frame
+  std::vector<std::optional<Hit>> vehicle_hits;
   std::vector<double> patterns;
   std::vector<std::optional<Hit>> hits;
   std::vector<MirrorPath> paths;
@@ -759,7 +776,9 @@ struct BeamSynthesizer::Scratch {
   std::vector<StraightReturn> returns;
   std::vector<bool> occluded;
   PulseSpreader spreader;
+  PulseSpreader vehicle_spreader;  // the vehicle's echoes, apart from the scene's (FormLevels)
   std::vector<double> echo_power;
+  std::vector<double> vehicle_power;
   std::vector<double> impulse_power;  // the second trip's: each echo over one bin
   std::vector<double> speckle;
   std::vector<double> powers;
@@ -788,8 +807,9 @@ class BeamSynthesizer::BeamJob {
             T_world_sonar.linear() *
             Eigen::AngleAxisd(head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix()),
         origin_(T_world_sonar.translation().cast<float>()) {
-    PulseSpreader& spreader = scratch_.spreader;
-    if (spreader.Bins() != bins_) spreader.Reset(bins_);  // AddTo() leaves it empty
+    for (PulseSpreader* spreader : {&scratch_.spreader, &scratch_.vehicle_spreader}) {
+      if (spreader->Bins() != bins_) spreader->Reset(bins_);  // AddTo() leaves it empty
+    }
     if (s_.second_trip_ > 0.0) scratch_.impulse_power.assign(bins_, 0.0);
     scratch_.echo_power.assign(bins_, 0.0);
   }
@@ -802,6 +822,9 @@ class BeamSynthesizer::BeamJob {
   // The aperture's rays and their first hits, traced as one coherent bundle: each hit's echo,
   // and the mirror paths that go on from it.
   void TracePrimaries();
+  // The vehicle's parts along the primaries (TracePrimaries' hits in `scratch_.hits`): a ray
+  // that meets one before the scene ends there, its hit the part's (normal in the world frame).
+  void MeetVehicle();
   // The mirror paths, one bounce at a time (see above the definition).
   void TraceMultipath();
   // The echo's bins, its skirts, second trip, speckle, reverberation, self-reflection and
@@ -816,6 +839,11 @@ class BeamSynthesizer::BeamJob {
             s_.second_trip_ > 0.0,
             scratch_.spreader,
             scratch_.impulse_power};
+  }
+  // The vehicle's echoes: the pulse alone, no second trip (FormLevels adds them after the
+  // scene's skirts, second trip and reverberation).
+  EchoDeposit VehicleDeposit() {
+    return {s_, g_, a_.pulse_length_m, false, scratch_.vehicle_spreader, scratch_.impulse_power};
   }
 
   const BeamSynthesizer& s_;
@@ -868,6 +896,32 @@ void BeamSynthesizer::BeamJob::SeedPlace() {
   }
 }
 
+void BeamSynthesizer::BeamJob::MeetVehicle() {
+  // The vehicle's frame: T_world_sonar = T_world_vehicle · T_vehicle_sonar.
+  const Eigen::Isometry3d& T_vehicle_sonar = g_.T_vehicle_sonar;
+  const Eigen::Matrix3f R_vehicle_world =
+      (T_vehicle_sonar.linear() * T_world_sonar_.linear().transpose()).cast<float>();
+  const std::vector<Eigen::Vector3f>& directions = scratch_.directions;
+  std::vector<Eigen::Vector3f>& in_vehicle = scratch_.vehicle_directions;
+  in_vehicle.resize(directions.size());
+  for (std::size_t r = 0; r < directions.size(); ++r) {
+    in_vehicle[r] = R_vehicle_world * directions[r];
+  }
+  std::vector<std::optional<Hit>>& parts = scratch_.vehicle_hits;
+  parts.resize(directions.size());
+  s_.vehicle_tracer_->IntersectBundle(T_vehicle_sonar.translation().cast<float>(), in_vehicle,
+                                      static_cast<float>(max_range_), parts);
+  out_.traced_rays += directions.size();
+  std::vector<std::optional<Hit>>& hits = scratch_.hits;
+  for (std::size_t r = 0; r < directions.size(); ++r) {
+    const std::optional<Hit>& part = parts[r];
+    if (!part || (hits[r] && hits[r]->distance <= part->distance)) continue;
+    hits[r] = Hit{.distance = part->distance,
+                  .normal = R_vehicle_world.transpose() * part->normal,
+                  .mesh = s_.vehicle_first_mesh_ + part->mesh};
+  }
+}
+
 void BeamSynthesizer::BeamJob::TracePrimaries() {
   const auto rays = static_cast<std::size_t>(a_.rays_horizontal) * a_.rays_vertical;
   std::vector<Eigen::Vector3f>& directions = scratch_.directions;
@@ -877,26 +931,30 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
   hits.resize(rays);
   s_.tracer_.IntersectBundle(origin_, directions, static_cast<float>(max_range_), hits);
   out_.traced_rays += rays;
+  if (s_.vehicle_tracer_) MeetVehicle();
   std::vector<MirrorPath>& paths = scratch_.paths;
   paths.clear();
   EchoDeposit deposit = Deposit();
+  EchoDeposit vehicle_deposit = VehicleDeposit();
   for (std::size_t r = 0; r < rays; ++r) {
     const auto& hit = hits[r];
     if (!hit) continue;
     const Eigen::Vector3f& direction = directions[r];
     const double pattern = patterns[r];
     const double range = std::max<double>(hit->distance, g_.bin_size_m);
-    if (!out_.truth.first_hit_range_m || range < *out_.truth.first_hit_range_m) {
+    const bool on_vehicle = hit->mesh >= s_.vehicle_first_mesh_;
+    if (!on_vehicle && (!out_.truth.first_hit_range_m || range < *out_.truth.first_hit_range_m)) {
       out_.truth.first_hit_range_m = range;
       out_.truth.first_hit_mesh = hit->mesh;
     }
     const Material& material = s_.materials_by_mesh_[hit->mesh];
     const double cos_incidence = std::abs(hit->normal.dot(direction));
     // Straight back: the mirror direction makes 2θ with it, cos 2θ = 2 cos²θ - 1.
-    deposit(range, pattern * material.reflectivity *
-                           CosPower(cos_incidence, material.backscatter_exponent) +
-                       pattern * Glint(material, 2.0 * cos_incidence * cos_incidence - 1.0));
-    if (a_.max_bounces > 0 && material.specular > 0.0) {
+    (on_vehicle ? vehicle_deposit : deposit)(
+        range,
+        pattern * material.reflectivity * CosPower(cos_incidence, material.backscatter_exponent) +
+            pattern * Glint(material, 2.0 * cos_incidence * cos_incidence - 1.0));
+    if (a_.max_bounces > 0 && material.specular > 0.0 && !on_vehicle) {
       paths.push_back({.from = origin_,
                        .direction = direction,
                        .hit = *hit,
@@ -1049,6 +1107,15 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
     }
   }
   s_.AddReverberation(echo);
+  if (s_.vehicle_tracer_) {
+    // The vehicle's echoes are heard as they are: the real log's show no skirts, second trip or
+    // reverberation (behind the SHAD's own echo at 0.3 m its beams at head angle 0° are silent
+    // from 0.55 m to the floor at 1.45 m), so those are the tank's answers to its own echoes.
+    std::vector<double>& vehicle = scratch_.vehicle_power;
+    vehicle.assign(bins_, 0.0);
+    scratch_.vehicle_spreader.AddTo(vehicle);
+    for (std::size_t k = 0; k < bins_; ++k) echo[k] += vehicle[k] / weight_sum_;
+  }
   // The powers first, then their levels: no 8-bit store inside the loop that draws the noise.
   // The self-reflection is the sonar's own, not the place's: added after the speckle.
   std::vector<double>& self_reflection = scratch_.self_reflection;

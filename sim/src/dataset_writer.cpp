@@ -206,6 +206,14 @@ std::string SceneConfigHash(const Scene& scene, std::uint64_t seed) {
     meshes.push_back(mesh.file.empty() ? json(nullptr) : json(mapping::Sha256OfFile(mesh.file)));
   }
   inputs["mesh_files_sha256"] = meshes;
+  // The vehicle's part files too (a scene without parts hashes as it always did).
+  if (!scene.vehicle.empty()) {
+    json parts = json::array();
+    for (const MeshSpec& part : scene.vehicle) {
+      parts.push_back(part.file.empty() ? json(nullptr) : json(mapping::Sha256OfFile(part.file)));
+    }
+    inputs["vehicle_files_sha256"] = parts;
+  }
   // The scenes it extends are part of it (a scene that extends none hashes as it always did).
   if (!scene.extends.empty()) {
     json bases = json::array();

@@ -306,11 +306,11 @@ double SweepSpread(std::span<const mapping::Beam> beams, const mapping::SensorGe
       .MeanSpread();
 }
 
-// FidelityReport::Ringing over bins [first, last] (last < bins).
-FidelityReport::Ringing RingingStats(std::span<const mapping::Beam> beams,
-                                     const mapping::SensorGeometry& sensor, std::size_t first,
-                                     std::size_t last) {
-  FidelityReport::Ringing out;
+// FidelityReport::HeadAngleCells over bins [first, last] (last < bins).
+FidelityReport::HeadAngleCells HeadAngleStats(std::span<const mapping::Beam> beams,
+                                              const mapping::SensorGeometry& sensor,
+                                              std::size_t first, std::size_t last) {
+  FidelityReport::HeadAngleCells out;
   out.first_bin = first;
   out.last_bin = last;
   const CellSums cells = SumCells(beams, sensor, first, last + 1);
@@ -368,11 +368,11 @@ FidelityReport::Ringing RingingStats(std::span<const mapping::Beam> beams,
   return out;
 }
 
-nlohmann::json RingingJson(const FidelityReport::Ringing& ringing) {
-  return {{"mean", ringing.mean},
-          {"ping_spread", ringing.ping_spread},
-          {"angle_spread", ringing.angle_spread},
-          {"angle_correlation_1_and_5_steps", ringing.angle_correlation}};
+nlohmann::json HeadAngleJson(const FidelityReport::HeadAngleCells& cells) {
+  return {{"mean", cells.mean},
+          {"ping_spread", cells.ping_spread},
+          {"angle_spread", cells.angle_spread},
+          {"angle_correlation_1_and_5_steps", cells.angle_correlation}};
 }
 
 std::array<double, 256> Histogram(std::span<const mapping::Beam> beams, std::size_t first) {
@@ -560,9 +560,18 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
       std::size_t high = own.size() - 1;
       while (high > low && own[high] < half) --high;
       if (low < own.size() && half > 0.0) {
-        r.sim_ringing = RingingStats(sim, sensor, low, high);
-        r.real_ringing = RingingStats(real, sensor, low, high);
+        r.sim_ringing = HeadAngleStats(sim, sensor, low, high);
+        r.real_ringing = HeadAngleStats(real, sensor, low, high);
       }
+    }
+  }
+  {
+    const auto near_end = static_cast<std::size_t>(
+        std::min<double>(static_cast<double>(bins),
+                         std::floor(FidelityReport::kNearRangeM / sensor.bin_size_m + 0.5)));
+    if (near_end > usable) {
+      r.sim_near_range = HeadAngleStats(sim, sensor, usable, near_end - 1);
+      r.real_near_range = HeadAngleStats(real, sensor, usable, near_end - 1);
     }
   }
   r.sim_histogram = Histogram(sim, first);
@@ -670,8 +679,12 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"local_contrast_real", r.real_local_contrast},
                  {"self_reflection",
                   {{"bins", {r.real_ringing.first_bin, r.real_ringing.last_bin}},
-                   {"sim", RingingJson(r.sim_ringing)},
-                   {"real", RingingJson(r.real_ringing)}}},
+                   {"sim", HeadAngleJson(r.sim_ringing)},
+                   {"real", HeadAngleJson(r.real_ringing)}}},
+                 {"near_range",
+                  {{"bins", {r.real_near_range.first_bin, r.real_near_range.last_bin}},
+                   {"sim", HeadAngleJson(r.sim_near_range)},
+                   {"real", HeadAngleJson(r.real_near_range)}}},
                  {"sweep_spread_sim", r.sim_sweep_spread},
                  {"sweep_spread_real", r.real_sweep_spread},
                  {"outputs",

@@ -137,11 +137,16 @@ MeshCheck CheckMesh(TriangleMesh& mesh, const std::string& where) {
   return check;
 }
 
-std::vector<TriangleMesh> BuildSceneMeshes(const Scene& scene) {
+namespace {
+
+// BuildSceneMeshes of `specs` (the scene's meshes or its vehicle's parts), their seeds from
+// `seed_base` on.
+std::vector<TriangleMesh> BuildMeshes(const Scene& scene, const std::vector<MeshSpec>& specs,
+                                      std::uint64_t seed_base) {
   std::vector<TriangleMesh> meshes;
-  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
-    const MeshSpec& spec = scene.meshes[i];
-    meshes.push_back(BuildMesh(spec, DeriveSeed(scene.seed, 0x6d657368ULL + i)));
+  for (std::size_t i = 0; i < specs.size(); ++i) {
+    const MeshSpec& spec = specs[i];
+    meshes.push_back(BuildMesh(spec, DeriveSeed(scene.seed, seed_base + i)));
     meshes.back().name = spec.name;
     const std::string where = scene.file + ": mesh '" + spec.name + "'" +
                               (spec.file.empty() ? std::string() : " (" + spec.file + ")");
@@ -157,6 +162,16 @@ std::vector<TriangleMesh> BuildSceneMeshes(const Scene& scene) {
     }
   }
   return meshes;
+}
+
+}  // namespace
+
+std::vector<TriangleMesh> BuildSceneMeshes(const Scene& scene) {
+  return BuildMeshes(scene, scene.meshes, 0x6d657368ULL);  // "mesh"
+}
+
+std::vector<TriangleMesh> BuildVehicleMeshes(const Scene& scene) {
+  return BuildMeshes(scene, scene.vehicle, 0x76656869636c65ULL);  // "vehicle"
 }
 
 }  // namespace sonarbench::sim

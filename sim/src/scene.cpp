@@ -202,16 +202,42 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
       }
     }
   }
-  // Meshes are added to the base's; their names must be new.
+  // Meshes and vehicle parts are added to the base's; their names must be new in both lists.
   const std::size_t base_meshes = scene.meshes.size();
+  const std::size_t base_vehicle = scene.vehicle.size();
+  const auto name_used = [&](const std::string& name) {
+    const auto same = [&](const MeshSpec& m) { return m.name == name; };
+    return std::ranges::any_of(scene.meshes, same) || std::ranges::any_of(scene.vehicle, same);
+  };
   if (!base || root.Has("meshes")) {
     for (YamlReader& item : root.Sequence("meshes")) {
       MeshSpec mesh = ReadMesh(item, scene.materials);
-      if (std::any_of(scene.meshes.begin(), scene.meshes.end(),
-                      [&](const MeshSpec& m) { return m.name == mesh.name; })) {
+      if (name_used(mesh.name)) {
         item.Fail("name", "a mesh name not used before in the scene, got '" + mesh.name + "'");
       }
       scene.meshes.push_back(std::move(mesh));
+    }
+  }
+  if (root.Has("vehicle")) {
+    for (YamlReader& item : root.Sequence("vehicle")) {
+      for (const char* key : {"truth", "fill"}) {
+        if (item.Has(key)) {
+          item.Fail(key, std::string("no '") + key + "' key: a vehicle part is never ground truth");
+        }
+      }
+      MeshSpec part = ReadMesh(item, scene.materials);
+      part.truth = false;
+      if (name_used(part.name)) {
+        item.Fail("name", "a mesh name not used before in the scene, got '" + part.name + "'");
+      }
+      if (part.material < scene.materials.size() && scene.materials[part.material].specular > 0.0) {
+        item.Fail("material",
+                  "a material with specular 0 (the multipath is not traced off the "
+                  "vehicle), got '" +
+                      scene.materials[part.material].name + "' with " +
+                      std::to_string(scene.materials[part.material].specular));
+      }
+      scene.vehicle.push_back(std::move(part));
     }
   }
   if (!base || root.Has("trajectory")) {
@@ -259,18 +285,22 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
 
   // Mesh files and the sensor model are their own files, read (and their errors reported) only
   // once the scene is sound; a base's were read with it.
-  for (std::size_t i = base_meshes; i < scene.meshes.size(); ++i) {
-    MeshSpec& mesh = scene.meshes[i];
-    if (mesh.type != MeshSpec::Type::kFile) continue;
-    mesh.file = resolve(mesh.file);
-    try {
-      MeshFileData data = LoadMeshFile(mesh.file);
-      mesh.file_vertices = std::move(data.vertices);
-      mesh.file_triangles = std::move(data.triangles);
-    } catch (const InputError& e) {
-      throw InputError(path + ": mesh '" + mesh.name + "': " + e.what());
+  const auto load_files = [&](std::vector<MeshSpec>& meshes, std::size_t first) {
+    for (std::size_t i = first; i < meshes.size(); ++i) {
+      MeshSpec& mesh = meshes[i];
+      if (mesh.type != MeshSpec::Type::kFile) continue;
+      mesh.file = resolve(mesh.file);
+      try {
+        MeshFileData data = LoadMeshFile(mesh.file);
+        mesh.file_vertices = std::move(data.vertices);
+        mesh.file_triangles = std::move(data.triangles);
+      } catch (const InputError& e) {
+        throw InputError(path + ": mesh '" + mesh.name + "': " + e.what());
+      }
     }
-  }
+  };
+  load_files(scene.meshes, base_meshes);
+  load_files(scene.vehicle, base_vehicle);
   if (!base) {
     scene.sensor_model_file = resolve(scene.sensor_model_file);
     scene.sensor = LoadSensorModel(scene.sensor_model_file);

@@ -49,7 +49,10 @@ BeamSynthesizer SceneSynthesizer(const Scene& scene, const RayTracer& tracer, st
   std::vector<Material> materials_by_mesh;
   for (const MeshSpec& mesh : scene.meshes)
     materials_by_mesh.push_back(scene.materials[mesh.material]);
-  return BeamSynthesizer(scene.sensor, tracer, std::move(materials_by_mesh), seed);
+  VehicleParts vehicle{.meshes = BuildVehicleMeshes(scene), .materials = {}};
+  for (const MeshSpec& part : scene.vehicle)
+    vehicle.materials.push_back(scene.materials[part.material]);
+  return BeamSynthesizer(scene.sensor, tracer, std::move(materials_by_mesh), seed, vehicle);
 }
 
 std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const BeamSynthesizer& synthesizer,

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -16,10 +17,11 @@ namespace sonarbench::sim {
 
 /// What the simulator knows about one beam that the sonar does not report.
 struct BeamTruth {
-  /// Nearest surface any of the beam's rays hit [m], and the mesh it belongs to.
+  /// Nearest surface any of the beam's rays hit [m], and the mesh it belongs to: the scene's
+  /// surfaces only, never the vehicle's parts (a ray a part stops hits nothing behind it).
   std::optional<double> first_hit_range_m;
   std::uint32_t first_hit_mesh = 0;
-  /// The first hit along the beam axis, if within range.
+  /// The scene's first hit along the beam axis, if within range (the vehicle's parts ignored).
   std::optional<double> axis_hit_range_m;
   /// The sonar's true pose, from which the beam was rendered.
   Eigen::Isometry3d T_world_sonar = Eigen::Isometry3d::Identity();
@@ -65,11 +67,25 @@ enum class EchoPower { kKeep, kDrop };
 /// first trip does) and feeds a reverberation tail heard after it (AddReverberation), all
 /// before speckle.
 ///
+/// Parts of the vehicle the sonar hears (Scene::vehicle): its meshes in the vehicle's body
+/// frame, where the sonar sits at the sensor's T_vehicle_sonar, and each one's material
+/// (diffuse: specular 0).
+struct VehicleParts {
+  std::vector<TriangleMesh> meshes;
+  std::vector<Material> materials;
+};
+
 /// Thread-safe: Synthesize() is const and draws only from a generator seeded by its argument.
 class BeamSynthesizer {
  public:
+  /// With `vehicle` parts, each primary ray is traced against them too (their own BVH, in the
+  /// vehicle's frame, so one build serves every pose): a ray that meets a part before the
+  /// scene echoes off the part, diffusely, and goes no further. Their echoes are not ground
+  /// truth (BeamTruth counts the scene's surfaces only, where the rays reach them) and start
+  /// no mirror paths; the multipath's rays pass the vehicle by.
   BeamSynthesizer(const SensorModel& sensor, const RayTracer& tracer,
-                  std::vector<Material> materials_by_mesh, std::uint64_t run_seed = 0);
+                  std::vector<Material> materials_by_mesh, std::uint64_t run_seed = 0,
+                  const VehicleParts& vehicle = {});
 
   /// One beam at head angle `head_angle_rad` from a sonar at `T_world_sonar`. `seed` drives its
   /// background noise and, unless the acoustics' speckle_correlation_m is set (then the run seed
@@ -239,7 +255,12 @@ class BeamSynthesizer {
   };
   SensorModel sensor_;
   const RayTracer& tracer_;
+  /// The scene's meshes' materials, then the vehicle parts' (from vehicle_first_mesh_ on).
   std::vector<Material> materials_by_mesh_;
+  /// The vehicle parts' BVH, in the vehicle's frame (null without parts); a hit on part i is
+  /// mesh vehicle_first_mesh_ + i.
+  std::shared_ptr<const RayTracer> vehicle_tracer_;
+  std::uint32_t vehicle_first_mesh_ = 0;
   /// Seeds the echoes' randomness per place when the acoustics' speckle_correlation_m is set.
   std::uint64_t place_seed_ = 0;
   /// Whether any material is a rough mirror: only then do mirror paths track their image (the

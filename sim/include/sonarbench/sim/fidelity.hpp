@@ -128,7 +128,7 @@ struct FidelityReport {
   /// the cells' means over head steps, averaged over the bins (how much it changes with head
   /// angle, sweep after sweep alike); `angle_correlation`: per bin, the correlation of the cells'
   /// means 1 and kRingingFarStep head steps apart (around the turn), averaged over the bins.
-  struct Ringing {
+  struct HeadAngleCells {
     std::size_t first_bin = 0;
     std::size_t last_bin = 0;
     double mean = 0.0;
@@ -136,9 +136,15 @@ struct FidelityReport {
     double angle_spread = 0.0;
     std::array<double, 2> angle_correlation{};
   };
-  Ringing sim_ringing;
-  Ringing real_ringing;
+  HeadAngleCells sim_ringing;
+  HeadAngleCells real_ringing;
   static constexpr int kRingingFarStep = 5;
+  /// The same over the near range past the self-reflection: the first usable bin to the last
+  /// whose centre lies within kNearRangeM, where a vehicle's own parts echo (by head angle, still
+  /// from ping to ping: a large `angle_spread` and a small `ping_spread`).
+  HeadAngleCells sim_near_range;
+  HeadAngleCells real_near_range;
+  static constexpr double kNearRangeM = 0.8;
   /// Intensity histograms (fractions of all usable bins), and their intersection Σ min(p, q):
   /// 1 for identical distributions, 0 for disjoint ones.
   std::array<double, 256> sim_histogram{};

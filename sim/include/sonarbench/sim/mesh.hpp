@@ -46,4 +46,8 @@ MeshCheck CheckMesh(TriangleMesh& mesh, const std::string& where);
 /// checked by CheckMesh.
 [[nodiscard]] std::vector<TriangleMesh> BuildSceneMeshes(const Scene& scene);
 
+/// Builds the scene's vehicle parts (Scene::vehicle) as BuildSceneMeshes does, in the vehicle's
+/// body frame.
+[[nodiscard]] std::vector<TriangleMesh> BuildVehicleMeshes(const Scene& scene);
+
 }  // namespace sonarbench::sim

@@ -113,6 +113,11 @@ struct Scene {
   SensorModel sensor;
   std::vector<Material> materials;
   std::vector<MeshSpec> meshes;
+  /// Parts of the vehicle the sonar hears (`vehicle:`, meshes as under `meshes`), posed in the
+  /// vehicle's body frame (the trajectory's; the sonar sits in it at `sonar_mounting`): they move
+  /// with the vehicle, echo and shadow the primary rays that reach them, and are never ground
+  /// truth. Their materials are diffuse (specular 0): the multipath is not traced off them.
+  std::vector<MeshSpec> vehicle;
   Trajectory trajectory;
   /// The navigation error on the poses the mapper gets (none by default).
   NavigationError navigation;
@@ -134,7 +139,7 @@ struct Scene {
 /// - `name` is required; `sensor_model` is refused (the base's model, as it set it); `seed`,
 ///   `sweeps` and `start_head_angle_deg` replace the base's;
 /// - `materials`: one named as a base material replaces it, a new name is added;
-/// - `meshes`: added to the base's (a name the base uses is an error);
+/// - `meshes` and `vehicle`: added to the base's (a name either list uses is an error);
 /// - `trajectory` and `sonar_mounting` replace the base's whole;
 /// - `navigation`, `sonar_acoustics` and `mapping` (with its `detection`): key by key over
 ///   the base's;

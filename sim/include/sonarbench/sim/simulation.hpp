@@ -39,8 +39,9 @@ struct ScheduledBeam {
     const std::function<void(std::size_t done, std::size_t total)>& on_sweep = {});
 
 /// The synthesizer of a scene's run: its sensor, its meshes' materials (mesh i's at i, as
-/// BuildSceneMeshes orders them) and the run seed. Build it once per run: it tables the range
-/// loss, the AD steps and the jitter slots.
+/// BuildSceneMeshes orders them), its vehicle's parts (BuildVehicleMeshes) and the run seed.
+/// Build it once per run: it tables the range loss, the AD steps and the jitter slots, and
+/// builds the vehicle's BVH.
 [[nodiscard]] BeamSynthesizer SceneSynthesizer(const Scene& scene, const RayTracer& tracer,
                                                std::uint64_t seed);
 
