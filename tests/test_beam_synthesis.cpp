@@ -202,14 +202,14 @@ TEST(BeamSynthesis, WallAtKnownRangeEchoesInItsBin) {
 // plane filling the aperture is ρ·(Σ b d̂)·n̂: turning the plane by φ about the beam's vertical
 // scales it by cos φ, up to the horizontal component of Σ b d̂ (zero for the symmetric pattern;
 // under 1% for the jittered rays, which the same seed keeps identical between the two pings).
-// A plane part of the vehicle, `ahead` metres in front of the sonar along the vehicle's x,
-// facing it (vehicle frame), `size` wide (y) and tall (z), its centre `up` metres above the sonar.
+// A plane part of the vehicle, `ahead` metres in front of the sonar along its head-angle-0 axis
+// and facing it, posed in the vehicle's frame through the sonar's mounting: `size` wide and
+// tall, its centre `up` metres above the sonar's axis.
 MeshSpec PartAhead(const SensorModel& sensor, double ahead, double size, double up) {
   MeshSpec part;
   part.type = MeshSpec::Type::kPlane;
   part.size_m = {size, size, 0.0};
-  part.T_world_mesh = Eigen::Translation3d(sensor.geometry.T_vehicle_sonar.translation() +
-                                           Eigen::Vector3d(ahead, 0.0, up)) *
+  part.T_world_mesh = sensor.geometry.T_vehicle_sonar * Eigen::Translation3d(ahead, 0.0, up) *
                       Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitY());
   return part;
 }
@@ -221,14 +221,16 @@ Material Diffuse() {
   return m;
 }
 
-// A vehicle part 1 m ahead of a sonar mounted 0.2 m forward and 0.1 m up on the vehicle: heard
-// at 1 m (its first bin floor(1 m / bin), as a wall's) by the beam looking at it, the same
-// wherever the vehicle is and however it is turned (the rays are the same in the sonar's frame;
-// their turn into the vehicle's is in floats: 1e-4 of the power), by none looking away; and it
-// is not the scene, so the beam's truth holds no hit (the scene's one wall lies out of range).
+// A vehicle part 1 m ahead of a sonar mounted 0.2 m forward and 0.1 m up on the vehicle, turned
+// 90° so that its head angle 0 looks along the vehicle's y: heard at 1 m (its first bin
+// floor(1 m / bin), as a wall's) by the beam looking at it, the same wherever the vehicle is and
+// however it is turned (the rays are the same in the sonar's frame; their turn into the
+// vehicle's is in floats: 1e-4 of the power), by none looking away; and it is not the scene, so
+// the beam's truth holds no hit (the scene's one wall lies out of range).
 TEST(BeamSynthesis, VehiclePartEchoesAtItsRangeWhereverTheVehicleIs) {
   SensorModel sensor = QuietSensor();
-  sensor.geometry.T_vehicle_sonar = mapping::PoseFromXyzRpy({0.2, 0.0, 0.1}, {0, 0, 0});
+  sensor.geometry.T_vehicle_sonar =
+      mapping::PoseFromXyzRpy({0.2, 0.0, 0.1}, {0, 0, 90.0 * kDegToRad});
   const std::vector<TriangleMesh> scene = Wall(50.0, 0.0);
   const RayTracer tracer(scene);
   VehicleParts vehicle{.meshes = {BuildMesh(PartAhead(sensor, 1.0, 20.0, 0.0), 0)},
