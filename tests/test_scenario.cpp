@@ -186,6 +186,12 @@ TEST_F(TankScenario, OutputsAreWrittenWithTheReportLast) {
                    result_->metrics.occupied_precision);
   EXPECT_TRUE(report["timing"].contains("map_s"));
   EXPECT_EQ(report["parameters"]["mapping"]["rays_vertical"], 64);
+  // Every mesh's preflight, the vehicle's parts marked as such.
+  std::size_t parts = 0;
+  for (const auto& mesh : report["meshes"]) parts += mesh["vehicle_part"].get<bool>() ? 1 : 0;
+  EXPECT_EQ(report["meshes"].size(), scene_->meshes.size() + scene_->vehicle.size());
+  EXPECT_EQ(parts, scene_->vehicle.size());
+  EXPECT_GT(parts, 0u);
   // The map file is a real OctoMap.
   octomap::OcTree reread(0.1);
   ASSERT_TRUE(reread.readBinary((dir.path() / "map.bt").string()));
@@ -378,13 +384,19 @@ TEST(Cli, BadSceneExitsTwoNamingTheKeyAndWritesOnlyAnErrorJunit) {
 TEST(Cli, BadMeshFilesExitTwoNamingSceneMeshAndFile) {
   test::TempDir dir;
   std::ofstream(dir.path() / "nan.obj") << "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n";
-  auto scene_with = [&](const std::string& file) {
+  // The file as a mesh of the scene's, or as a part of the vehicle's beside a plane bed.
+  auto scene_with = [&](const std::string& file, bool as_vehicle_part = false) {
     const auto scene = dir.path() / "scene.yaml";
+    const std::string from_file = std::string("{name: ") + (as_vehicle_part ? "fin" : "rock") +
+                                  ", type: file, file: " + file + ", material: a}";
     std::ofstream(scene) << "name: x\nsensor_model: "
                          << test::SourcePath("sensor-models/shad-micron.yaml")
                          << "\nsweeps: 1\nmaterials: [{name: a, reflectivity: 0.5}]\n"
-                         << "meshes: [{name: rock, type: file, file: " << file
-                         << ", material: a}]\n"
+                         << (as_vehicle_part
+                                 ? "meshes: [{name: bed, type: plane, size_m: [4, 4, 0], "
+                                   "material: a}]\nvehicle: ["
+                                 : "meshes: [")
+                         << from_file << "]\n"
                          << "trajectory: {type: static, position_m: [0, 0, 1]}\n";
     return scene.string();
   };
@@ -401,6 +413,14 @@ TEST(Cli, BadMeshFilesExitTwoNamingSceneMeshAndFile) {
   EXPECT_NE(output.find("scene.yaml: mesh 'rock': " + (dir.path() / "missing.stl").string() +
                         ": no such mesh file"),
             std::string::npos)
+      << output;
+  // A vehicle's part from a bad file is refused the same way.
+  EXPECT_EQ(RunCli("run " + scene_with("nan.obj", true) + " --out " + (dir.path() / "v").string(),
+                   &output),
+            2);
+  EXPECT_NE(
+      output.find("mesh 'fin' (" + (dir.path() / "nan.obj").string() + "): vertex 2 is not finite"),
+      std::string::npos)
       << output;
 }
 

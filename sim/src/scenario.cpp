@@ -36,6 +36,8 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   for (const TriangleMesh& mesh : meshes)
     result.meshes.push_back({mesh.name, mesh.triangles.size(), mesh.check});
+  for (const TriangleMesh& part : BuildVehicleMeshes(scene))
+    result.meshes.push_back({part.name, part.triangles.size(), part.check, true});
   const RayTracer tracer(meshes);
   result.timings.build_scene_s = clock.Lap();
 

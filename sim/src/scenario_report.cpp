@@ -136,7 +136,8 @@ nlohmann::json MeshesJson(const std::vector<ScenarioResult::MeshSummary>& meshes
                    {"triangles", m.triangles},
                    {"zero_area_triangles_dropped", m.check.zero_area_triangles},
                    {"boundary_edges", m.check.boundary_edges},
-                   {"non_manifold_edges", m.check.non_manifold_edges}});
+                   {"non_manifold_edges", m.check.non_manifold_edges},
+                   {"vehicle_part", m.vehicle_part}});
   }
   return out;
 }

@@ -48,11 +48,13 @@ struct ScenarioResult {
   mapping::KeySet observable;
   /// The sonar's position at the first beam [m], where the side slice of the map is cut.
   Eigen::Vector3d sonar_start_m = Eigen::Vector3d::Zero();
-  /// Each mesh's name, triangle count and preflight findings, in scene order.
+  /// Each mesh's name, triangle count and preflight findings, in scene order, then the
+  /// vehicle's parts'.
   struct MeshSummary {
     std::string name;
     std::size_t triangles = 0;
     MeshCheck check;
+    bool vehicle_part = false;
   };
   std::vector<MeshSummary> meshes;
   /// The metrics against the scene's criteria.
