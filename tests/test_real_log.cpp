@@ -7,6 +7,7 @@
 #include <fstream>
 #include <numbers>
 #include <set>
+#include <string>
 
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mat_log.hpp"
@@ -486,6 +487,47 @@ TEST(Fidelity, SelfReflectionIsMeasuredOverItsBinsPerHeadAngleAndSweep) {
     EXPECT_NEAR(r->angle_correlation[0], -1.0, 1e-9);
     EXPECT_NEAR(r->angle_correlation[1], -1.0, 1e-9);
   }
+}
+
+// The near range past the self-reflection (bins 28-63 of the Micron's 0.0125 m, centres within
+// 0.8 m): beams at head steps 0-99 hear 60 there (a vehicle's part), the rest 20, both sweeps
+// alike, and 0 elsewhere but a ringing at 100 in bins 5-22 (so the ringing bins are those):
+// per head angle 60 or 20, mean 40, no spread from ping to ping, and across head angles the
+// standard deviation of a hundred 60s and a hundred 20s. Its per-head-angle means go to
+// by_head_angle.csv.
+TEST(Fidelity, NearRangeIsMeasuredPerHeadAngle) {
+  const mapping::SensorGeometry sensor;
+  const int steps = sensor.BeamsPerSweep();
+  const std::vector<mapping::Beam> beams = TwoSweeps(sensor, [steps](int b, int k) -> std::uint8_t {
+    if (k >= 5 && k <= 22) return 100;
+    if (k >= 28 && k <= 63) return b % steps < 100 ? 60 : 20;
+    return 0;
+  });
+  const auto report = sim::CompareWithLog(beams, beams, sensor, 1.6);
+  const sim::FidelityReport::HeadAngleCells& near = report.real_near_range;
+  EXPECT_EQ(near.first_bin, 28u);
+  EXPECT_EQ(near.last_bin, 63u);
+  EXPECT_DOUBLE_EQ(near.mean, 40.0);
+  EXPECT_DOUBLE_EQ(near.ping_spread, 0.0);
+  EXPECT_NEAR(near.angle_spread, 20.0 * std::sqrt(200.0 / 199.0), 1e-9);
+  ASSERT_EQ(near.by_head_angle.size(), static_cast<std::size_t>(steps));
+  EXPECT_EQ(near.by_head_angle[0], 60.0);
+  EXPECT_EQ(near.by_head_angle[99], 60.0);
+  EXPECT_EQ(near.by_head_angle[100], 20.0);
+  EXPECT_EQ(report.real_ringing.by_head_angle[150], 100.0);
+
+  test::TempDir dir;
+  sim::WriteFidelityOutputs(dir.path().string(), report, beams, beams, sensor, "scene.yaml",
+                            "log.mat");
+  std::ifstream csv(dir.path() / "by_head_angle.csv");
+  std::string header;
+  std::string first;
+  std::getline(csv, header);
+  std::getline(csv, first);
+  EXPECT_EQ(header,
+            "head_angle_deg,sim_self_reflection,real_self_reflection,sim_near_range,"
+            "real_near_range");
+  EXPECT_EQ(first, "0,100.000000,100.000000,60.000000,60.000000");
 }
 
 // The real log's statistics that the guard below holds the simulated tank to, as `sonarbench

@@ -322,6 +322,15 @@ FidelityReport::HeadAngleCells HeadAngleStats(std::span<const mapping::Beam> bea
   if (count == 0.0) return out;
   out.mean = std::accumulate(sum.begin(), sum.end(), 0.0) / count;
   out.ping_spread = cells.MeanSpread();
+  out.by_head_angle.resize(steps);
+  for (std::size_t j = 0; j < steps; ++j) {
+    const auto row = static_cast<std::ptrdiff_t>(j * width);
+    const double seen = std::accumulate(n.begin() + row, n.begin() + row + width, 0.0);
+    if (seen > 0.0) {
+      out.by_head_angle[j] =
+          std::accumulate(sum.begin() + row, sum.begin() + row + width, 0.0) / seen;
+    }
+  }
   // Per bin, the cells' means over the head steps seen twice or more, around the turn.
   double bins_counted = 0.0;
   for (std::size_t k = 0; k < width; ++k) {
@@ -608,6 +617,18 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
           << field(r.real_wall_peak_by_angle[a]) << "\n";
   }
   WriteText((dir / "wall_range.csv").string(), walls.str());
+  std::ostringstream angles;
+  angles << "head_angle_deg,sim_self_reflection,real_self_reflection,sim_near_range,"
+            "real_near_range\n";
+  const auto at = [](const FidelityReport::HeadAngleCells& cells, std::size_t a) {
+    return a < cells.by_head_angle.size() ? cells.by_head_angle[a] : std::nullopt;
+  };
+  for (std::size_t a = 0; a < static_cast<std::size_t>(sensor.BeamsPerSweep()); ++a) {
+    angles << a * sensor.step_angle_rad * 180.0 / std::numbers::pi << ","
+           << field(at(r.sim_ringing, a)) << "," << field(at(r.real_ringing, a)) << ","
+           << field(at(r.sim_near_range, a)) << "," << field(at(r.real_near_range, a)) << "\n";
+  }
+  WriteText((dir / "by_head_angle.csv").string(), angles.str());
   // An aligned profile, entry i at offset i - before.
   const auto write_aligned = [&](const char* name, const std::vector<double>& sim,
                                  const std::vector<double>& real, long before) {
@@ -690,7 +711,7 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"outputs",
                   {"profile.csv", "profile.png", "wall_range.csv", "wall_profile.csv",
                    "direct_wall_profile.csv", "second_trip_profile.csv", "histogram.csv",
-                   "polar.png", "fan.png"}}});
+                   "by_head_angle.csv", "polar.png", "fan.png"}}});
   WriteJson((dir / "fidelity.json").string(), report);
 }
 

@@ -128,6 +128,8 @@ struct FidelityReport {
   /// the cells' means over head steps, averaged over the bins (how much it changes with head
   /// angle, sweep after sweep alike); `angle_correlation`: per bin, the correlation of the cells'
   /// means 1 and kRingingFarStep head steps apart (around the turn), averaged over the bins.
+  /// `by_head_angle`: per head-angle step, the mean intensity over its cells (none where no
+  /// beam was), what by_head_angle.csv writes.
   struct HeadAngleCells {
     std::size_t first_bin = 0;
     std::size_t last_bin = 0;
@@ -135,6 +137,7 @@ struct FidelityReport {
     double ping_spread = 0.0;
     double angle_spread = 0.0;
     std::array<double, 2> angle_correlation{};
+    std::vector<std::optional<double>> by_head_angle;
   };
   HeadAngleCells sim_ringing;
   HeadAngleCells real_ringing;
@@ -171,9 +174,10 @@ std::size_t SecondTripProfile(std::span<const mapping::Beam> beams,
                               double& excess);
 
 /// Writes fidelity.json, profile.csv, wall_range.csv, wall_profile.csv,
-/// direct_wall_profile.csv, second_trip_profile.csv, histogram.csv, profile.png (the two mean
-/// profiles), and polar and fan images of each run's first sweep side by side (sim left, real
-/// right) into `out_dir`.
+/// direct_wall_profile.csv, second_trip_profile.csv, histogram.csv, by_head_angle.csv (the
+/// self-reflection's and the near range's mean per head angle: where a vehicle's parts echo),
+/// profile.png (the two mean profiles), and polar and fan images of each run's first sweep side
+/// by side (sim left, real right) into `out_dir`.
 void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& report,
                           std::span<const mapping::Beam> sim_sweep,
                           std::span<const mapping::Beam> real_sweep,
