@@ -1637,6 +1637,69 @@ TEST(BeamSynthesis, QuantisationFollowsTheAdWindow) {
   EXPECT_EQ(synthesizer.Quantise(a.ad_low_db + 2 * a.ad_span_db), 255);
 }
 
+// The receiver's ceiling: below its knee the AD window alone; above it the output
+// knee + w·tanh((x - knee) / w) (w = ceiling - knee) of the window's step x, rounded, so a level
+// x = knee + w·atanh((y - knee) / w) reports y; rising with the level and never past the
+// ceiling, however strong the echo; the table-driven QuantisePower agreeing with it off the
+// steps' edges; and with knee = ceiling, a hard clip.
+TEST(BeamSynthesis, ReceiverCeilingCompressesAboveItsKneeAndNeverPassesIt) {
+  SensorModel sensor = QuietSensor();
+  Acoustics& a = sensor.acoustics;
+  a.ad_knee = 170.0;
+  a.ad_ceiling = 191.0;
+  const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
+  const RayTracer tracer(meshes);
+  const BeamSynthesizer ceiling(sensor, tracer, {Material{}});
+  const BeamSynthesizer plain(QuietSensor(), tracer, {Material{}});
+  const auto level = [&](double steps) { return a.ad_low_db + steps / 255.0 * a.ad_span_db; };
+  for (double x = 0.0; x < 169.5; x += 0.25) {
+    ASSERT_EQ(ceiling.Quantise(level(x)), plain.Quantise(level(x))) << x;
+  }
+  const double w = a.ad_ceiling - a.ad_knee;
+  for (const int y : {171, 175, 180, 185, 190}) {
+    EXPECT_EQ(ceiling.Quantise(level(a.ad_knee + w * std::atanh((y - a.ad_knee) / w))), y);
+  }
+  EXPECT_EQ(ceiling.Quantise(level(255.0)), 191);
+  EXPECT_EQ(ceiling.Quantise(level(2000.0)), 191);  // 314 dB over the window's foot
+  int previous = 0;
+  int compared = 0;
+  for (double x = -10.0; x < 600.0; x += 0.0137) {
+    const int q = ceiling.Quantise(level(x));
+    ASSERT_GE(q, previous) << x;
+    ASSERT_LE(q, 191) << x;
+    previous = q;
+    const double y = x <= a.ad_knee ? x : a.ad_knee + w * std::tanh((x - a.ad_knee) / w);
+    if (std::abs(y - std::round(y - 0.5) - 0.5) < 1e-9) continue;  // on an edge
+    ASSERT_EQ(ceiling.QuantisePower(std::pow(10.0, level(x) / 10.0)), q) << x;
+    ++compared;
+  }
+  EXPECT_EQ(previous, 191);
+  EXPECT_GT(compared, 40000);
+
+  a.ad_knee = 191.0;
+  const BeamSynthesizer clip(sensor, tracer, {Material{}});
+  EXPECT_EQ(clip.Quantise(level(190.4)), 190);
+  EXPECT_EQ(clip.Quantise(level(190.6)), 191);
+  EXPECT_EQ(clip.Quantise(level(300.0)), 191);
+  EXPECT_EQ(clip.QuantisePower(std::pow(10.0, level(190.4) / 10.0)), 190);
+  EXPECT_EQ(clip.QuantisePower(std::pow(10.0, level(300.0) / 10.0)), 191);
+}
+
+// A wall 20 dB over the window's top, pinged: without a ceiling its echo clips at 255; under a
+// ceiling of 191 (knee 170) it crowds just under 191, and no bin passes it.
+TEST(BeamSynthesis, ASaturatingEchoStaysUnderTheReceiversCeiling) {
+  SensorModel sensor = QuietSensor();
+  sensor.acoustics.gain_db = 40.0;
+  const std::vector<TriangleMesh> wall = Wall(2.0, 0.0);
+  const SynthesizedBeam open = Ping(sensor, wall);
+  EXPECT_EQ(*std::ranges::max_element(open.beam.intensities), 255);
+  sensor.acoustics.ad_knee = 170.0;
+  sensor.acoustics.ad_ceiling = 191.0;
+  const SynthesizedBeam capped = Ping(sensor, wall);
+  EXPECT_EQ(*std::ranges::max_element(capped.beam.intensities), 191);
+  EXPECT_EQ(capped.echo_power, open.echo_power);  // the ceiling is the receiver's, not the echo's
+}
+
 // A sensor whose only return is a flat self-reflection profile, `bins` long at -21 dB: 19 dB
 // above the AD window's foot, level 121.1 (quantised 121), clear of both ends by over 4σ for
 // the spreads tested below (1.5 dB).

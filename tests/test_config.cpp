@@ -348,6 +348,22 @@ TEST(SceneFile, SelfReflectionSpreadsAreTheSonars) {
   for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
 }
 
+// The receiver's ceiling is off unless asked for (knee and ceiling at 255); a knee over its
+// ceiling, or either out of the 8 bits, is refused with the key and line.
+TEST(SceneFile, ReceiverCeilingIsCheckedAgainstItsKnee) {
+  const sim::SensorModel micron =
+      sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
+  EXPECT_EQ(micron.acoustics.ad_knee, 255.0);
+  EXPECT_EQ(micron.acoustics.ad_ceiling, 255.0);
+  const std::pair<std::string, std::vector<std::string>> cases[] = {
+      {"  ad_ceiling: 191\n",
+       {"'sonar_acoustics.ad_knee'", "at or below ad_ceiling (191)", "got 255"}},
+      {"  ad_knee: 200\n  ad_ceiling: 191\n", {"'sonar_acoustics.ad_knee'", "got 200"}},
+      {"  ad_ceiling: 256\n", {"'sonar_acoustics.ad_ceiling'", "'256'"}},
+      {"  ad_knee: -1\n", {"'sonar_acoustics.ad_knee'", "'-1'"}}};
+  for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
+}
+
 // The scenes built on the fitted tank (the two that must fail, and the crate) extend it: they
 // must keep its acoustics, materials and detection, or they no longer test what their comments
 // say. The two must-fail scenes also keep the tank's criteria, only expecting them to fail, and

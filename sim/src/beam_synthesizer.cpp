@@ -19,6 +19,24 @@
 namespace sonarbench::sim {
 namespace {
 
+// The receiver's ceiling (Acoustics::ad_knee, ad_ceiling) on a level x in AD steps, as the AD
+// window maps it: x to the knee, then knee + w·tanh((x - knee) / w), w = ceiling - knee (a hard
+// clip at the ceiling for w = 0).
+double ReceiverCeiling(const Acoustics& a, double x) {
+  const double width = a.ad_ceiling - a.ad_knee;
+  if (x <= a.ad_knee) return x;
+  if (width <= 0.0) return a.ad_ceiling;
+  return a.ad_knee + width * std::tanh((x - a.ad_knee) / width);
+}
+
+// Its inverse: the least x whose output reaches y; infinite where the ceiling keeps it from y.
+double UnderCeiling(const Acoustics& a, double y) {
+  const double width = a.ad_ceiling - a.ad_knee;
+  if (y <= a.ad_knee) return y;
+  if (y >= a.ad_ceiling) return std::numeric_limits<double>::infinity();
+  return a.ad_knee + width * std::atanh((y - a.ad_knee) / width);
+}
+
 // c_e = exp(-|e| / steps) for |e| up to `max_reach` or to where what is left holds under 1e-12
 // of the power, whichever is nearer (entry e + reach): the kernel that makes draws e-fold their
 // correlation over `steps` head steps.
@@ -90,12 +108,17 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
     }
   }
   TabulateSelfReflection(run_seed);
-  // Quantise rounds half up: step q begins where the level reaches q - 0.5 AD steps.
+  // Quantise rounds half up: step q begins where the output reaches q - 0.5 AD steps, at the
+  // level the ceiling's inverse gives; the steps past the ceiling are never reached.
   const Acoustics& a = sensor_.acoustics;
   ad_thresholds_[0] = 0.0;
+  ad_top_step_ = 0;
   for (int q = 1; q < 256; ++q) {
-    const double level_db = a.ad_low_db + (q - 0.5) / 255.0 * a.ad_span_db;
-    ad_thresholds_[static_cast<std::size_t>(q)] = std::pow(10.0, level_db / 10.0);
+    const double steps = UnderCeiling(a, q - 0.5);
+    const double level_db = a.ad_low_db + steps / 255.0 * a.ad_span_db;
+    ad_thresholds_[static_cast<std::size_t>(q)] =
+        std::isinf(steps) ? steps : std::pow(10.0, level_db / 10.0);
+    if (!std::isinf(steps)) ad_top_step_ = static_cast<std::uint8_t>(q);
   }
   // Buckets of positive doubles by their exponent and top mantissa bits: with 2^m per octave,
   // a bucket spans 3.01/2^m dB; m is chosen so that spans half an AD step, or less.
@@ -108,12 +131,12 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
   ad_bucket_shift_ = 52 - mantissa_bits;
   ad_first_bucket_ = std::bit_cast<std::uint64_t>(ad_thresholds_[1]) >> ad_bucket_shift_;
   const std::uint64_t last_bucket =
-      std::bit_cast<std::uint64_t>(ad_thresholds_[255]) >> ad_bucket_shift_;
+      std::bit_cast<std::uint64_t>(ad_thresholds_[ad_top_step_]) >> ad_bucket_shift_;
   ad_bucket_steps_.resize(last_bucket - ad_first_bucket_ + 1);
   unsigned q = 0;
   for (std::uint64_t b = ad_first_bucket_; b <= last_bucket; ++b) {
     const double start = std::bit_cast<double>(b << ad_bucket_shift_);
-    while (q < 255 && start >= ad_thresholds_[q + 1]) ++q;
+    while (q < ad_top_step_ && start >= ad_thresholds_[q + 1]) ++q;
     ad_bucket_steps_[b - ad_first_bucket_] = static_cast<std::uint8_t>(q);
   }
 
@@ -353,6 +376,7 @@ struct AdSteps {
   const std::uint8_t* bucket_steps;
   std::uint64_t first_bucket;
   int bucket_shift;
+  std::uint8_t top;  // the highest step the ceiling lets a level reach
 
   // The largest q with thresholds[q] <= power (the thresholds increase; q = 0 below them): the
   // table gives it at the start of the power's bucket, and the power may pass the next
@@ -360,7 +384,7 @@ struct AdSteps {
   // of half an AD step hold at most one threshold; the loop keeps it exact for wider ones.
   std::uint8_t operator()(double power) const {
     if (!(power >= thresholds[1])) return 0;
-    if (power >= thresholds[255]) return 255;
+    if (power >= thresholds[top]) return top;
     const std::uint64_t bucket =
         (std::bit_cast<std::uint64_t>(power) >> bucket_shift) - first_bucket;
     unsigned q = bucket_steps[bucket];
@@ -373,8 +397,8 @@ struct AdSteps {
 }  // namespace
 
 std::uint8_t BeamSynthesizer::QuantisePower(double power) const {
-  return AdSteps{ad_thresholds_.data(), ad_bucket_steps_.data(), ad_first_bucket_,
-                 ad_bucket_shift_}(power);
+  return AdSteps{ad_thresholds_.data(), ad_bucket_steps_.data(), ad_first_bucket_, ad_bucket_shift_,
+                 ad_top_step_}(power);
 }
 
 namespace {
@@ -633,7 +657,8 @@ double Glint(const Material& m, double cos_alpha) {
 
 std::uint8_t BeamSynthesizer::Quantise(double level_db) const {
   const Acoustics& a = sensor_.acoustics;
-  const double scaled = std::round((level_db - a.ad_low_db) / a.ad_span_db * 255.0);
+  const double scaled =
+      std::round(ReceiverCeiling(a, (level_db - a.ad_low_db) / a.ad_span_db * 255.0));
   return static_cast<std::uint8_t>(std::clamp(scaled, 0.0, 255.0));
 }
 
@@ -1144,7 +1169,7 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
     }
   }
   const AdSteps quantise{s_.ad_thresholds_.data(), s_.ad_bucket_steps_.data(), s_.ad_first_bucket_,
-                         s_.ad_bucket_shift_};
+                         s_.ad_bucket_shift_, s_.ad_top_step_};
   std::uint8_t* const levels = out_.beam.intensities.data();
   for (std::size_t k = 0; k < bins_; ++k) levels[k] = quantise(powers[k]);
   if (echo_power == EchoPower::kKeep) out_.echo_power = echo;

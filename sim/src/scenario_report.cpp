@@ -89,6 +89,8 @@ nlohmann::json SensorJson(const SensorModel& s) {
             {"second_trip_db", a.second_trip_db},
             {"ad_low_db", a.ad_low_db},
             {"ad_span_db", a.ad_span_db},
+            {"ad_knee", a.ad_knee},
+            {"ad_ceiling", a.ad_ceiling},
             {"self_reflection_db", a.self_reflection_db},
             {"self_reflection_ping_spread_db", a.self_reflection_ping_spread_db},
             {"self_reflection_ringing_range_m", a.self_reflection_ringing_range_m},

@@ -1,5 +1,7 @@
 #include "sonarbench/sim/sensor_model.hpp"
 
+#include <sstream>
+
 namespace sonarbench::sim {
 
 void ReadAcoustics(YamlReader& node, Acoustics& a) {
@@ -28,6 +30,8 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("second_trip_db", a.second_trip_db, InRange(-100.0, 20.0));
   node.Optional("ad_low_db", a.ad_low_db, InRange(-300.0, 100.0));
   node.Optional("ad_span_db", a.ad_span_db, InRange(1.0, 200.0));
+  node.Optional("ad_knee", a.ad_knee, InRange(0.0, 255.0));
+  node.Optional("ad_ceiling", a.ad_ceiling, InRange(1.0, 255.0));
   node.Optional("self_reflection_db", a.self_reflection_db);
   node.Optional("self_reflection_ping_spread_db", a.self_reflection_ping_spread_db,
                 InRange(0.0, 10.0));
@@ -57,6 +61,11 @@ void CheckAcoustics(YamlReader& node, const Acoustics& merged) {
     if (spread > 0.0 && merged.self_reflection_db.empty()) {
       node.Fail(key, "a self-reflection profile to vary (self_reflection_db), got none");
     }
+  }
+  if (merged.ad_knee > merged.ad_ceiling) {
+    std::ostringstream got;
+    got << "a knee at or below ad_ceiling (" << merged.ad_ceiling << "), got " << merged.ad_knee;
+    node.Fail("ad_knee", got.str());
   }
   if (merged.self_reflection_ringing_range_m > 0.0 &&
       merged.self_reflection_ping_spread_db <= 0.0) {

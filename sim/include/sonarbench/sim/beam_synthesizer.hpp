@@ -103,7 +103,8 @@ class BeamSynthesizer {
   double DrawRays(const Eigen::Matrix3d& R_world_beam, Rng& rng,
                   std::vector<Eigen::Vector3f>& directions, std::vector<double>& patterns) const;
 
-  /// Maps a level [dB] to the 8-bit intensity the sonar would report.
+  /// Maps a level [dB] to the 8-bit intensity the sonar would report: the AD window's step,
+  /// under the receiver's ceiling (Acoustics::ad_knee, ad_ceiling), rounded.
   [[nodiscard]] std::uint8_t Quantise(double level_db) const;
 
   /// The same for a linear power: the number of AD steps whose lower edge the power reaches,
@@ -294,6 +295,8 @@ class BeamSynthesizer {
   void CorrelateSectors();
   /// Power at which each AD step begins: step q for power ≥ ad_thresholds_[q] (index 0 unused).
   std::array<double, 256> ad_thresholds_{};
+  /// The highest step a level can reach under the receiver's ceiling (Acoustics::ad_ceiling).
+  std::uint8_t ad_top_step_ = 255;
   /// Per bucket of powers (the top bits of the double, from the bucket of ad_thresholds_[1]
   /// on), the AD step at the bucket's start.
   std::vector<std::uint8_t> ad_bucket_steps_;

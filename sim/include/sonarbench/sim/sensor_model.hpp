@@ -98,6 +98,13 @@ struct Acoustics {
   /// Level mapped to intensity 0, and the span [dB] mapped onto 0..255 (the Micron's ADLow/ADSpan).
   double ad_low_db = -40.0;
   double ad_span_db = 40.0;
+  /// The receiver's ceiling [intensity, 0-255]: where the AD window would put a level at x
+  /// above `ad_knee`, the sonar reports knee + w·tanh((x - knee) / w), w = ad_ceiling - knee, so
+  /// levels far over the knee crowd towards the ceiling and never pass it (a detector that
+  /// saturates smoothly); ad_knee = ad_ceiling is a hard clip. 255 and 255, the defaults: none
+  /// but the 8 bits' own. See BeamSynthesizer::Quantise.
+  double ad_knee = 255.0;
+  double ad_ceiling = 255.0;
   /// Mean self-reflection (vehicle body and transducer ringing) power per bin from bin 0, at the
   /// receiver output [dB]; bins past the end of the list get none. It is the sonar's own: not
   /// the place's, so no speckle multiplies it, but it varies by these (BeamSynthesizer::
