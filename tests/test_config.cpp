@@ -364,6 +364,55 @@ TEST(SceneFile, ReceiverCeilingIsCheckedAgainstItsKnee) {
   for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
 }
 
+// Sidelobes are off unless asked for; an extent inside the main lobe's rays (±1.5° on the
+// Micron), a level over the main lobe's, or no strata, are refused with the key and line.
+TEST(SceneFile, SidelobesMustReachPastTheMainLobe) {
+  const sim::SensorModel micron =
+      sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
+  EXPECT_EQ(micron.acoustics.sidelobe_extent_deg, 0.0);
+  EXPECT_EQ(sim::PrimaryRays(micron.acoustics), 640u);
+  const std::pair<std::string, std::vector<std::string>> cases[] = {
+      {"  sidelobe_extent_deg: 1.5\n",
+       {"'sonar_acoustics.sidelobe_extent_deg'", "past the main lobe's rays (1.5°)", "got 1.5"}},
+      {"  sidelobe_db: 3\n  sidelobe_extent_deg: 20\n", {"'sonar_acoustics.sidelobe_db'", "'3'"}},
+      {"  sidelobe_rays_vertical: 0\n  sidelobe_extent_deg: 20\n",
+       {"'sonar_acoustics.sidelobe_rays_vertical'", "'0'"}}};
+  for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
+}
+
+// The sidelobes' trial is the fitted tank with only what its comment names changed: the
+// sidelobes, the ceiling, the gain and the walls' glint.
+TEST(SceneFile, SidelobesTrialIsTheTankWithItsChangesOnly) {
+  const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  const sim::Scene trial =
+      sim::LoadScene(test::SourcePath("scenes/trials/cras-tank-sidelobes.yaml"));
+  sim::Acoustics acoustics = trial.sensor.acoustics;
+  EXPECT_EQ(acoustics.sidelobe_extent_deg, 22.0);
+  EXPECT_EQ(acoustics.sidelobe_db, -16.0);
+  EXPECT_EQ(acoustics.sidelobe_width_deg, 8.0);
+  EXPECT_EQ(acoustics.ad_knee, 170.0);
+  EXPECT_EQ(acoustics.ad_ceiling, 191.0);
+  EXPECT_EQ(acoustics.gain_db, 4.0);
+  acoustics.sidelobe_extent_deg = tank.sensor.acoustics.sidelobe_extent_deg;
+  acoustics.sidelobe_db = tank.sensor.acoustics.sidelobe_db;
+  acoustics.sidelobe_width_deg = tank.sensor.acoustics.sidelobe_width_deg;
+  acoustics.ad_knee = tank.sensor.acoustics.ad_knee;
+  acoustics.ad_ceiling = tank.sensor.acoustics.ad_ceiling;
+  acoustics.gain_db = tank.sensor.acoustics.gain_db;
+  EXPECT_EQ(acoustics, tank.sensor.acoustics);
+  ASSERT_EQ(trial.materials.size(), tank.materials.size());
+  for (std::size_t i = 0; i < tank.materials.size(); ++i) {
+    sim::Material material = trial.materials[i];
+    if (material.name == "tank_wall") {
+      EXPECT_EQ(material.glint, 0.3);
+      material.glint = tank.materials[i].glint;
+    }
+    EXPECT_EQ(material, tank.materials[i]);
+  }
+  EXPECT_EQ(trial.meshes.size(), tank.meshes.size());
+  EXPECT_EQ(trial.vehicle.size(), tank.vehicle.size());
+}
+
 // The scenes built on the fitted tank (the two that must fail, and the crate) extend it: they
 // must keep its acoustics, materials and detection, or they no longer test what their comments
 // say. The two must-fail scenes also keep the tank's criteria, only expecting them to fail, and

@@ -106,8 +106,7 @@ const Setup& TheSetup(const std::string& file) {
 }
 
 double PrimaryRaysPerSweep(const Scene& scene) {
-  const Acoustics& a = scene.sensor.acoustics;
-  return static_cast<double>(a.rays_horizontal) * a.rays_vertical *
+  return static_cast<double>(PrimaryRays(scene.sensor.acoustics)) *
          scene.sensor.geometry.BeamsPerSweep();
 }
 
@@ -188,6 +187,9 @@ void BM_SynthesisNoMultipath(benchmark::State& state, const std::string& file) {
 const std::string kTank = "cras-tank.yaml";
 // The seabed survey: a 30 m × 12 m height field at 25 cm (11.5 k triangles), no multipath.
 const std::string kSeabed = "seabed.yaml";
+// The tank's trial with the horizontal pattern's sidelobes (320 more primary rays per beam, to
+// ±22°), a receiver ceiling and glinting walls.
+const std::string kTankSidelobes = "trials/cras-tank-sidelobes.yaml";
 
 BENCHMARK_CAPTURE(BM_RawEmbree, tank, kTank)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RawEmbreeBundle, tank, kTank)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -195,6 +197,11 @@ BENCHMARK_CAPTURE(BM_SynthesisNoMultipath, tank, kTank)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Synthesis, tank, kTank)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Synthesis, tank_sidelobes, kTankSidelobes)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)

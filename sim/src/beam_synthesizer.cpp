@@ -155,20 +155,47 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
   const mapping::SensorGeometry& g = sensor_.geometry;
   pattern_k_h_ = 4.0 * std::log(2.0) / (g.beam_width_horizontal_rad * g.beam_width_horizontal_rad);
   pattern_k_v_ = 4.0 * std::log(2.0) / (g.beam_width_vertical_rad * g.beam_width_vertical_rad);
-  const auto tabulate = [](int strata, double aperture, double k) {
+  if (a.sidelobe_extent_deg > 0.0) {
+    sidelobe_level_ = std::pow(10.0, a.sidelobe_db / 10.0);
+    sidelobe_width2_ = std::pow(a.sidelobe_width_deg * mapping::kDegToRad, 2);
+    sidelobe_extent_rad_ = a.sidelobe_extent_deg * mapping::kDegToRad;
+  }
+  // The slots of `strata` strata: slot a of stratum i at the angle angle_at((i + (a + ½)/slots)
+  // / strata), with the factor factor(angle).
+  const auto tabulate = [](int strata, const auto& angle_at, const auto& factor) {
     std::vector<JitterSlot> slots;
     for (int i = 0; i < strata; ++i) {
       for (int slot = 0; slot < kJitterSlots; ++slot) {
-        const double angle = ((i + (slot + 0.5) / kJitterSlots) / strata - 0.5) * aperture;
-        slots.push_back({std::sin(angle), std::cos(angle), std::exp(-k * angle * angle)});
+        const double angle = angle_at((i + (slot + 0.5) / kJitterSlots) / strata);
+        slots.push_back({std::sin(angle), std::cos(angle), factor(angle)});
       }
     }
     return slots;
   };
-  horizontal_slots_ = tabulate(
-      a.rays_horizontal, a.aperture_scale_horizontal * g.beam_width_horizontal_rad, pattern_k_h_);
-  vertical_slots_ = tabulate(a.rays_vertical, a.aperture_scale_vertical * g.beam_width_vertical_rad,
-                             pattern_k_v_);
+  const auto centred = [](double aperture) {
+    return [aperture](double fraction) { return (fraction - 0.5) * aperture; };
+  };
+  const auto horizontal = [&](double angle) {
+    return std::exp(-pattern_k_h_ * angle * angle) + SidelobePattern(angle);
+  };
+  const auto vertical = [&](double angle) { return std::exp(-pattern_k_v_ * angle * angle); };
+  const double aperture_h = a.aperture_scale_horizontal * g.beam_width_horizontal_rad;
+  const double aperture_v = a.aperture_scale_vertical * g.beam_width_vertical_rad;
+  horizontal_slots_ = tabulate(a.rays_horizontal, centred(aperture_h), horizontal);
+  vertical_slots_ = tabulate(a.rays_vertical, centred(aperture_v), vertical);
+  if (sidelobe_level_ > 0.0) {
+    // A sidelobe ray stands for a stratum wider than a main-lobe ray's in both directions: its
+    // pattern factor carries the ratio of their solid angles, so the weights stay the pattern's
+    // integral over the rays' strata.
+    const double span = sidelobe_extent_rad_ - 0.5 * aperture_h;
+    const double area = (span / a.sidelobe_rays_horizontal) / (aperture_h / a.rays_horizontal) *
+                        (static_cast<double>(a.rays_vertical) / a.sidelobe_rays_vertical);
+    sidelobe_horizontal_slots_ = tabulate(
+        a.sidelobe_rays_horizontal,
+        [&](double fraction) { return 0.5 * aperture_h + fraction * span; },
+        [&](double angle) { return area * horizontal(angle); });
+    sidelobe_vertical_slots_ = tabulate(a.sidelobe_rays_vertical, centred(aperture_v), vertical);
+  }
 
   if (a.level_jitter_db > 0.0) {
     level_jitter_factors_.reserve(kLevelJitters);
@@ -662,11 +689,17 @@ std::uint8_t BeamSynthesizer::Quantise(double level_db) const {
   return static_cast<std::uint8_t>(std::clamp(scaled, 0.0, 255.0));
 }
 
+double BeamSynthesizer::SidelobePattern(double theta) const {
+  if (!(std::abs(theta) <= sidelobe_extent_rad_) || sidelobe_level_ <= 0.0) return 0.0;
+  const double falloff = sidelobe_width2_ / (sidelobe_width2_ + theta * theta);
+  return sidelobe_level_ * falloff * falloff;
+}
+
 double BeamSynthesizer::DrawRays(const Eigen::Matrix3d& R_world_beam, Rng& rng,
                                  std::vector<Eigen::Vector3f>& directions,
                                  std::vector<double>& patterns) const {
   const Acoustics& a = sensor_.acoustics;
-  directions.resize(static_cast<std::size_t>(a.rays_horizontal) * a.rays_vertical);
+  directions.resize(PrimaryRays(a));
   patterns.resize(directions.size());
   double weight_sum = 0.0;
   const Eigen::Vector3d ahead = R_world_beam.col(0);
@@ -686,6 +719,25 @@ double BeamSynthesizer::DrawRays(const Eigen::Matrix3d& R_world_beam, Rng& rng,
       patterns[static_cast<std::size_t>(r)] = pattern;
       directions[static_cast<std::size_t>(r)] =
           (v.cos * (h.cos * ahead + h.sin * left) + v.sin * up).cast<float>();
+    }
+  }
+  if (sidelobe_level_ <= 0.0) return weight_sum;
+  // The sidelobes' strata, left of the main lobe's rays then right, drawn as theirs are.
+  std::size_t r = MainLobeRays(a);
+  for (const double side : {1.0, -1.0}) {
+    for (int i = 0; i < a.sidelobe_rays_horizontal; ++i) {
+      const JitterSlot* stratum_h =
+          &sidelobe_horizontal_slots_[static_cast<std::size_t>(i) * kJitterSlots];
+      for (int j = 0; j < a.sidelobe_rays_vertical; ++j, ++r) {
+        const std::uint64_t draw = rng.Next();
+        const JitterSlot& h = stratum_h[(draw >> 32) & kSlotMask];
+        const JitterSlot& v = sidelobe_vertical_slots_[static_cast<std::size_t>(j) * kJitterSlots +
+                                                       ((draw >> 48) & kSlotMask)];
+        const double pattern = h.weight * v.weight;
+        weight_sum += pattern;
+        patterns[r] = pattern;
+        directions[r] = (v.cos * (h.cos * ahead + side * h.sin * left) + v.sin * up).cast<float>();
+      }
     }
   }
   return weight_sum;
@@ -772,6 +824,7 @@ struct OneWayPattern {
   Eigen::Matrix3d R_beam_world;
   double k_h = 0.0;
   double k_v = 0.0;
+  const BeamSynthesizer& synthesizer;  // its sidelobes (SidelobePattern), if any
 
   double operator()(const Eigen::Vector3d& towards, double blur = 0.0) const {
     const Eigen::Vector3d u = R_beam_world * towards;
@@ -780,8 +833,16 @@ struct OneWayPattern {
     const double epsilon = std::asin(std::clamp(u.z(), -1.0, 1.0));
     const double wide_h = 1.0 + k_h * blur;
     const double wide_v = 1.0 + k_v * blur;
-    return std::exp(-0.5 * (k_h * theta * theta / wide_h + k_v * epsilon * epsilon / wide_v)) /
-           std::sqrt(wide_h * wide_v);
+    const double sidelobe = synthesizer.SidelobePattern(theta);
+    if (sidelobe <= 0.0) {
+      return std::exp(-0.5 * (k_h * theta * theta / wide_h + k_v * epsilon * epsilon / wide_v)) /
+             std::sqrt(wide_h * wide_v);
+    }
+    // The sidelobes' pedestal is far wider than any blur: added unblurred to the main lobe's
+    // two-way power, the one-way the square root of the sum.
+    const double main_h = std::exp(-k_h * theta * theta / wide_h) / wide_h;
+    return std::sqrt(main_h + sidelobe) * std::exp(-0.5 * k_v * epsilon * epsilon / wide_v) /
+           std::sqrt(wide_v);
   }
 };
 
@@ -948,7 +1009,8 @@ void BeamSynthesizer::BeamJob::MeetVehicle() {
 }
 
 void BeamSynthesizer::BeamJob::TracePrimaries() {
-  const auto rays = static_cast<std::size_t>(a_.rays_horizontal) * a_.rays_vertical;
+  const std::size_t rays = PrimaryRays(a_);
+  const std::size_t main_lobe_rays = MainLobeRays(a_);
   std::vector<Eigen::Vector3f>& directions = scratch_.directions;
   std::vector<double>& patterns = scratch_.patterns;
   weight_sum_ = s_.DrawRays(R_world_beam_, *echo_rng_, directions, patterns);
@@ -968,7 +1030,8 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
     const double pattern = patterns[r];
     const double range = std::max<double>(hit->distance, g_.bin_size_m);
     const bool on_vehicle = hit->mesh >= s_.vehicle_first_mesh_;
-    if (!on_vehicle && (!out_.truth.first_hit_range_m || range < *out_.truth.first_hit_range_m)) {
+    if (!on_vehicle && r < main_lobe_rays &&
+        (!out_.truth.first_hit_range_m || range < *out_.truth.first_hit_range_m)) {
       out_.truth.first_hit_range_m = range;
       out_.truth.first_hit_mesh = hit->mesh;
     }
@@ -1002,7 +1065,8 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
 //    reverse path (sonar → P_k → mirrors → sonar), equal by reciprocity, and (R/d)^(S/10) turns
 //    the monostatic spreading at R into the last leg's own.
 void BeamSynthesizer::BeamJob::TraceMultipath() {
-  const OneWayPattern one_way_pattern{R_world_beam_.transpose(), s_.pattern_k_h_, s_.pattern_k_v_};
+  const OneWayPattern one_way_pattern{R_world_beam_.transpose(), s_.pattern_k_h_, s_.pattern_k_v_,
+                                      s_};
   // The two-way pattern of the way out and back along a mirror path ending at p's hit. Through
   // perfect mirrors the echo comes back along the way out: the ray's own two-way pattern.
   // Through rough ones the way back is a path of its own, each rough mirror tilting it

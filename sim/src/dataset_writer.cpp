@@ -330,7 +330,7 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   manifest["truth"] = {
       {"per_beam",
        "truth/sweep_NNNN.csv: beam, time_s, head_angle_rad, first_hit_range_m "
-       "(nearest surface any ray of the beam hit), first_hit_mesh, "
+       "(nearest surface any ray of the beam's main lobe hit), first_hit_mesh, "
        "axis_hit_range_m; empty when nothing within range"},
       {"occupancy", "truth/occupancy.bt: every cell a mesh surface crosses, at resolution_m"},
       {"resolution_m", scene.mapping.resolution_m}};

@@ -308,7 +308,7 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
   if (T_vehicle_sonar) scene.sensor.geometry.T_vehicle_sonar = *T_vehicle_sonar;
   if (acoustics) {
     ReadAcoustics(*acoustics, scene.sensor.acoustics);
-    CheckAcoustics(*acoustics, scene.sensor.acoustics);
+    CheckAcoustics(*acoustics, scene.sensor.acoustics, scene.sensor.geometry);
     root.ThrowIfErrors();
   }
   return scene;

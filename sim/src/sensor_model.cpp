@@ -4,11 +4,26 @@
 
 namespace sonarbench::sim {
 
+std::size_t MainLobeRays(const Acoustics& a) {
+  return static_cast<std::size_t>(a.rays_horizontal) * static_cast<std::size_t>(a.rays_vertical);
+}
+
+std::size_t PrimaryRays(const Acoustics& a) {
+  if (a.sidelobe_extent_deg <= 0.0) return MainLobeRays(a);
+  return MainLobeRays(a) + 2 * static_cast<std::size_t>(a.sidelobe_rays_horizontal) *
+                               static_cast<std::size_t>(a.sidelobe_rays_vertical);
+}
+
 void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("rays_horizontal", a.rays_horizontal, IntInRange(1, 1024));
   node.Optional("rays_vertical", a.rays_vertical, IntInRange(1, 8192));
   node.Optional("aperture_scale_horizontal", a.aperture_scale_horizontal, InRange(0.1, 4.0));
   node.Optional("aperture_scale_vertical", a.aperture_scale_vertical, InRange(0.1, 4.0));
+  node.Optional("sidelobe_extent_deg", a.sidelobe_extent_deg, InRange(0.0, 89.0));
+  node.Optional("sidelobe_db", a.sidelobe_db, InRange(-100.0, 0.0));
+  node.Optional("sidelobe_width_deg", a.sidelobe_width_deg, InRange(0.01, 89.0));
+  node.Optional("sidelobe_rays_horizontal", a.sidelobe_rays_horizontal, IntInRange(1, 1024));
+  node.Optional("sidelobe_rays_vertical", a.sidelobe_rays_vertical, IntInRange(1, 8192));
   node.Optional("spreading_db_per_decade", a.spreading_db_per_decade, InRange(0.0, 80.0));
   node.Optional("absorption_db_per_m", a.absorption_db_per_m, InRange(0.0, 100.0));
   node.Optional("tvg_db_per_decade", a.tvg_db_per_decade, InRange(0.0, 80.0));
@@ -43,7 +58,16 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
                 InRange(0.0, 90.0));
 }
 
-void CheckAcoustics(YamlReader& node, const Acoustics& merged) {
+void CheckAcoustics(YamlReader& node, const Acoustics& merged,
+                    const mapping::SensorGeometry& geometry) {
+  const double main_lobe_edge_deg = 0.5 * merged.aperture_scale_horizontal *
+                                    geometry.beam_width_horizontal_rad / mapping::kDegToRad;
+  if (merged.sidelobe_extent_deg > 0.0 && merged.sidelobe_extent_deg <= main_lobe_edge_deg) {
+    std::ostringstream got;
+    got << "an extent past the main lobe's rays (" << main_lobe_edge_deg << "°), got "
+        << merged.sidelobe_extent_deg;
+    node.Fail("sidelobe_extent_deg", got.str());
+  }
   if (merged.speckle_looks > 1 && !merged.speckle) {
     node.Fail("speckle_looks",
               "speckle: true (looks of a speckle that is off), got speckle: false");
@@ -86,7 +110,7 @@ SensorModel ReadSensorModel(YamlReader& root) {
   model.geometry = mapping::ReadSensorGeometry(geometry);
   YamlReader node = root.Child("acoustics");
   ReadAcoustics(node, model.acoustics);
-  CheckAcoustics(node, model.acoustics);
+  CheckAcoustics(node, model.acoustics, model.geometry);
   node.RejectUnknownKeys();
   root.RejectUnknownKeys();
   return model;

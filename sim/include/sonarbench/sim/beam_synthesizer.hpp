@@ -97,11 +97,15 @@ class BeamSynthesizer {
                                            EchoPower echo_power = EchoPower::kKeep) const;
 
   /// A beam's primary rays, for a beam whose frame (x along its axis, z up the fan) is
-  /// `R_world_beam`: rays_horizontal × rays_vertical, one per stratum, each at a jitter slot in
-  /// both directions picked by one draw from `rng`. Writes their world directions and two-way
-  /// pattern weights; returns the weights' sum.
+  /// `R_world_beam`: rays_horizontal × rays_vertical, one per stratum, then the sidelobes' (if
+  /// any, PrimaryRays), each at a jitter slot in both directions picked by one draw from `rng`.
+  /// Writes their world directions and two-way pattern weights; returns the weights' sum.
   double DrawRays(const Eigen::Matrix3d& R_world_beam, Rng& rng,
                   std::vector<Eigen::Vector3f>& directions, std::vector<double>& patterns) const;
+
+  /// The sidelobes' share of the two-way horizontal pattern at θ [rad] off the axis
+  /// (Acoustics::sidelobe_extent_deg): S (θ_s² / (θ_s² + θ²))² within the extent, else 0.
+  [[nodiscard]] double SidelobePattern(double theta) const;
 
   /// Maps a level [dB] to the 8-bit intensity the sonar would report: the AD window's step,
   /// under the receiver's ceiling (Acoustics::ad_knee, ad_ceiling), rounded.
@@ -312,6 +316,14 @@ class BeamSynthesizer {
   /// Stratum i's slot a at [i · kJitterSlots + a]: horizontal angles θ, vertical angles ε.
   std::vector<JitterSlot> horizontal_slots_;
   std::vector<JitterSlot> vertical_slots_;
+  /// The sidelobes (Acoustics::sidelobe_extent_deg), if any: S, θ_s² [rad²], the extent [rad],
+  /// and their strata's slots (horizontal: one side, from the main lobe's rays' edge out, their
+  /// factors times the ratio of a sidelobe stratum's solid angle to a main-lobe one's).
+  double sidelobe_level_ = 0.0;
+  double sidelobe_width2_ = 0.0;
+  double sidelobe_extent_rad_ = 0.0;
+  std::vector<JitterSlot> sidelobe_horizontal_slots_;
+  std::vector<JitterSlot> sidelobe_vertical_slots_;
   /// kSpreadOffsets standard 2-D Gaussian offsets (SpreadMirror).
   std::vector<Eigen::Vector2f> spread_offsets_;
 };

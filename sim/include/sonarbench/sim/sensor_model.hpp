@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,20 @@ struct Acoustics {
   /// two-way Gaussian's -12 dB).
   double aperture_scale_horizontal = 1.0;
   double aperture_scale_vertical = 1.0;
+  /// The horizontal pattern's sidelobes: with `sidelobe_extent_deg` [deg] > 0 the sonar also
+  /// hears, weakly, what lies that far either side of its axis. The two-way horizontal pattern
+  /// is then exp(-4 ln2 θ²/w_h²) + S (θ_s² / (θ_s² + θ²))² out to the extent (0 past it), S =
+  /// 10^(sidelobe_db/10) and θ_s = `sidelobe_width_deg` [deg]: a pedestal S under the main lobe
+  /// whose level falls 12 dB per octave of angle past θ_s, as a uniform aperture's sidelobe
+  /// peaks do (sinc⁴). Sampled by `sidelobe_rays_horizontal` strata on each side, from the
+  /// main lobe's rays' edge (aperture_scale_horizontal · w_h / 2) out to the extent, each split
+  /// into `sidelobe_rays_vertical` strata up the fan; the first-hit truth stays the main lobe's.
+  /// 0, the default: no sidelobes (no rays). The vertical pattern keeps none.
+  double sidelobe_extent_deg = 0.0;
+  double sidelobe_db = -30.0;
+  double sidelobe_width_deg = 5.0;
+  int sidelobe_rays_horizontal = 4;
+  int sidelobe_rays_vertical = 40;
   /// Net geometric loss of an area-scattering echo [dB per decade of range] (two-way spherical
   /// spreading, 40 dB, less the growth of the ensonified area, 20 dB).
   double spreading_db_per_decade = 20.0;
@@ -138,14 +153,22 @@ struct SensorModel {
 
 /// Loads a sensor model YAML file; throws InputError naming the file and key on bad input.
 [[nodiscard]] SensorModel LoadSensorModel(const std::string& path);
+/// Primary rays per beam: the main lobe's rays_horizontal × rays_vertical and, with sidelobes,
+/// their 2 × sidelobe_rays_horizontal × sidelobe_rays_vertical.
+[[nodiscard]] std::size_t MainLobeRays(const Acoustics& a);
+[[nodiscard]] std::size_t PrimaryRays(const Acoustics& a);
+
 /// Reads the keys of an `acoustics` mapping that are present into `a` (absent ones keep their
 /// value), without rejecting unknown keys: the caller does, once.
 void ReadAcoustics(YamlReader& node, Acoustics& a);
 /// Reports on `node` (an acoustics mapping) a key that `merged`, the settings in force once that
 /// mapping is applied, sets without what it needs: speckle_angular_correlation_deg without the
 /// place's speckle, speckle_looks over 1 without speckle, a self-reflection spread without a
-/// self-reflection profile, self_reflection_angle_correlation_deg without its spread.
-void CheckAcoustics(YamlReader& node, const Acoustics& merged);
+/// self-reflection profile, self_reflection_angle_correlation_deg without its spread, a
+/// receiver knee over its ceiling, sidelobes that end inside the main lobe's rays (`geometry`'s
+/// beam width).
+void CheckAcoustics(YamlReader& node, const Acoustics& merged,
+                    const mapping::SensorGeometry& geometry);
 /// Reads a sensor model from an already-open reader (the root of a sensor model file).
 [[nodiscard]] SensorModel ReadSensorModel(YamlReader& root);
 
