@@ -35,8 +35,9 @@ tilted one's earlier on one side and later on the other. With --arc HEAD_DEG BIN
 echo at bin BIN (a tank's corner) is heard across head angles: for the head steps within ±12 of
 HEAD_DEG (the manifest's step), each beam's largest intensity within 2 bins of BIN, averaged
 over the beams at that head angle: a beam hears the point at its own range wherever its pattern
-reaches it, so the arc's width is the pattern's, not the beam's nominal width. Standard library
-only.
+reaches it, so the arc's width is the pattern's, not the beam's nominal width; then the arc's
+peak (the nearest the centre among equals), the contiguous head steps around it within 20
+units of it, and the arc at ±6 and ±12 steps. Standard library only.
 """
 import argparse
 import glob
@@ -208,6 +209,27 @@ def arc_row(with_angles, head_deg, bin_index, step_rad, steps=12, reach=2):
     return rows
 
 
+def arc_summary(rows, drop=20):
+    """(peak, its offset, (first, last) offsets of the contiguous head steps around the peak
+    within `drop` of it, {offset: mean} at ±6 and ±12 steps) of arc_row's rows; the peak the
+    largest mean, the nearest to the centre among equals; None if no step has beams."""
+    heard = [(off, m) for off, m in rows if m is not None]
+    if not heard:
+        return None
+    peak_off, peak = max(heard, key=lambda r: (r[1], -abs(r[0])))
+    means = [m for _, m in rows]
+    i = [off for off, _ in rows].index(peak_off)
+    first = last = i
+    while first > 0 and means[first - 1] is not None and means[first - 1] >= peak - drop:
+        first -= 1
+    while last + 1 < len(rows) and means[last + 1] is not None and means[last + 1] >= peak - drop:
+        last += 1
+    centre = len(rows) // 2
+    flanks = {rows[centre + k][0]: rows[centre + k][1] for k in (-12, -6, 6, 12)
+              if 0 <= centre + k < len(rows)}
+    return peak, peak_off, (rows[first][0], rows[last][0]), flanks
+
+
 def fine_texture(with_angles, first, step_rad, reach=15, lags=3):
     """([correlation along range at 1..lags bins], [across 1..lags head steps], contrast) of the
     beams' bins from `first` on, each less its beam's mean over the bins within `reach` of it."""
@@ -324,6 +346,13 @@ def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None)
               "largest within 2 bins): " +
               ", ".join(f"{off:+.1f} " + (f"{m:.0f}" if m is not None else "none")
                         for off, m in rows))
+        summary = arc_summary(rows)
+        if summary is not None:
+            peak, peak_off, (first, last), flanks = summary
+            print(f"  its peak {peak:.0f} at {peak_off:+.1f}°; within 20 of it from {first:+.1f}° "
+                  f"to {last:+.1f}°; " +
+                  ", ".join(f"at {off:+.1f}° " + (f"{m:.0f}" if m is not None else "none")
+                            for off, m in sorted(flanks.items())))
 
 
 if __name__ == "__main__":

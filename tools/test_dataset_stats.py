@@ -170,6 +170,10 @@ def main():
             "-21.6 none, " in result.stdout, result.stdout
         assert "-10.8 none, -9.0 0, -7.2 0, -5.4 0, -3.6 150, -1.8 150, +0.0 150, +1.8 150, " \
             "+3.6 150, +5.4 0, +7.2 0, +9.0 0, +10.8 none, " in result.stdout, result.stdout
+        # Its summary: the peak, 150, at the steps -3.6..+3.6, the nearest the centre taken; the
+        # steps within 20 of it those five; ±10.8° and ±21.6° have no beams.
+        assert "its peak 150 at +0.0°; within 20 of it from -3.6° to +3.6°; at -21.6° none, " \
+            "at -10.8° none, at +10.8° none, at +21.6° none" in result.stdout, result.stdout
         result = run(os.path.join(tmp, "arc"), "--arc", "9", "150.5")
         assert result.returncode != 0 and "expected BIN a whole number" in result.stderr, \
             result.stderr
