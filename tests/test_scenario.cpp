@@ -186,6 +186,13 @@ TEST_F(TankScenario, OutputsAreWrittenWithTheReportLast) {
                    result_->metrics.occupied_precision);
   EXPECT_TRUE(report["timing"].contains("map_s"));
   EXPECT_EQ(report["parameters"]["mapping"]["rays_vertical"], 64);
+  // The sensor's settings in force, the ones off by default too.
+  const auto& acoustics = report["parameters"]["sensor"]["acoustics"];
+  EXPECT_EQ(acoustics["gain_db"], scene_->sensor.acoustics.gain_db);
+  EXPECT_EQ(acoustics["sidelobe_extent_deg"], 0.0);
+  EXPECT_EQ(acoustics["sidelobe_rays_vertical"], scene_->sensor.acoustics.sidelobe_rays_vertical);
+  EXPECT_EQ(acoustics["ad_knee"], 255.0);
+  EXPECT_EQ(acoustics["ad_ceiling"], 255.0);
   // Every mesh's preflight, the vehicle's parts marked as such.
   std::size_t parts = 0;
   for (const auto& mesh : report["meshes"]) parts += mesh["vehicle_part"].get<bool>() ? 1 : 0;
