@@ -183,7 +183,7 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
   const double aperture_v = a.aperture_scale_vertical * g.beam_width_vertical_rad;
   horizontal_slots_ = tabulate(a.rays_horizontal, centred(aperture_h), horizontal);
   vertical_slots_ = tabulate(a.rays_vertical, centred(aperture_v), vertical);
-  if (sidelobe_level_ > 0.0) {
+  if (a.sidelobe_extent_deg > 0.0) {
     // A sidelobe ray stands for a stratum wider than a main-lobe ray's in both directions: its
     // pattern factor carries the ratio of their solid angles, so the weights stay the pattern's
     // integral over the rays' strata.
@@ -690,7 +690,8 @@ std::uint8_t BeamSynthesizer::Quantise(double level_db) const {
 }
 
 double BeamSynthesizer::SidelobePattern(double theta) const {
-  if (!(std::abs(theta) <= sidelobe_extent_rad_) || sidelobe_level_ <= 0.0) return 0.0;
+  // Without sidelobes θ_s² is 0 too: return before 0/0 on the axis.
+  if (sidelobe_level_ <= 0.0 || !(std::abs(theta) <= sidelobe_extent_rad_)) return 0.0;
   const double falloff = sidelobe_width2_ / (sidelobe_width2_ + theta * theta);
   return sidelobe_level_ * falloff * falloff;
 }
@@ -721,9 +722,10 @@ double BeamSynthesizer::DrawRays(const Eigen::Matrix3d& R_world_beam, Rng& rng,
           (v.cos * (h.cos * ahead + h.sin * left) + v.sin * up).cast<float>();
     }
   }
-  if (sidelobe_level_ <= 0.0) return weight_sum;
-  // The sidelobes' strata, left of the main lobe's rays then right, drawn as theirs are.
+  // The sidelobes' strata, if PrimaryRays counted any: left of the main lobe's rays then right,
+  // drawn as theirs are.
   std::size_t r = MainLobeRays(a);
+  if (r == directions.size()) return weight_sum;
   for (const double side : {1.0, -1.0}) {
     for (int i = 0; i < a.sidelobe_rays_horizontal; ++i) {
       const JitterSlot* stratum_h =
