@@ -4,6 +4,7 @@ simulated run with a real log bin by bin where `sonarbench fidelity` gives only 
 
     python3 tools/dataset_stats.py DIR [DIR ...] [--crossing T --from R] [--bins FIRST LAST]
                                    [--lit FIRST LAST] [--arc HEAD_DEG BIN]
+                                   [--behind-walls FIRST LAST]
 
 DIR is what `sonarbench simulate SCENE --out DIR` or `sonarbench import LOG.mat --out DIR`
 wrote. For each, per range band: the mean intensity, the share of bins at 0 and at 150 or
@@ -37,7 +38,11 @@ HEAD_DEG (the manifest's step), each beam's largest intensity within 2 bins of B
 over the beams at that head angle: a beam hears the point at its own range wherever its pattern
 reaches it, so the arc's width is the pattern's, not the beam's nominal width; then the arc's
 peak (the nearest the centre among equals), the contiguous head steps around it within 20
-units of it, and the arc at ±6 and ±12 steps. Standard library only.
+units of it, and the arc at ±6 and ±12 steps. With --behind-walls FIRST LAST, what a tank's
+beams hear behind its walls against how squarely they meet them: per head angle (to 0.1°) the
+mean of its beams per bin, its peak in bins FIRST to LAST (the wall), and the means over the
+bins 10-29, 30-69 and 70-129 past that peak; averaged per 5° band of head angle off the nearest
+side's normal (0°, 90°, 180°, 270°: a tank square to the sonar's axes). Standard library only.
 """
 import argparse
 import glob
@@ -285,7 +290,46 @@ def manifest_sensor(directory):
                  "and .step_angle_deg as numbers")
 
 
-def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None):
+BEHIND_BANDS_DEG = (0, 5, 10, 15, 20, 25, 30, 35, 40, 45)
+BEHIND_WINDOWS = ((10, 30), (30, 70), (70, 130))
+
+
+def behind_walls(with_angles, first, last):
+    """Per band of head angle off the nearest side's normal (0, 90, 180 and 270 degrees; bands
+    BEHIND_BANDS_DEG, the last closed): (low, high, cells, mean peak, [mean over each of
+    BEHIND_WINDOWS]) over the band's cells. A cell is a head angle (to 0.1°) and its beams' mean
+    per bin (over the beams long enough); its peak the largest of those in bins first..last, and
+    each window the mean over the bins that many past the peak (those past the beams' end left
+    out; a cell none of whose window's bins exist does not count for that window)."""
+    cells = {}
+    for angle, _, b in with_angles:
+        cells.setdefault(round(math.degrees(angle) % 360.0, 1) % 360.0, []).append(b)
+    bands = [[low, high, 0, 0.0, [[0.0, 0] for _ in BEHIND_WINDOWS]]
+             for low, high in zip(BEHIND_BANDS_DEG[:-1], BEHIND_BANDS_DEG[1:])]
+    for degrees, beams in cells.items():
+        length = max(len(b) for b in beams)
+        means = []
+        for k in range(length):
+            values = [b[k] for b in beams if len(b) > k]
+            means.append(sum(values) / len(values))
+        if first >= length:
+            continue
+        top = min(last, length - 1)
+        peak_bin = max(range(first, top + 1), key=lambda k: (means[k], -k))
+        off = min(abs((degrees - side + 180.0) % 360.0 - 180.0) for side in (0, 90, 180, 270))
+        band = next(b for b in bands if b[0] <= off < b[1] or (off == b[1] == BEHIND_BANDS_DEG[-1]))
+        band[2] += 1
+        band[3] += means[peak_bin]
+        for (start, end), total in zip(BEHIND_WINDOWS, band[4]):
+            window = means[peak_bin + start:peak_bin + end]
+            if window:
+                total[0] += sum(window) / len(window)
+                total[1] += 1
+    return [(low, high, n, peak / n, [t / c if c else None for t, c in windows])
+            for low, high, n, peak, windows in bands if n]
+
+
+def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None, behind=None):
     far_half, step_rad = manifest_sensor(directory)
     with_angles = load_beams(directory, with_angles=True)
     beams = [(size, b) for _, size, b in with_angles]
@@ -354,6 +398,14 @@ def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None)
                   ", ".join(f"at {off:+.1f}° " + (f"{m:.0f}" if m is not None else "none")
                             for off, m in sorted(flanks.items())))
 
+    if behind is not None:
+        print(f"  behind the walls (cells' peak in bins {behind[0]}-{behind[1]}, then the mean "
+              "over the bins " + ", ".join(f"{a}-{b - 1}" for a, b in BEHIND_WINDOWS) +
+              " past it), by head angle off the nearest side's normal:")
+        for low, high, n, peak, windows in behind_walls(with_angles, *behind):
+            print(f"    {low:2d}-{high:2d}°: {n} cells, peak {peak:.1f}, " +
+                  " / ".join(f"{w:.1f}" if w is not None else "none" for w in windows))
+
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__,
@@ -370,6 +422,9 @@ if __name__ == "__main__":
                              "over all beams and per octant of head angle")
     parser.add_argument("--arc", type=float, nargs=2, metavar=("HEAD_DEG", "BIN"),
                         help="also report bin BIN across the head steps within 12 of HEAD_DEG")
+    parser.add_argument("--behind-walls", type=int, nargs=2, metavar=("FIRST", "LAST"),
+                        help="also report, per band of head angle off the sides' normals, each "
+                             "head angle's mean peak in bins FIRST to LAST and the means past it")
     args = parser.parse_args()
     if (args.crossing is None) != (args.from_m is None):
         parser.error("--crossing and --from go together")
@@ -379,5 +434,8 @@ if __name__ == "__main__":
         parser.error(f"--lit {args.lit[0]} {args.lit[1]}: expected 0 <= FIRST < LAST")
     if args.arc is not None and (args.arc[1] < 0 or args.arc[1] != int(args.arc[1])):
         parser.error(f"--arc {args.arc[0]:g} {args.arc[1]:g}: expected BIN a whole number >= 0")
+    if args.behind_walls is not None and not 0 <= args.behind_walls[0] <= args.behind_walls[1]:
+        parser.error(f"--behind-walls {args.behind_walls[0]} {args.behind_walls[1]}: expected "
+                     "0 <= FIRST <= LAST")
     for d in args.directories:
-        report(d, args.crossing, args.from_m, args.bins, args.lit, args.arc)
+        report(d, args.crossing, args.from_m, args.bins, args.lit, args.arc, args.behind_walls)

@@ -178,6 +178,35 @@ def main():
         assert result.returncode != 0 and "expected BIN a whole number" in result.stderr, \
             result.stderr
 
+        # Behind the walls: head angles 0° and 92° (0-5° off the sides' normals) and 40° and 41°
+        # (40-45°). At 0° a peak of 200 at bin 100, then 50 over bins 110-129, 30 over 130-169
+        # and 20 over 170-229; at 92° a peak of 220 and nothing after it; at 40° a peak of 180 at
+        # bin 150, then 100, 80 and 60; at 41° a beam that ends 5 bins past its peak of 90, so it
+        # counts for the peak alone. Each angle seen twice (the same beam: the mean is it).
+        def wall_beam(length, peak_bin, peak, windows):
+            b = [0] * length
+            b[peak_bin] = peak
+            for (start, end), value in zip(((10, 30), (30, 70), (70, 130)), windows):
+                for k in range(peak_bin + start, min(peak_bin + end, length)):
+                    b[k] = value
+            return b
+        walls = [(0.0, wall_beam(BINS, 100, 200, (50, 30, 20))),
+                 (92.0, wall_beam(BINS, 100, 220, (0, 0, 0))),
+                 (40.0, wall_beam(BINS, 150, 180, (100, 80, 60))),
+                 (41.0, wall_beam(160, 155, 90, (0, 0, 0)))]
+        os.makedirs(os.path.join(tmp, "walls", "beams"))
+        write_beams(os.path.join(tmp, "walls", "beams", "sweep_0000.bin"),
+                    [b for _, b in walls] * 2, [math.radians(a) for a, _ in walls] * 2)
+        result = run(os.path.join(tmp, "walls"), "--behind-walls", "50", "300")
+        assert result.returncode == 0, result.stderr
+        assert "     0- 5°: 2 cells, peak 210.0, 25.0 / 15.0 / 10.0\n" in result.stdout, result.stdout
+        assert "    40-45°: 2 cells, peak 135.0, 100.0 / 80.0 / 60.0\n" in result.stdout, \
+            result.stdout
+        assert " 5-10°" not in result.stdout, result.stdout  # bands without cells are left out
+        result = run(os.path.join(tmp, "walls"), "--behind-walls", "300", "50")
+        assert result.returncode != 0 and "expected 0 <= FIRST <= LAST" in result.stderr, \
+            result.stderr
+
         # The fine texture: ten beams at consecutive head steps, beam b's bin k 100 + 10 (-1)^(k+b).
         # Each bin less its mean over the 31 bins around it is ±(10 + 10/31) (the window's odd one
         # out has the neighbours' sign), ±10 or so near the beam's end where the window is cut: along range the signs alternate (lag 1 and 3 near
@@ -217,7 +246,7 @@ def main():
         result = run(os.path.join(tmp, "bad"))
         assert result.returncode != 0, "a truncated file was accepted"
         assert "sweep_0000.bin: beam 0 truncated" in result.stderr, result.stderr
-    print("dataset_stats.py: shares, spreads, tail, arc, fine texture, a missing manifest and a "
+    print("dataset_stats.py: shares, spreads, tail, arc, behind the walls, fine texture, a missing manifest and a "
           "truncated file as expected")
 
 
