@@ -753,6 +753,48 @@ TEST(BeamSynthesis, GlintIsTheMirrorLobeTowardsTheSonar) {
   EXPECT_LT(echo(30.0 * kDegToRad, glint), 1e-100 * oblique);
 }
 
+// A glint is the sonar's mirror image, sound that came straight back: it takes the pulse's
+// skirts like any echo but feeds neither the reverberation nor the second trip. A wall 1 m
+// ahead at normal incidence that only glints is heard bit for bit the same with the tank's
+// reverberation and second trip as without them (skirts in both, and heard in front of the
+// wall); the same wall as a diffuse reflector gains a tail and a second trip.
+TEST(BeamSynthesis, GlintsFeedNoReverberationOrSecondTrip) {
+  SensorModel skirts = QuietSensor();
+  skirts.acoustics.aperture_scale_horizontal = 0.1;
+  skirts.acoustics.aperture_scale_vertical = 0.1;
+  skirts.acoustics.pulse_skirt_length_m = 0.05;
+  skirts.acoustics.pulse_skirt_db = 3.0;
+  SensorModel tank = skirts;
+  tank.acoustics.second_trip_db = 0.0;
+  tank.acoustics.reverberation_length_m = 0.5;
+  tank.acoustics.reverberation_db = -3.0;
+  Material glint;
+  glint.reflectivity = 0.0;
+  glint.specular_spread_rad = 20.0 * kDegToRad;
+  glint.glint = 0.2;
+  Material diffuse;
+  diffuse.reflectivity = 0.2;
+  diffuse.backscatter_exponent = 0.0;
+  const std::vector<TriangleMesh> wall = Wall(1.0, 0.0);
+  const RayTracer tracer(wall);
+  const auto echo = [&](const SensorModel& sensor, const Material& m) {
+    return BeamSynthesizer(sensor, tracer, {m})
+        .Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 12)
+        .echo_power;
+  };
+  const std::vector<double> glint_alone = echo(skirts, glint);
+  ASSERT_GT(std::accumulate(glint_alone.begin(), glint_alone.end(), 0.0), 0.0);
+  EXPECT_EQ(echo(tank, glint), glint_alone);
+  const double bin = skirts.geometry.bin_size_m;
+  const auto first = static_cast<std::size_t>(std::floor(1.0 / bin));
+  const auto after = static_cast<std::size_t>(std::ceil((1.0 + 0.5) / bin));
+  EXPECT_GT(glint_alone[first - 1], 0.0);  // the skirts
+  const std::vector<double> diffuse_alone = echo(skirts, diffuse);
+  const std::vector<double> diffuse_in_tank = echo(tank, diffuse);
+  EXPECT_GT(diffuse_in_tank[after], 2.0 * diffuse_alone[after]);                  // the tail
+  EXPECT_GT(diffuse_in_tank[2 * first + 2], 2.0 * diffuse_alone[2 * first + 2]);  // second trip
+}
+
 // A corner of two walls square to each other (a dihedral, its edge vertical, 2 m ahead, each
 // wall 45° off the beam) sends sound straight back: every ray leaves the second wall parallel to
 // the way it came, towards the sonar. With walls that only glint (no diffuse backscatter), the

@@ -60,9 +60,11 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
       materials_by_mesh_(std::move(materials_by_mesh)),
       vehicle_first_mesh_(static_cast<std::uint32_t>(materials_by_mesh_.size())),
       place_seed_(DeriveSeed(run_seed, 0x706c616365ULL)),
-      rough_mirrors_(std::ranges::any_of(materials_by_mesh_, [](const Material& m) {
-        return m.specular > 0.0 && m.specular_spread_rad > 0.0;
-      })) {
+      rough_mirrors_(std::ranges::any_of(
+          materials_by_mesh_,
+          [](const Material& m) { return m.specular > 0.0 && m.specular_spread_rad > 0.0; })),
+      scene_glints_(std::ranges::any_of(materials_by_mesh_,
+                                        [](const Material& m) { return m.glint > 0.0; })) {
   if (vehicle.meshes.size() != vehicle.materials.size()) {
     throw std::invalid_argument("BeamSynthesizer: " + std::to_string(vehicle.meshes.size()) +
                                 " vehicle meshes but " + std::to_string(vehicle.materials.size()) +
@@ -812,6 +814,7 @@ struct MirrorPath {
 struct StraightReturn {
   double range = 0.0;
   double weight = 0.0;
+  double glint = 0.0;  // its glint's part, apart (GlintDeposit)
 };
 
 // Adds echoes to a beam's bins: an echo of strength `strength` (before range losses) from range
@@ -907,8 +910,10 @@ struct BeamSynthesizer::Scratch {
   std::vector<bool> occluded;
   PulseSpreader spreader;
   PulseSpreader vehicle_spreader;  // the vehicle's echoes, apart from the scene's (FormLevels)
+  PulseSpreader glint_spreader;    // the scene's glints, apart from its diffuse echoes (FormLevels)
   std::vector<double> echo_power;
   std::vector<double> vehicle_power;
+  std::vector<double> glint_power;
   std::vector<double> impulse_power;  // the second trip's: each echo over one bin
   std::vector<double> speckle;
   std::vector<double> powers;
@@ -937,7 +942,8 @@ class BeamSynthesizer::BeamJob {
             T_world_sonar.linear() *
             Eigen::AngleAxisd(head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix()),
         origin_(T_world_sonar.translation().cast<float>()) {
-    for (PulseSpreader* spreader : {&scratch_.spreader, &scratch_.vehicle_spreader}) {
+    for (PulseSpreader* spreader :
+         {&scratch_.spreader, &scratch_.vehicle_spreader, &scratch_.glint_spreader}) {
       if (spreader->Bins() != bins_) spreader->Reset(bins_);  // AddTo() leaves it empty
     }
     if (s_.second_trip_ > 0.0) scratch_.impulse_power.assign(bins_, 0.0);
@@ -974,6 +980,10 @@ class BeamSynthesizer::BeamJob {
   // scene's skirts, second trip and reverberation).
   EchoDeposit VehicleDeposit() {
     return {s_, g_, a_.pulse_length_m, false, scratch_.vehicle_spreader, scratch_.impulse_power};
+  }
+  // The scene's glints: the pulse and its skirts, no second trip or reverberation (FormLevels).
+  EchoDeposit GlintDeposit() {
+    return {s_, g_, a_.pulse_length_m, false, scratch_.glint_spreader, scratch_.impulse_power};
   }
 
   const BeamSynthesizer& s_;
@@ -1067,6 +1077,7 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
   paths.clear();
   EchoDeposit deposit = Deposit();
   EchoDeposit vehicle_deposit = VehicleDeposit();
+  EchoDeposit glint_deposit = GlintDeposit();
   for (std::size_t r = 0; r < rays; ++r) {
     const auto& hit = hits[r];
     if (!hit) continue;
@@ -1082,10 +1093,15 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
     const Material& material = s_.materials_by_mesh_[hit->mesh];
     const double cos_incidence = std::abs(hit->normal.dot(direction));
     // Straight back: the mirror direction makes 2θ with it, cos 2θ = 2 cos²θ - 1.
-    (on_vehicle ? vehicle_deposit : deposit)(
-        range,
-        pattern * material.reflectivity * CosPower(cos_incidence, material.backscatter_exponent) +
-            pattern * Glint(material, 2.0 * cos_incidence * cos_incidence - 1.0));
+    const double diffuse =
+        pattern * material.reflectivity * CosPower(cos_incidence, material.backscatter_exponent);
+    const double glint = pattern * Glint(material, 2.0 * cos_incidence * cos_incidence - 1.0);
+    if (on_vehicle) {
+      vehicle_deposit(range, diffuse + glint);
+    } else {
+      deposit(range, diffuse);
+      if (glint > 0.0) glint_deposit(range, glint);
+    }
     if (a_.max_bounces > 0 && material.specular > 0.0 && !on_vehicle) {
       paths.push_back({.from = origin_,
                        .direction = direction,
@@ -1129,6 +1145,7 @@ void BeamSynthesizer::BeamJob::TraceMultipath() {
   const double spreading_db = a_.spreading_db_per_decade;
   const double max_range = max_range_;
   EchoDeposit deposit = Deposit();
+  EchoDeposit glint_deposit = GlintDeposit();
   Rng& echo_rng = *echo_rng_;
   std::vector<MirrorPath>& paths = scratch_.paths;
   std::vector<MirrorPath>& next_paths = scratch_.next_paths;
@@ -1176,8 +1193,10 @@ void BeamSynthesizer::BeamJob::TraceMultipath() {
       const double cos_in = std::abs(p.hit.normal.dot(p.direction));
       if (p.path <= max_range) {
         const double way = return_pattern(p) * p.specular * p.specular;
-        deposit(p.path, way * m.reflectivity * CosPower(cos_in, m.backscatter_exponent) +
-                            way * Glint(m, 2.0 * cos_in * cos_in - 1.0));
+        deposit(p.path, way * m.reflectivity * CosPower(cos_in, m.backscatter_exponent));
+        if (const double glint = way * Glint(m, 2.0 * cos_in * cos_in - 1.0); glint > 0.0) {
+          glint_deposit(p.path, glint);
+        }
       }
       const Eigen::Vector3f at = p.from + p.hit.distance * p.direction;
       const Eigen::Vector3d back = sonar - at.cast<double>();
@@ -1197,15 +1216,18 @@ void BeamSynthesizer::BeamJob::TraceMultipath() {
         glint = Glint(m, static_cast<double>(mirror.dot(to_sonar)));
       }
       stream.push_back({at + 1e-4f * to_sonar, to_sonar, static_cast<float>(d) - 2e-4f});
-      returns.push_back({range, (weight * m.reflectivity *
-                                     CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) +
-                                 weight * glint) *
-                                    std::pow(range / d, spreading_db / 10.0)});
+      const double last_leg = std::pow(range / d, spreading_db / 10.0);
+      returns.push_back({range,
+                         weight * m.reflectivity *
+                             CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) * last_leg,
+                         weight * glint * last_leg});
     }
     s_.tracer_.OccludedStream(stream, scratch_.occluded);
     out_.traced_rays += stream.size();
     for (std::size_t q = 0; q < returns.size(); ++q) {
-      if (!scratch_.occluded[q]) deposit(returns[q].range, returns[q].weight);
+      if (scratch_.occluded[q]) continue;
+      deposit(returns[q].range, returns[q].weight);
+      if (returns[q].glint > 0.0) glint_deposit(returns[q].range, returns[q].glint);
     }
   }
 }
@@ -1240,6 +1262,17 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
     }
   }
   s_.AddReverberation(echo);
+  if (s_.scene_glints_) {
+    // A glint is the sonar's mirror image, sound that came straight back: it has the pulse's
+    // skirts like any echo, but feeds no reverberation and no second trip (the real tank is
+    // quiet behind walls met squarely: README, "Fidelity", behind the walls).
+    std::vector<double>& glints = scratch_.glint_power;
+    glints.assign(bins_, 0.0);
+    scratch_.glint_spreader.AddTo(glints);
+    for (double& power : glints) power /= weight_sum_;
+    s_.AddPulseSkirts(glints);
+    for (std::size_t k = 0; k < bins_; ++k) echo[k] += glints[k];
+  }
   if (s_.vehicle_tracer_) {
     // The vehicle's echoes are heard as they are: the real log's show no skirts, second trip or
     // reverberation (behind the SHAD's own echo at 0.3 m its beams at head angle 0° are silent

@@ -271,6 +271,9 @@ class BeamSynthesizer {
   /// Whether any material is a rough mirror: only then do mirror paths track their image (the
   /// way back's direction).
   bool rough_mirrors_ = false;
+  /// Whether any of the scene's materials (not the vehicle's) glints: only then are its glints
+  /// kept apart from its diffuse echoes (FormLevels).
+  bool scene_glints_ = false;
   /// The second trip's level T (0: none) and, per bin i, the time-varied gain r^(G/10) at its
   /// centre r = (i + ½) bins and its inverse (AddSecondTrip).
   double second_trip_ = 0.0;

@@ -30,9 +30,10 @@ struct Material {
   /// The rough mirror's glint: what it sends towards the receiver around its mirror direction,
   /// as a fraction of a perfect reflector's echo [0-1]: g · exp(-α²/2σ²), α the angle between
   /// the mirror direction and the way to the receiver, σ specular_spread_rad (so it needs one).
-  /// Added to the diffuse backscatter wherever that is heard: at normal incidence, and where
-  /// mirror paths turn back to the sonar (a corner of two walls and the floor sends sound
-  /// straight back). 0, the default: none.
+  /// Heard wherever the diffuse backscatter is: at normal incidence, and where mirror paths
+  /// turn back to the sonar (a corner of two walls and the floor sends sound straight back).
+  /// The sonar's mirror image, not sound scattered into the place: it takes the pulse's skirts
+  /// but feeds neither the reverberation nor the second trip. 0, the default: none.
   double glint = 0.0;
 
   bool operator==(const Material&) const = default;
