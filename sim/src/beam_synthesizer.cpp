@@ -5,7 +5,6 @@
 #include <bit>
 #include <cmath>
 #include <complex>
-#include <cstring>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -506,35 +505,6 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void AddScaled(
   for (std::size_t k = 0; k < to.size(); ++k) to[k] += w * from[k];
 }
 
-// to[k] = Σ_d w[d] · from[d][k] over d in order, from 0 (the bits of a zeroed `to` given one
-// AddScaled per d), 32 bins at a time: each bin's running sum stays in a register over the
-// sources. Written with vectors of 8 doubles (GCC's vector extension), which each clone lowers
-// to its own width: left to the vectoriser, the loop over sources came out as shuffles.
-__attribute__((target_clones("avx512f", "avx2", "default"))) void WeightedSum(
-    std::span<double> to, std::span<const double* const> from, std::span<const double> w) {
-  using Vector = double __attribute__((vector_size(64)));
-  constexpr std::size_t kLanes = 8;
-  constexpr std::size_t kVectors = 4;
-  std::size_t k = 0;
-  for (; k + kLanes * kVectors <= to.size(); k += kLanes * kVectors) {
-    Vector sum[kVectors] = {};
-    for (std::size_t d = 0; d < from.size(); ++d) {
-      const Vector weight = Vector{} + w[d];
-      for (std::size_t v = 0; v < kVectors; ++v) {
-        Vector x;
-        std::memcpy(&x, from[d] + k + v * kLanes, sizeof x);
-        sum[v] += weight * x;
-      }
-    }
-    std::memcpy(to.data() + k, sum, sizeof sum);
-  }
-  for (; k < to.size(); ++k) {
-    double sum = 0.0;
-    for (std::size_t d = 0; d < from.size(); ++d) sum += w[d] * from[d][k];
-    to[k] = sum;
-  }
-}
-
 }  // namespace
 
 namespace {
@@ -547,16 +517,14 @@ void SectorSpeckleLook(std::span<double> factors, int window,
   const std::size_t length = factors.size() + size - 1;
   // A sector's phasors, kept per thread and look for the next beams: a static sonar's
   // neighbouring beams share all but one of their sectors. Keyed by seed and length, so what a
-  // beam gets does not depend on which beams the thread did before. A sector drawn replaces the
-  // one used least recently: with one slot more than a look hears, never one this look holds.
+  // beam gets does not depend on which beams the thread did before.
   struct Sector {
     std::uint64_t seed = 0;
-    std::uint64_t used = 0;  // the look that last used it (Cache::looks)
     std::vector<std::complex<double>> phasors;
   };
   struct Cache {
     std::vector<Sector> sectors;
-    std::uint64_t looks = 0;
+    std::size_t next_slot = 0;
   };
   thread_local std::vector<Cache> caches;
   if (caches.size() <= static_cast<std::size_t>(look)) {
@@ -566,41 +534,31 @@ void SectorSpeckleLook(std::span<double> factors, int window,
   if (cache.sectors.size() < amplitude_weights.size() + 1) {
     cache.sectors.resize(amplitude_weights.size() + 1);
   }
-  const std::uint64_t this_look = ++cache.looks;
   const auto phasors_of =
       [&](std::uint64_t sector_seed) -> const std::vector<std::complex<double>>& {
     const std::uint64_t seed =
         look == 0 ? sector_seed : DeriveSeed(sector_seed, static_cast<std::uint64_t>(look));
-    for (Sector& sector : cache.sectors) {
-      if (sector.seed == seed && sector.phasors.size() == length) {
-        sector.used = this_look;
-        return sector.phasors;
-      }
+    for (const Sector& sector : cache.sectors) {
+      if (sector.seed == seed && sector.phasors.size() == length) return sector.phasors;
     }
-    Sector& sector = *std::ranges::min_element(cache.sectors, {}, &Sector::used);
-    sector.used = this_look;
+    Sector& sector = cache.sectors[cache.next_slot];
+    cache.next_slot = (cache.next_slot + 1) % cache.sectors.size();
     sector.seed = seed;
     sector.phasors.resize(length);
     Rng rng(seed);
     for (auto& z : sector.phasors) z = DrawPhasor(rng);
     return sector.phasors;
   };
-  // The sectors heard, each a source of the weighted sum; a complex number is an array of its
-  // real and imaginary parts ([complex.numbers]).
-  thread_local std::vector<const double*> sources;
-  thread_local std::vector<double> weights;
-  sources.clear();
-  weights.clear();
+  thread_local std::vector<std::complex<double>> amplitudes;
+  amplitudes.assign(length, 0.0);
   for (std::size_t d = 0; d < amplitude_weights.size(); ++d) {
     const double w = amplitude_weights[d];
     if (w == 0.0) continue;
-    sources.push_back(reinterpret_cast<const double*>(phasors_of(sector_seeds[d]).data()));
-    weights.push_back(w);
+    const std::vector<std::complex<double>>& z = phasors_of(sector_seeds[d]);
+    // A complex number is an array of its real and imaginary parts ([complex.numbers]).
+    AddScaled(std::span(reinterpret_cast<double*>(amplitudes.data()), 2 * length),
+              std::span(reinterpret_cast<const double*>(z.data()), 2 * length), w);
   }
-  thread_local std::vector<std::complex<double>> amplitudes;
-  amplitudes.resize(length);
-  WeightedSum(std::span(reinterpret_cast<double*>(amplitudes.data()), 2 * length), sources,
-              weights);
   WindowPower(amplitudes, size, factors);
 }
 
