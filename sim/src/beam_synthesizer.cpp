@@ -870,8 +870,7 @@ struct BeamSynthesizer::Scratch {
   PulseSpreader vehicle_spreader;  // the vehicle's echoes, apart from the scene's (FormLevels)
   PulseSpreader glint_spreader;    // the scene's glints, apart from its diffuse echoes (FormLevels)
   std::vector<double> echo_power;
-  std::vector<double> vehicle_power;
-  std::vector<double> glint_power;
+  std::vector<double> apart_power;    // the vehicle's or the glints' (FormLevels)
   std::vector<double> impulse_power;  // the second trip's: each echo over one bin
   std::vector<double> speckle;
   std::vector<double> powers;
@@ -1220,26 +1219,24 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
     }
   }
   s_.AddReverberation(echo);
-  if (s_.scene_glints_) {
-    // A glint is the sonar's mirror image, sound that came straight back: it has the pulse's
-    // skirts like any echo, but feeds no reverberation and no second trip (the real tank is
-    // quiet behind walls met squarely: README, "Fidelity", behind the walls).
-    std::vector<double>& glints = scratch_.glint_power;
-    glints.assign(bins_, 0.0);
-    scratch_.glint_spreader.AddTo(glints);
-    for (double& power : glints) power /= weight_sum_;
-    s_.AddPulseSkirts(glints);
-    for (std::size_t k = 0; k < bins_; ++k) echo[k] += glints[k];
-  }
-  if (s_.vehicle_tracer_) {
-    // The vehicle's echoes are heard as they are: the real log's show no skirts, second trip or
-    // reverberation (behind the SHAD's own echo at 0.3 m its beams at head angle 0° are silent
-    // from 0.55 m to the floor at 1.45 m), so those are the tank's answers to its own echoes.
-    std::vector<double>& vehicle = scratch_.vehicle_power;
-    vehicle.assign(bins_, 0.0);
-    scratch_.vehicle_spreader.AddTo(vehicle);
-    for (std::size_t k = 0; k < bins_; ++k) echo[k] += vehicle[k] / weight_sum_;
-  }
+  // Echoes heard apart from the scene's diffuse ones, after its second trip and reverberation:
+  // a spreader's bins, with the pulse's skirts if `skirts`.
+  const auto add_apart = [&](PulseSpreader& spreader, bool skirts) {
+    std::vector<double>& apart = scratch_.apart_power;
+    apart.assign(bins_, 0.0);
+    spreader.AddTo(apart);
+    for (double& power : apart) power /= weight_sum_;
+    if (skirts) s_.AddPulseSkirts(apart);
+    for (std::size_t k = 0; k < bins_; ++k) echo[k] += apart[k];
+  };
+  // A glint is the sonar's mirror image, sound that came straight back: it has the pulse's
+  // skirts like any echo, but feeds no reverberation and no second trip (the real tank is quiet
+  // behind walls met squarely: README, "Fidelity", behind the walls).
+  if (s_.scene_glints_) add_apart(scratch_.glint_spreader, true);
+  // The vehicle's echoes are heard as they are: the real log's show no skirts, second trip or
+  // reverberation (behind the SHAD's own echo at 0.3 m its beams at head angle 0° are silent
+  // from 0.55 m to the floor at 1.45 m), so those are the tank's answers to its own echoes.
+  if (s_.vehicle_tracer_) add_apart(scratch_.vehicle_spreader, false);
   // The powers first, then their levels: no 8-bit store inside the loop that draws the noise.
   // The self-reflection is the sonar's own, not the place's: added after the speckle.
   std::vector<double>& self_reflection = scratch_.self_reflection;
