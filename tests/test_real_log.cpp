@@ -307,6 +307,31 @@ TEST(Fidelity, WallPeaksArePercentilesOfEachBeamsStrongestEcho) {
                    5.0);
 }
 
+// Behind the walls by the angle off the sides' normals: every beam's wall (200) at bin 170, and
+// 10-69 bins behind it a value by the beam's head angle past the last multiple of 90° (1.8°
+// steps): 60 at 0-19.8° and 40 at 70.2-88.2° (within 20° of a normal, one side or the other: 12
+// and 11 beams a quadrant, a mean of 1160 / 23), 100 at 30.6-43.2° and 80 at 46.8-59.4° (30-45°
+// off: 8 beams a quadrant each), 90 at 45° (a beam either side may count, or neither: the mean
+// is 90 with it or without it), and 150 between, which neither band holds; 10 elsewhere.
+TEST(Fidelity, BehindWallsSplitsTheBeamsByTheirAngleOffTheSidesNormals) {
+  const mapping::SensorGeometry sensor;
+  const std::vector<mapping::Beam> beams = TwoSweeps(sensor, [](int b, int k) -> std::uint8_t {
+    if (k == 170) return 200;
+    if (k < 180 || k > 239) return 10;
+    const int tenths = (b * 18) % 900;  // the head angle past the last multiple of 90°, in 0.1°
+    if (tenths <= 200) return 60;
+    if (tenths >= 700) return 40;
+    if (tenths == 450) return 90;
+    if (tenths >= 300 && tenths < 450) return 100;
+    if (tenths > 450 && tenths <= 600) return 80;
+    return 150;
+  });
+  const auto report = sim::CompareWithLog(beams, beams, sensor, 1.6);
+  EXPECT_NEAR(report.sim_behind_walls[0], 1160.0 / 23.0, 1e-12);
+  EXPECT_NEAR(report.sim_behind_walls[1], 90.0, 1e-12);
+  EXPECT_EQ(report.real_behind_walls, report.sim_behind_walls);
+}
+
 // The direct wall profile: the simulated walls (200) are at bin 170 at every head angle; the
 // real log's too, with a front of 60 over the 5 bins before them, but every 4th of its beams
 // also holds a ghost (230) at bin 250, its strongest echo. The all-beam profile aligns those on
@@ -544,6 +569,10 @@ struct RealTank {
   static constexpr double kWallPeakMedian = 157.0;
   static constexpr double kNearRangeMean = 16.46;  // bins 28-63: the vehicle's echoes
   static constexpr double kNearRangeAngleSpread = 23.46;
+  // Behind the walls (10-69 bins past the strongest echo), beams within 20° of a side's normal
+  // and 30-45° off it (FidelityReport::real_behind_walls).
+  static constexpr double kBehindSquare = 43.03;
+  static constexpr double kBehindCorners = 83.78;
   // Mean intensity over the bins whose centres lie in [0.4, 1.5), [1.5, 2), [2, 2.5), [2.5, 3),
   // [3, 4) and [4, 4.5) m (the far range past 4.5 m, 59.5, is a ring the model lacks).
   static constexpr std::array<std::array<double, 3>, 6> kBands = {{{0.4, 1.5, 7.21},
@@ -627,6 +656,8 @@ TEST(Fidelity, RecordedRealLogStatisticsAreTheLogs) {
   EXPECT_EQ(r.real_near_range.last_bin, 63u);
   EXPECT_NEAR(r.real_near_range.mean, RealTank::kNearRangeMean, 0.005);
   EXPECT_NEAR(r.real_near_range.angle_spread, RealTank::kNearRangeAngleSpread, 0.005);
+  EXPECT_NEAR(r.real_behind_walls[0], RealTank::kBehindSquare, 0.005);
+  EXPECT_NEAR(r.real_behind_walls[1], RealTank::kBehindCorners, 0.005);
   for (const auto& [from, to, real] : RealTank::kBands) {
     EXPECT_NEAR(BandMean(r.real_mean, g.bin_size_m, from, to), real, 0.005) << from << " m";
   }

@@ -209,6 +209,12 @@ int Fidelity(const FidelityArgs& args) {
             << report.real_wall_peak[1] << "/" << report.real_wall_peak[2]
             << "; behind it (16-120 bins), mean |difference| "
             << report.wall_tail_mean_abs_difference << "\n"
+            << "behind the walls (mean " << sim::FidelityReport::kBehindFirst << "-"
+            << sim::FidelityReport::kBehindLast << " bins past the strongest echo), beams within "
+            << sim::FidelityReport::kSquareDeg << " deg of a side's normal / "
+            << sim::FidelityReport::kCornerFromDeg << "-45 deg off it: sim "
+            << report.sim_behind_walls[0] << " / " << report.sim_behind_walls[1] << ", real "
+            << report.real_behind_walls[0] << " / " << report.real_behind_walls[1] << "\n"
             << "wall echo's front (20 bins before the strongest, over the beams whose strongest "
                "echo is the simulated wall: sim "
             << report.sim_direct_wall_beams << ", real " << report.real_direct_wall_beams

@@ -98,6 +98,32 @@ std::vector<double> WallProfile(std::span<const mapping::Beam> beams,
   return sum;
 }
 
+// FidelityReport::sim_behind_walls for `beams`: the wall profile over the beams whose head angle
+// lies in each band off the nearest side's normal, averaged over the offsets behind the wall.
+std::array<double, 2> BehindWalls(std::span<const mapping::Beam> beams,
+                                  const StrongestBins& strongest, std::size_t first_usable) {
+  using R = FidelityReport;
+  const std::array<std::array<double, 2>, 2> bands = {
+      {{0.0, R::kSquareDeg}, {R::kCornerFromDeg, 45.0}}};
+  std::array<double, 2> out{};
+  for (std::size_t band = 0; band < 2; ++band) {
+    StrongestBins in_band(strongest.size());
+    for (std::size_t b = 0; b < beams.size(); ++b) {
+      // std::remainder leaves the head angle within ±45° of the nearest multiple of 90°.
+      const double off =
+          std::abs(std::remainder(beams[b].head_angle_rad * 180.0 / std::numbers::pi, 90.0));
+      if (off >= bands[band][0] && off <= bands[band][1]) in_band[b] = strongest[b];
+    }
+    const std::vector<double> profile = WallProfile(beams, in_band, first_usable);
+    const auto from = static_cast<std::size_t>(R::kWallProfileBefore + R::kBehindFirst);
+    const auto to = static_cast<std::size_t>(R::kWallProfileBefore + R::kBehindLast);
+    out[band] = std::accumulate(profile.begin() + static_cast<long>(from),
+                                profile.begin() + static_cast<long>(to) + 1, 0.0) /
+                static_cast<double>(to - from + 1);
+  }
+  return out;
+}
+
 // `strongest`, less the beams whose strongest bin lies more than `reach` bins from the range
 // `wall_m` gives for their head angle (or whose angle has none); `kept` counts the rest.
 StrongestBins NearWall(std::span<const mapping::Beam> beams, const StrongestBins& strongest,
@@ -505,6 +531,8 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   r.wall_tail_mean_abs_difference =
       MeanAbsDifference(std::span(r.sim_wall_profile).subspan(tail_start),
                         std::span(r.real_wall_profile).subspan(tail_start));
+  r.sim_behind_walls = BehindWalls(sim, sim_strongest, first);
+  r.real_behind_walls = BehindWalls(real, real_strongest, first);
   r.sim_direct_wall_profile =
       WallProfile(sim,
                   NearWall(sim, sim_strongest, r.sim_wall_m, sensor,
@@ -678,6 +706,8 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"wall_angles_compared", r.wall_angles_compared},
                  {"wall_peak_intensity_p10_p50_p90_sim", r.sim_wall_peak},
                  {"wall_tail_mean_abs_difference", r.wall_tail_mean_abs_difference},
+                 {"behind_walls_square_corners_sim", r.sim_behind_walls},
+                 {"behind_walls_square_corners_real", r.real_behind_walls},
                  {"wall_peak_intensity_p10_p50_p90_real", r.real_wall_peak},
                  {"wall_front_mean_abs_difference", r.wall_front_mean_abs_difference},
                  {"direct_wall_beams_sim", r.sim_direct_wall_beams},

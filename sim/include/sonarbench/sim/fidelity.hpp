@@ -47,6 +47,18 @@ struct FidelityReport {
   /// strongest echo to the end: the tail behind the walls (reverberation, ghosts) alone.
   double wall_tail_mean_abs_difference = 0.0;
   static constexpr int kWallTailStart = 16;
+  /// What lies behind the walls against how squarely a beam meets them: the wall profile (above)
+  /// over the beams whose head angle lies within kSquareDeg of a side's normal (0°, 90°, 180°,
+  /// 270°: a tank square to head angle 0), and over those kCornerFromDeg-45° off it (towards the
+  /// corners), each averaged over the offsets kBehindFirst..kBehindLast past the strongest echo.
+  /// The real tank is quiet behind walls met squarely and loud towards its corners; a tail that
+  /// every echo feeds alike is not (README, "Fidelity", behind the walls).
+  std::array<double, 2> sim_behind_walls{};  // {met squarely, towards the corners}
+  std::array<double, 2> real_behind_walls{};
+  static constexpr double kSquareDeg = 20.0;
+  static constexpr double kCornerFromDeg = 30.0;
+  static constexpr int kBehindFirst = 10;
+  static constexpr int kBehindLast = 69;
   /// The wall profile again over the beams whose strongest echo is the wall the simulation
   /// puts there: within kDirectWallReach bins of the simulated run's median strongest range at
   /// the beam's head angle (sim_wall_m). The real log's strongest echo lies far behind its wall
