@@ -103,6 +103,8 @@ std::vector<double> WallProfile(std::span<const mapping::Beam> beams,
 std::array<double, 2> BehindWalls(std::span<const mapping::Beam> beams,
                                   const StrongestBins& strongest, std::size_t first_usable) {
   using R = FidelityReport;
+  static_assert(R::kBehindFirst >= 0 && R::kBehindLast <= R::kWallProfileAfter,
+                "the offsets behind the wall lie in the wall profile");
   const std::array<std::array<double, 2>, 2> bands = {
       {{0.0, R::kSquareDeg}, {R::kCornerFromDeg, 45.0}}};
   std::array<double, 2> out{};
