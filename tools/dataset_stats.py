@@ -86,6 +86,16 @@ def load_beams(directory, with_angles=False):
     return beams
 
 
+def head_cell(angle):
+    """A head angle [rad] as the cell it belongs to: degrees in [0, 360), to 0.1 degree."""
+    return round(math.degrees(angle) % 360.0, 1) % 360.0
+
+
+def off_side(degrees, side):
+    """How far [deg, 0-180] a head angle lies from a side's bearing."""
+    return abs((degrees - side + 180.0) % 360.0 - 180.0)
+
+
 def percentile(sorted_values, q):
     return sorted_values[min(len(sorted_values) - 1, int(q * len(sorted_values)))]
 
@@ -107,7 +117,7 @@ def cell_deviations(with_angles, first=FIRST_SPREAD_BIN):
     beam's end: (the bin size, the cells' means, each beam's deviations from them)."""
     by_angle = {}
     for angle, size, b in with_angles:
-        by_angle.setdefault(round(math.degrees(angle) % 360.0, 1) % 360.0, []).append((size, b))
+        by_angle.setdefault(head_cell(angle), []).append((size, b))
     for group in by_angle.values():
         if len(group) < 2:
             continue
@@ -145,7 +155,7 @@ def side_crossings(with_angles, threshold, from_m):
     for angle, size, b in with_angles:
         degrees = math.degrees(angle) % 360.0
         for side, ranges in sides.items():
-            off = abs((degrees - side + 180.0) % 360.0 - 180.0)
+            off = off_side(degrees, side)
             if off > 20.0:
                 continue
             for k in range(max(0, math.ceil(from_m / size - 0.5)), len(b)):
@@ -303,20 +313,20 @@ def behind_walls(with_angles, first, last):
     out; a cell none of whose window's bins exist does not count for that window)."""
     cells = {}
     for angle, _, b in with_angles:
-        cells.setdefault(round(math.degrees(angle) % 360.0, 1) % 360.0, []).append(b)
+        cells.setdefault(head_cell(angle), []).append(b)
     bands = [[low, high, 0, 0.0, [[0.0, 0] for _ in BEHIND_WINDOWS]]
              for low, high in zip(BEHIND_BANDS_DEG[:-1], BEHIND_BANDS_DEG[1:])]
     for degrees, beams in cells.items():
         length = max(len(b) for b in beams)
+        if first >= length:
+            continue
         means = []
         for k in range(length):
             values = [b[k] for b in beams if len(b) > k]
             means.append(sum(values) / len(values))
-        if first >= length:
-            continue
         top = min(last, length - 1)
         peak_bin = max(range(first, top + 1), key=lambda k: (means[k], -k))
-        off = min(abs((degrees - side + 180.0) % 360.0 - 180.0) for side in (0, 90, 180, 270))
+        off = min(off_side(degrees, side) for side in (0, 90, 180, 270))
         band = next(b for b in bands if b[0] <= off < b[1] or (off == b[1] == BEHIND_BANDS_DEG[-1]))
         band[2] += 1
         band[3] += means[peak_bin]
