@@ -1112,27 +1112,33 @@ void BeamSynthesizer::BeamJob::TraceMultipath() {
   for (int bounce = 1; bounce <= a_.max_bounces && !paths.empty(); ++bounce) {
     next_paths.clear();
     stream.clear();
-    for (MirrorPath p : paths) {
-      const Material& mirror = s_.materials_by_mesh_[p.hit.mesh];
-      p.specular *= mirror.specular;
-      if (p.specular <= 0.0 || p.path >= 2.0 * max_range) continue;
-      p.from += p.hit.distance * p.direction;
+    // Each path is read where it was and written where it goes: read back from a copy just
+    // made, its fields stalled on store forwarding (perf; 102 -> 92 ms a sweep, synthesis_bench).
+    for (const MirrorPath& was : paths) {
+      const Material& mirror = s_.materials_by_mesh_[was.hit.mesh];
+      const double specular = was.specular * mirror.specular;
+      if (specular <= 0.0 || was.path >= 2.0 * max_range) continue;
+      MirrorPath& p = next_paths.emplace_back(was);
+      p.specular = specular;
+      const Eigen::Vector3f step = was.hit.distance * was.direction;
+      const Eigen::Vector3f from = was.from + step;
+      p.from = from;
       if (s_.rough_mirrors_) {
-        p.image += p.unfold * (p.hit.distance * p.direction);
-        p.unfold -= 2.0f * (p.unfold * p.hit.normal) * p.hit.normal.transpose();
+        p.image = was.image + was.unfold * step;
+        p.unfold = was.unfold - 2.0f * (was.unfold * was.hit.normal) * was.hit.normal.transpose();
       }
       if (const double sigma = mirror.specular_spread_rad; sigma > 0.0) {
         const double variance = sigma * sigma;
-        p.blur[0] += variance;
-        p.blur[1] += variance * p.path;
-        p.blur[2] += variance * p.path * p.path;
+        p.blur[0] = was.blur[0] + variance;
+        p.blur[1] = was.blur[1] + variance * was.path;
+        p.blur[2] = was.blur[2] + variance * was.path * was.path;
       }
-      p.direction = s_.SpreadMirror(
-          (p.direction - 2.0f * p.direction.dot(p.hit.normal) * p.hit.normal).normalized(),
-          p.hit.normal, mirror, echo_rng);
-      stream.push_back({p.from + 1e-4f * p.direction, p.direction,
-                        static_cast<float>(2.0 * max_range - p.path)});
-      next_paths.push_back(p);
+      const Eigen::Vector3f direction = s_.SpreadMirror(
+          (was.direction - 2.0f * was.direction.dot(was.hit.normal) * was.hit.normal).normalized(),
+          was.hit.normal, mirror, echo_rng);
+      p.direction = direction;
+      stream.push_back(
+          {from + 1e-4f * direction, direction, static_cast<float>(2.0 * max_range - was.path)});
     }
     hits.resize(stream.size());
     s_.tracer_.IntersectStream(stream, hits);
@@ -1143,33 +1149,36 @@ void BeamSynthesizer::BeamJob::TraceMultipath() {
     returns.clear();
     for (std::size_t q = 0; q < next_paths.size(); ++q) {
       if (!hits[q]) continue;
-      MirrorPath& p = paths.emplace_back(next_paths[q]);
-      p.hit = *hits[q];
-      p.path += p.hit.distance;
-      const Material& m = s_.materials_by_mesh_[p.hit.mesh];
-      const double cos_in = std::abs(p.hit.normal.dot(p.direction));
-      if (p.path <= max_range) {
-        const double way = return_pattern(p) * p.specular * p.specular;
-        deposit(p.path, way * m.reflectivity * CosPower(cos_in, m.backscatter_exponent));
+      const MirrorPath& was = next_paths[q];
+      const Hit& hit = *hits[q];
+      const double path = was.path + hit.distance;
+      MirrorPath& p = paths.emplace_back(was);
+      p.hit = hit;
+      p.path = path;
+      const Material& m = s_.materials_by_mesh_[hit.mesh];
+      const double cos_in = std::abs(hit.normal.dot(was.direction));
+      if (path <= max_range) {
+        const double way = return_pattern(p) * was.specular * was.specular;
+        deposit(path, way * m.reflectivity * CosPower(cos_in, m.backscatter_exponent));
         if (const double glint = way * Glint(m, 2.0 * cos_in * cos_in - 1.0); glint > 0.0) {
-          glint_deposit(p.path, glint);
+          glint_deposit(path, glint);
         }
       }
-      const Eigen::Vector3f at = p.from + p.hit.distance * p.direction;
+      const Eigen::Vector3f at = was.from + hit.distance * was.direction;
       const Eigen::Vector3d back = sonar - at.cast<double>();
       const double d = back.norm();
-      const double range = 0.5 * (p.path + d);
+      const double range = 0.5 * (path + d);
       if (range > max_range || d < g_.bin_size_m) continue;
       const double receive = one_way_pattern(-back / d);
       // Culled on the largest its law can give: ρ for the diffuse part, g for the glint.
-      const double weight = 2.0 * std::sqrt(p.pattern) * receive * p.specular;
+      const double weight = 2.0 * std::sqrt(was.pattern) * receive * was.specular;
       if (weight * std::max(m.reflectivity, m.glint) < kNegligibleWeight) continue;
       const Eigen::Vector3f to_sonar = (back / d).cast<float>();
-      const double cos_out = std::abs(p.hit.normal.dot(to_sonar));
+      const double cos_out = std::abs(hit.normal.dot(to_sonar));
       double glint = 0.0;  // towards the sonar from the mirror direction, if m glints
       if (m.glint > 0.0) {
         const Eigen::Vector3f mirror =
-            p.direction - 2.0f * p.direction.dot(p.hit.normal) * p.hit.normal;
+            was.direction - 2.0f * was.direction.dot(hit.normal) * hit.normal;
         glint = Glint(m, static_cast<double>(mirror.dot(to_sonar)));
       }
       stream.push_back({at + 1e-4f * to_sonar, to_sonar, static_cast<float>(d) - 2e-4f});
