@@ -1827,6 +1827,99 @@ TEST(BeamSynthesis, SidelobesLeaveTheFirstHitToTheMainLobe) {
   EXPECT_GT(beam.echo_power[plate_bin + 1], 0.0);
 }
 
+// The back lobe, sent and heard: plates facing the sonar 1 m ahead and 1 m behind, each wider
+// and taller than what its lobe's rays reach (the main lobe's ±1.5° × ±17.5°, the back lobe's
+// ±60° either way at σ = 20°), return echo powers in the ratio of the two-way patterns'
+// integrals over them, each ray's echo cos φ cos ε of the plate's (its incidence): B² ∬
+// exp(-(φ² + ε²)/σ²) cos φ cos² ε dφ dε behind (a back-lobe stratum spans cos ε dφ dε) against
+// ∬ exp(-k_h θ² - k_v ε²) cos θ cos ε dθ dε ahead, both separable. No range loss, the farthest
+// echo at 1 / cos² 60° = 4 m (inside the 5 m of bins), and 64 pings: 1% holds the strata's
+// sampling many times over, and a stratum's cos ε, 3% here, is outside it. Without a back lobe the
+// plate behind is not heard, and the plate ahead is heard the same with or without it (the back
+// lobe's weights stay out of the beam's normalisation).
+TEST(BeamSynthesis, BackLobeHearsAPlateBehindAsItsPatternSays) {
+  SensorModel sensor = QuietSensor();
+  Acoustics& a = sensor.acoustics;
+  a.back_lobe_width_deg = 20.0;
+  a.back_lobe_db = -10.0;
+  a.back_lobe_rays = 24;
+  const double deg = mapping::kDegToRad;
+  const auto echo = [&](const SensorModel& model, const std::vector<TriangleMesh>& plate) {
+    double total = 0.0;
+    for (std::uint64_t seed = 1; seed <= 64; ++seed) total += TotalPower(Ping(model, plate, seed));
+    return total;
+  };
+  const double reach = std::tan(65.0 * deg);
+  const std::vector<TriangleMesh> ahead = Plate(1.0, 0.0, 65.0 * deg, 2.0 * reach);
+  const std::vector<TriangleMesh> behind = Plate(1.0, std::numbers::pi, 65.0 * deg, 2.0 * reach);
+  const double main_lobe = echo(sensor, ahead);
+  const double back_lobe = echo(sensor, behind);
+  const auto integral = [deg](double half_deg, const auto& f) {
+    double sum = 0.0;
+    constexpr int kSteps = 20000;
+    for (int i = 0; i < kSteps; ++i) sum += f((-1.0 + (2.0 * i + 1.0) / kSteps) * half_deg * deg);
+    return sum * 2.0 * half_deg * deg / kSteps;
+  };
+  const double k_h = 4.0 * std::log(2.0) / std::pow(sensor.geometry.beam_width_horizontal_rad, 2);
+  const double k_v = 4.0 * std::log(2.0) / std::pow(sensor.geometry.beam_width_vertical_rad, 2);
+  const double expected_main =
+      integral(1.5, [&](double t) { return std::exp(-k_h * t * t) * std::cos(t); }) *
+      integral(17.5, [&](double e) { return std::exp(-k_v * e * e) * std::cos(e); });
+  const double k_b = 1.0 / std::pow(20.0 * deg, 2);
+  const double expected_back =
+      std::pow(10.0, 2.0 * a.back_lobe_db / 10.0) *
+      integral(60.0, [&](double p) { return std::exp(-k_b * p * p) * std::cos(p); }) *
+      integral(60.0, [&](double e) { return std::exp(-k_b * e * e) * std::pow(std::cos(e), 2); });
+  EXPECT_NEAR(back_lobe / main_lobe, expected_back / expected_main,
+              0.01 * expected_back / expected_main);
+
+  SensorModel none = sensor;
+  none.acoustics.back_lobe_width_deg = 0.0;
+  EXPECT_EQ(echo(none, behind), 0.0);
+  EXPECT_EQ(echo(none, ahead), main_lobe);
+}
+
+// A mirror path's last leg heard behind: a mirror 1 m ahead (no echo of its own) sends each
+// ray back past the sonar to a plate 2 m behind it (no mirror), whose echo straight back comes
+// from behind at (4 + 2) / 2 = 3 m. It is heard through the back lobe's one-way pattern B (and,
+// by reciprocity, sent through it), so its power is B's: 10 times as much at -10 dB as at -20
+// dB, to rounding (the rays and their normalisation are the same), and none without a back
+// lobe. Nothing else lies at 2.9-3.6 m: the plate's own echoes through the back lobe end before
+// 2 / cos² 30° + the pulse = 2.72 m, the mirror path back the way it came is at 4 m.
+TEST(BeamSynthesis, BackLobeHearsAMirrorPathsLastLegInProportionToItsLevel) {
+  const double deg = mapping::kDegToRad;
+  std::vector<TriangleMesh> meshes = Wall(1.0, 0.0);
+  const double reach = std::tan(40.0 * deg) * 2.0;
+  meshes.push_back(Plate(2.0, std::numbers::pi, 40.0 * deg, 2.0 * reach).front());
+  const RayTracer tracer(meshes);
+  Material mirror;
+  mirror.reflectivity = 0.0;
+  mirror.specular = 1.0;
+  Material plate;
+  plate.reflectivity = 0.5;
+  const auto power_at_3m = [&](double back_lobe_width_deg, double back_lobe_db) {
+    SensorModel sensor = QuietSensor();
+    sensor.acoustics.max_bounces = 1;
+    sensor.acoustics.back_lobe_width_deg = back_lobe_width_deg;
+    sensor.acoustics.back_lobe_db = back_lobe_db;
+    const BeamSynthesizer synthesizer(sensor, tracer, {mirror, plate});
+    const SynthesizedBeam beam =
+        synthesizer.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 11);
+    const double bin = sensor.geometry.bin_size_m;
+    double sum = 0.0;
+    for (auto k = static_cast<std::size_t>(2.9 / bin); k < static_cast<std::size_t>(3.6 / bin);
+         ++k) {
+      sum += beam.echo_power[k];
+    }
+    return sum;
+  };
+  const double at_10 = power_at_3m(10.0, -10.0);
+  const double at_20 = power_at_3m(10.0, -20.0);
+  EXPECT_GT(at_20, 0.0);
+  EXPECT_NEAR(at_10 / at_20, 10.0, 1e-9);
+  EXPECT_EQ(power_at_3m(0.0, -10.0), 0.0);
+}
+
 // A sensor whose only return is a flat self-reflection profile, `bins` long at -21 dB: 19 dB
 // above the AD window's foot, level 121.1 (quantised 121), clear of both ends by over 4σ for
 // the spreads tested below (1.5 dB).

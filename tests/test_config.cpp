@@ -380,6 +380,25 @@ TEST(SceneFile, SidelobesMustReachPastTheMainLobe) {
   for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
 }
 
+// The sensor model has no back lobe unless asked for (a scene's acoustics may add one: its
+// strata then join the primary rays); a level over the main lobe's, a width past 90°, or no
+// strata, are refused with the key and line.
+TEST(SceneFile, BackLobeIsOffUnlessAskedForAndChecked) {
+  const sim::SensorModel micron =
+      sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
+  EXPECT_EQ(micron.acoustics.back_lobe_width_deg, 0.0);
+  sim::Acoustics with_back_lobe = micron.acoustics;
+  with_back_lobe.back_lobe_width_deg = 30.0;
+  with_back_lobe.back_lobe_rays = 8;
+  EXPECT_EQ(sim::PrimaryRays(with_back_lobe), 640u + 64u);
+  const std::pair<std::string, std::vector<std::string>> cases[] = {
+      {"  back_lobe_db: 1\n  back_lobe_width_deg: 30\n", {"'sonar_acoustics.back_lobe_db'", "'1'"}},
+      {"  back_lobe_width_deg: 91\n", {"'sonar_acoustics.back_lobe_width_deg'", "'91'"}},
+      {"  back_lobe_rays: 0\n  back_lobe_width_deg: 30\n",
+       {"'sonar_acoustics.back_lobe_rays'", "'0'"}}};
+  for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
+}
+
 // The sidelobes' trial is the fitted tank with only what its comment names changed: the
 // sidelobes, the ceiling, the gain and the walls' glint.
 TEST(SceneFile, SidelobesTrialIsTheTankWithItsChangesOnly) {

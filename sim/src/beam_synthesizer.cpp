@@ -198,6 +198,24 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
         [&](double angle) { return area * horizontal(angle); });
     sidelobe_vertical_slots_ = tabulate(a.sidelobe_rays_vertical, centred(aperture_v), vertical);
   }
+  if (a.back_lobe_width_deg > 0.0) {
+    back_level_ = std::pow(10.0, a.back_lobe_db / 10.0);
+    const double sigma = a.back_lobe_width_deg * mapping::kDegToRad;
+    back_k_ = 1.0 / (sigma * sigma);
+    // Strata over ±min(3σ, 90°) about the axis behind in both directions. A stratum at
+    // elevation ε spans Δφ cos ε · Δε of solid angle; a main-lobe ray stands for Δθ · Δε_main.
+    const double span = 2.0 * std::min(3.0 * sigma, 0.5 * std::numbers::pi);
+    const double stratum = span / a.back_lobe_rays;
+    const double level = back_level_ * back_level_;
+    back_horizontal_slots_ = tabulate(a.back_lobe_rays, centred(span), [&](double angle) {
+      return level * std::exp(-back_k_ * angle * angle) * stratum /
+             (aperture_h / a.rays_horizontal);
+    });
+    back_vertical_slots_ = tabulate(a.back_lobe_rays, centred(span), [&](double angle) {
+      return std::exp(-back_k_ * angle * angle) * std::cos(angle) * stratum /
+             (aperture_v / a.rays_vertical);
+    });
+  }
 
   if (a.level_jitter_db > 0.0) {
     level_jitter_factors_.reserve(kLevelJitters);
@@ -691,6 +709,15 @@ std::uint8_t BeamSynthesizer::Quantise(double level_db) const {
   return static_cast<std::uint8_t>(std::clamp(scaled, 0.0, 255.0));
 }
 
+double BeamSynthesizer::BackLobePattern(const Eigen::Vector3d& u, double blur) const {
+  if (back_level_ <= 0.0) return 0.0;
+  const double phi = std::atan2(u.y(), -u.x());
+  const double epsilon = std::asin(std::clamp(u.z(), -1.0, 1.0));
+  // exp(-k θ²/2) per direction, each averaged over a Gaussian offset of variance `blur`.
+  const double wide = 1.0 + back_k_ * blur;
+  return back_level_ * std::exp(-0.5 * back_k_ * (phi * phi + epsilon * epsilon) / wide) / wide;
+}
+
 double BeamSynthesizer::SidelobePattern(double theta) const {
   // Without sidelobes θ_s² is 0 too: return before 0/0 on the axis.
   if (sidelobe_level_ <= 0.0 || !(std::abs(theta) <= sidelobe_extent_rad_)) return 0.0;
@@ -724,25 +751,39 @@ double BeamSynthesizer::DrawRays(const Eigen::Matrix3d& R_world_beam, Rng& rng,
           (v.cos * (h.cos * ahead + h.sin * left) + v.sin * up).cast<float>();
     }
   }
-  // The sidelobes' strata, if PrimaryRays counted any: left of the main lobe's rays then right,
-  // drawn as theirs are.
+  // Further strata after the main lobe's, drawn as theirs are: `h_strata` horizontal ones of
+  // `h_slots` on the side `side` of the horizontal axis `axis`, each split into `v_strata` of
+  // `v_slots`; their weights added to the sum if `counted`.
   std::size_t r = MainLobeRays(a);
-  if (r == directions.size()) return weight_sum;
-  for (const double side : {1.0, -1.0}) {
-    for (int i = 0; i < a.sidelobe_rays_horizontal; ++i) {
-      const JitterSlot* stratum_h =
-          &sidelobe_horizontal_slots_[static_cast<std::size_t>(i) * kJitterSlots];
-      for (int j = 0; j < a.sidelobe_rays_vertical; ++j, ++r) {
+  const auto draw_strata = [&](const std::vector<JitterSlot>& h_slots, int h_strata,
+                               const std::vector<JitterSlot>& v_slots, int v_strata,
+                               const Eigen::Vector3d& axis, double side, bool counted) {
+    for (int i = 0; i < h_strata; ++i) {
+      const JitterSlot* stratum_h = &h_slots[static_cast<std::size_t>(i) * kJitterSlots];
+      for (int j = 0; j < v_strata; ++j, ++r) {
         const std::uint64_t draw = rng.Next();
         const JitterSlot& h = stratum_h[(draw >> 32) & kSlotMask];
-        const JitterSlot& v = sidelobe_vertical_slots_[static_cast<std::size_t>(j) * kJitterSlots +
-                                                       ((draw >> 48) & kSlotMask)];
+        const JitterSlot& v =
+            v_slots[static_cast<std::size_t>(j) * kJitterSlots + ((draw >> 48) & kSlotMask)];
         const double pattern = h.weight * v.weight;
-        weight_sum += pattern;
+        if (counted) weight_sum += pattern;
         patterns[r] = pattern;
-        directions[r] = (v.cos * (h.cos * ahead + side * h.sin * left) + v.sin * up).cast<float>();
+        directions[r] = (v.cos * (h.cos * axis + side * h.sin * left) + v.sin * up).cast<float>();
       }
     }
+  };
+  // The sidelobes', if PrimaryRays counted any: left of the main lobe's rays, then right.
+  if (a.sidelobe_extent_deg > 0.0) {
+    for (const double side : {1.0, -1.0}) {
+      draw_strata(sidelobe_horizontal_slots_, a.sidelobe_rays_horizontal, sidelobe_vertical_slots_,
+                  a.sidelobe_rays_vertical, ahead, side, true);
+    }
+  }
+  // The back lobe's, if PrimaryRays counted any, about the axis behind; their weights stay out
+  // of the sum (Acoustics::back_lobe_width_deg).
+  if (a.back_lobe_width_deg > 0.0) {
+    draw_strata(back_horizontal_slots_, a.back_lobe_rays, back_vertical_slots_, a.back_lobe_rays,
+                -ahead, 1.0, false);
   }
   return weight_sum;
 }
@@ -821,8 +862,9 @@ class EchoDeposit {
 };
 
 // A beam's one-way pattern towards a world direction (unit), R_beam_world taking world
-// directions into the beam's frame (x along its axis, z up the fan): 0 outside the half-space
-// ahead; with `blur` > 0 its mean over a 2-D Gaussian offset of that variance per axis [rad²]:
+// directions into the beam's frame (x along its axis, z up the fan): the back lobe's, if any,
+// outside the half-space ahead; with `blur` > 0 its mean over a 2-D Gaussian offset of that
+// variance per axis [rad²]:
 // for exp(-k θ²/2) per axis, exp(-k θ² / (2 (1 + k τ²))) / √(1 + k τ²). k_h and k_v are the
 // two-way pattern's exponents.
 struct OneWayPattern {
@@ -833,7 +875,7 @@ struct OneWayPattern {
 
   double operator()(const Eigen::Vector3d& towards, double blur = 0.0) const {
     const Eigen::Vector3d u = R_beam_world * towards;
-    if (u.x() <= 0.0) return 0.0;
+    if (u.x() <= 0.0) return synthesizer.BackLobePattern(u, blur);
     const double theta = std::atan2(u.y(), u.x());
     const double epsilon = std::asin(std::clamp(u.z(), -1.0, 1.0));
     const double wide_h = 1.0 + k_h * blur;

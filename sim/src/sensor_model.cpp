@@ -9,9 +9,15 @@ std::size_t MainLobeRays(const Acoustics& a) {
 }
 
 std::size_t PrimaryRays(const Acoustics& a) {
-  if (a.sidelobe_extent_deg <= 0.0) return MainLobeRays(a);
-  return MainLobeRays(a) + 2 * static_cast<std::size_t>(a.sidelobe_rays_horizontal) *
-                               static_cast<std::size_t>(a.sidelobe_rays_vertical);
+  std::size_t rays = MainLobeRays(a);
+  if (a.sidelobe_extent_deg > 0.0) {
+    rays += 2 * static_cast<std::size_t>(a.sidelobe_rays_horizontal) *
+            static_cast<std::size_t>(a.sidelobe_rays_vertical);
+  }
+  if (a.back_lobe_width_deg > 0.0) {
+    rays += static_cast<std::size_t>(a.back_lobe_rays) * static_cast<std::size_t>(a.back_lobe_rays);
+  }
+  return rays;
 }
 
 void ReadAcoustics(YamlReader& node, Acoustics& a) {
@@ -24,6 +30,9 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("sidelobe_width_deg", a.sidelobe_width_deg, InRange(0.01, 89.0));
   node.Optional("sidelobe_rays_horizontal", a.sidelobe_rays_horizontal, IntInRange(1, 1024));
   node.Optional("sidelobe_rays_vertical", a.sidelobe_rays_vertical, IntInRange(1, 8192));
+  node.Optional("back_lobe_width_deg", a.back_lobe_width_deg, InRange(0.0, 90.0));
+  node.Optional("back_lobe_db", a.back_lobe_db, InRange(-100.0, 0.0));
+  node.Optional("back_lobe_rays", a.back_lobe_rays, IntInRange(1, 1024));
   node.Optional("spreading_db_per_decade", a.spreading_db_per_decade, InRange(0.0, 80.0));
   node.Optional("absorption_db_per_m", a.absorption_db_per_m, InRange(0.0, 100.0));
   node.Optional("tvg_db_per_decade", a.tvg_db_per_decade, InRange(0.0, 80.0));

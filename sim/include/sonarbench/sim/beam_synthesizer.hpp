@@ -97,15 +97,21 @@ class BeamSynthesizer {
                                            EchoPower echo_power = EchoPower::kKeep) const;
 
   /// A beam's primary rays, for a beam whose frame (x along its axis, z up the fan) is
-  /// `R_world_beam`: rays_horizontal × rays_vertical, one per stratum, then the sidelobes' (if
-  /// any, PrimaryRays), each at a jitter slot in both directions picked by one draw from `rng`.
-  /// Writes their world directions and two-way pattern weights; returns the weights' sum.
+  /// `R_world_beam`: rays_horizontal × rays_vertical, one per stratum, then the sidelobes' and
+  /// the back lobe's (if any, PrimaryRays), each at a jitter slot in both directions picked by
+  /// one draw from `rng`. Writes their world directions and two-way pattern weights; returns
+  /// the sum of the main lobe's and the sidelobes' weights (the beam's normalisation).
   double DrawRays(const Eigen::Matrix3d& R_world_beam, Rng& rng,
                   std::vector<Eigen::Vector3f>& directions, std::vector<double>& patterns) const;
 
   /// The sidelobes' share of the two-way horizontal pattern at θ [rad] off the axis
   /// (Acoustics::sidelobe_extent_deg): S (θ_s² / (θ_s² + θ²))² within the extent, else 0.
   [[nodiscard]] double SidelobePattern(double theta) const;
+
+  /// The back lobe's one-way pattern (Acoustics::back_lobe_width_deg) towards `u`, a unit
+  /// direction in the beam's frame (x along its axis) with u.x ≤ 0; with `blur` > 0 its mean
+  /// over a 2-D Gaussian offset of that variance per axis [rad²]. 0 without a back lobe.
+  [[nodiscard]] double BackLobePattern(const Eigen::Vector3d& u, double blur) const;
 
   /// Maps a level [dB] to the 8-bit intensity the sonar would report: the AD window's step,
   /// under the receiver's ceiling (Acoustics::ad_knee, ad_ceiling), rounded.
@@ -327,6 +333,13 @@ class BeamSynthesizer {
   double sidelobe_extent_rad_ = 0.0;
   std::vector<JitterSlot> sidelobe_horizontal_slots_;
   std::vector<JitterSlot> sidelobe_vertical_slots_;
+  /// The back lobe (Acoustics::back_lobe_width_deg), if any: B, 1/σ² [rad⁻²], and its strata's
+  /// slots (factors: the two-way pattern B² exp(-θ²/σ²) split between the two directions, times
+  /// the ratio of a stratum's solid angle to a main-lobe one's).
+  double back_level_ = 0.0;
+  double back_k_ = 0.0;
+  std::vector<JitterSlot> back_horizontal_slots_;
+  std::vector<JitterSlot> back_vertical_slots_;
   /// kSpreadOffsets standard 2-D Gaussian offsets (SpreadMirror).
   std::vector<Eigen::Vector2f> spread_offsets_;
 };

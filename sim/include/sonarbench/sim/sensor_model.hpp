@@ -34,6 +34,17 @@ struct Acoustics {
   double sidelobe_width_deg = 5.0;
   int sidelobe_rays_horizontal = 4;
   int sidelobe_rays_vertical = 40;
+  /// A back lobe: with `back_lobe_width_deg` [deg] > 0 the transducer also sends and hears,
+  /// weakly, behind it. Its one-way pattern there is B exp(-θ²/2σ²), θ the angle off the axis
+  /// behind, B = 10^(back_lobe_db/10) and σ = `back_lobe_width_deg`; an echo sent and heard
+  /// behind is B² down, one sent ahead and heard behind (a mirror path's last leg) B. Sampled by
+  /// `back_lobe_rays` × `back_lobe_rays` strata over min(3σ, 90°) either side of that axis in
+  /// both directions, each weighted by its solid angle. The echoes it adds are not counted in
+  /// the beam's normalisation (a back lobe does not dim what lies ahead), and the first-hit
+  /// truth stays the main lobe's. 0, the default: no back lobe (no rays).
+  double back_lobe_width_deg = 0.0;
+  double back_lobe_db = -30.0;
+  int back_lobe_rays = 8;
   /// Net geometric loss of an area-scattering echo [dB per decade of range] (two-way spherical
   /// spreading, 40 dB, less the growth of the ensonified area, 20 dB).
   double spreading_db_per_decade = 20.0;
