@@ -20,18 +20,19 @@ namespace {
 using mapping::kDegToRad;
 
 // The default tank scenario, run once for the whole suite (≈ 15 s on 2 cores); ctest runs this
-// executable as one test so that the run is shared. Multipath, the tank's reverberation, its
-// second trip and its pulse's skirts are switched off here, so that "nothing echoes from beyond
-// a wall" holds exactly and a wall's echo starts at the wall, and so is its scattering's
-// correlation across azimuth (its texture in long arcs leaves whole sectors of floor unmapped);
-// BeamSynthesis tests both on their own. The scene's floor is fitted as faint as the real log's and
-// its threshold (110) set against the reverberation, so it maps little floor. These tests are about
-// where echoes land, so the walls here are bright (reflectivity 0.5, where the fitted 0.012
-// matches the real log's moderate wall echoes), the floor brighter (0.2, cos^0.5: 12 times the
-// fitted floor's 0.03 cos¹ where the fan meets it, at 72.5° incidence)
-// and, with no ghosts to reject, the threshold 90: the floor's echo is a run of its own before
-// the wall's in nearly every beam. (A floor as bright as the walls merges with their echo into
-// one run at the floor's range: with the threshold 60, 34-75 of a wall's 88-90 columns mapped.)
+// executable as one test so that the run is shared. Multipath, the tank's reverberation, its second
+// trip, its pulse's skirts and the back lobe (which hears the wall behind the sonar) are switched
+// off here, so that "nothing echoes from beyond a wall" holds exactly and a wall's echo starts at
+// the wall, and so is its scattering's correlation across azimuth (its texture in long arcs leaves
+// whole sectors of floor unmapped); BeamSynthesis tests both on their own. The scene's floor is
+// fitted as faint as the real log's and its threshold (110) set against the reverberation, so it
+// maps little floor. These tests are about where echoes land, so the walls here are bright
+// (reflectivity 0.5, where the fitted 0.012 matches the real log's moderate wall echoes), the floor
+// brighter (0.2, cos^0.5: 12 times the fitted floor's 0.03 cos¹ where the fan meets it, at 72.5°
+// incidence) and, with no ghosts to reject, the threshold 90: the floor's echo is a run of its own
+// before the wall's in nearly every beam. (A floor as bright as the walls merges with their echo
+// into one run at the floor's range: with the threshold 60, 34-75 of a wall's 88-90 columns
+// mapped.)
 class TankScenario : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -44,6 +45,7 @@ class TankScenario : public ::testing::Test {
     scene_->sensor.acoustics.reverberation_length_m = 0.0;
     scene_->sensor.acoustics.second_trip_db = -100.0;
     scene_->sensor.acoustics.pulse_skirt_length_m = 0.0;
+    scene_->sensor.acoustics.back_lobe_width_deg = 0.0;
     scene_->sensor.acoustics.speckle_angular_correlation_deg = 0.0;
     scene_->mapping.detection.threshold = 90;
     result_ = new ScenarioResult(RunScenario(*scene_, RunOptions{}));
