@@ -1757,6 +1757,23 @@ std::vector<TriangleMesh> Plate(double range, double azimuth_rad, double half_an
   return {BuildMesh(spec, 0)};
 }
 
+// The total echo power of Ping's beam over the pings of seeds 1-64: their strata's jitter
+// averaged out.
+double TotalPowerOverPings(const SensorModel& sensor, const std::vector<TriangleMesh>& meshes) {
+  double total = 0.0;
+  for (std::uint64_t seed = 1; seed <= 64; ++seed) total += TotalPower(Ping(sensor, meshes, seed));
+  return total;
+}
+
+// ∫ f over [from, to] by the midpoint rule, 20000 steps.
+template <typename F>
+double Midpoint(double from, double to, const F& f) {
+  constexpr int kSteps = 20000;
+  double sum = 0.0;
+  for (int i = 0; i < kSteps; ++i) sum += f(from + (i + 0.5) / kSteps * (to - from));
+  return sum * (to - from) / kSteps;
+}
+
 // Sidelobes: plates facing the sonar 2 m out, each taller than the fan, return echo powers in
 // the ratio of the two-way horizontal pattern's integrals over their bearings, exp(-4 ln2
 // θ²/w²) + S (θ_s² / (θ_s² + θ²))²: one over the main lobe's rays (±1.5°), one at 8-12° to the
@@ -1774,26 +1791,17 @@ TEST(BeamSynthesis, SidelobesHearPlatesOffTheAxisAsThePatternSays) {
   a.sidelobe_rays_horizontal = 45;
   a.sidelobe_rays_vertical = 40;
   const double deg = mapping::kDegToRad;
-  const auto echo = [&](const SensorModel& model, const std::vector<TriangleMesh>& plate) {
-    double total = 0.0;
-    for (std::uint64_t seed = 1; seed <= 64; ++seed) total += TotalPower(Ping(model, plate, seed));
-    return total;
-  };
-  const double main_lobe = echo(sensor, Plate(2.0, 0.0, 1.5 * deg, 4.0));
-  const double left = echo(sensor, Plate(2.0, 10.0 * deg, 2.0 * deg, 4.0));
-  const double right = echo(sensor, Plate(2.0, -20.0 * deg, 2.0 * deg, 4.0));
+  const double main_lobe = TotalPowerOverPings(sensor, Plate(2.0, 0.0, 1.5 * deg, 4.0));
+  const double left = TotalPowerOverPings(sensor, Plate(2.0, 10.0 * deg, 2.0 * deg, 4.0));
+  const double right = TotalPowerOverPings(sensor, Plate(2.0, -20.0 * deg, 2.0 * deg, 4.0));
   const double w = sensor.geometry.beam_width_horizontal_rad;
   const double s = std::pow(10.0, a.sidelobe_db / 10.0);
   const double ts2 = std::pow(a.sidelobe_width_deg * deg, 2);
   const auto integral = [&](double from_deg, double to_deg) {
-    double sum = 0.0;
-    constexpr int kSteps = 20000;
-    for (int i = 0; i < kSteps; ++i) {
-      const double theta = (from_deg + (i + 0.5) / kSteps * (to_deg - from_deg)) * deg;
+    return Midpoint(from_deg * deg, to_deg * deg, [&](double theta) {
       const double falloff = ts2 / (ts2 + theta * theta);
-      sum += std::exp(-4.0 * std::log(2.0) * theta * theta / (w * w)) + s * falloff * falloff;
-    }
-    return sum * (to_deg - from_deg) / kSteps;
+      return std::exp(-4.0 * std::log(2.0) * theta * theta / (w * w)) + s * falloff * falloff;
+    });
   };
   const double expected_left = integral(8.0, 12.0) / integral(-1.5, 1.5);
   const double expected_right = integral(18.0, 22.0) / integral(-1.5, 1.5);
@@ -1803,7 +1811,7 @@ TEST(BeamSynthesis, SidelobesHearPlatesOffTheAxisAsThePatternSays) {
 
   SensorModel narrow = sensor;
   narrow.acoustics.sidelobe_extent_deg = 0.0;
-  EXPECT_EQ(echo(narrow, Plate(2.0, 10.0 * deg, 2.0 * deg, 4.0)), 0.0);
+  EXPECT_EQ(TotalPowerOverPings(narrow, Plate(2.0, 10.0 * deg, 2.0 * deg, 4.0)), 0.0);
 }
 
 // The first-hit truth is the main lobe's: a plate only the sidelobes reach, nearer than the
@@ -1844,21 +1852,13 @@ TEST(BeamSynthesis, BackLobeHearsAPlateBehindAsItsPatternSays) {
   a.back_lobe_db = -10.0;
   a.back_lobe_rays = 24;
   const double deg = mapping::kDegToRad;
-  const auto echo = [&](const SensorModel& model, const std::vector<TriangleMesh>& plate) {
-    double total = 0.0;
-    for (std::uint64_t seed = 1; seed <= 64; ++seed) total += TotalPower(Ping(model, plate, seed));
-    return total;
-  };
   const double reach = std::tan(65.0 * deg);
   const std::vector<TriangleMesh> ahead = Plate(1.0, 0.0, 65.0 * deg, 2.0 * reach);
   const std::vector<TriangleMesh> behind = Plate(1.0, std::numbers::pi, 65.0 * deg, 2.0 * reach);
-  const double main_lobe = echo(sensor, ahead);
-  const double back_lobe = echo(sensor, behind);
+  const double main_lobe = TotalPowerOverPings(sensor, ahead);
+  const double back_lobe = TotalPowerOverPings(sensor, behind);
   const auto integral = [deg](double half_deg, const auto& f) {
-    double sum = 0.0;
-    constexpr int kSteps = 20000;
-    for (int i = 0; i < kSteps; ++i) sum += f((-1.0 + (2.0 * i + 1.0) / kSteps) * half_deg * deg);
-    return sum * 2.0 * half_deg * deg / kSteps;
+    return Midpoint(-half_deg * deg, half_deg * deg, f);
   };
   const double k_h = 4.0 * std::log(2.0) / std::pow(sensor.geometry.beam_width_horizontal_rad, 2);
   const double k_v = 4.0 * std::log(2.0) / std::pow(sensor.geometry.beam_width_vertical_rad, 2);
@@ -1875,8 +1875,8 @@ TEST(BeamSynthesis, BackLobeHearsAPlateBehindAsItsPatternSays) {
 
   SensorModel none = sensor;
   none.acoustics.back_lobe_width_deg = 0.0;
-  EXPECT_EQ(echo(none, behind), 0.0);
-  EXPECT_EQ(echo(none, ahead), main_lobe);
+  EXPECT_EQ(TotalPowerOverPings(none, behind), 0.0);
+  EXPECT_EQ(TotalPowerOverPings(none, ahead), main_lobe);
 }
 
 // A mirror path's last leg heard behind: a mirror 1 m ahead (no echo of its own) sends each
