@@ -4,7 +4,7 @@ simulated run with a real log bin by bin where `sonarbench fidelity` gives only 
 
     python3 tools/dataset_stats.py DIR [DIR ...] [--crossing T --from R] [--bins FIRST LAST]
                                    [--lit FIRST LAST] [--arc HEAD_DEG BIN]
-                                   [--behind-walls FIRST LAST]
+                                   [--behind-walls FIRST LAST] [--profile HEAD_DEG FIRST LAST]
 
 DIR is what `sonarbench simulate SCENE --out DIR` or `sonarbench import LOG.mat --out DIR`
 wrote. For each, per range band: the mean intensity, the share of bins at 0 and at 150 or
@@ -42,7 +42,10 @@ units of it, and the arc at ±6 and ±12 steps. With --behind-walls FIRST LAST, 
 beams hear behind its walls against how squarely they meet them: per head angle (to 0.1°) the
 mean of its beams per bin, its peak in bins FIRST to LAST (the wall), and the means over the
 bins 10-29, 30-69 and 70-129 past that peak; averaged per 5° band of head angle off the nearest
-side's normal (0°, 90°, 180°, 270°: a tank square to the sonar's axes). Standard library only.
+side's normal (0°, 90°, 180°, 270°: a tank square to the sonar's axes). With --profile HEAD_DEG
+FIRST LAST, what the beams pointing one way hear against range: the mean intensity of the beams
+within 6° of head angle HEAD_DEG, per group of 4 bins from FIRST to LAST (the last group may be
+shorter; bins past a beam's end left out). Standard library only.
 """
 import argparse
 import glob
@@ -339,7 +342,26 @@ def behind_walls(with_angles, first, last):
             for low, high, n, peak, windows in bands if n]
 
 
-def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None, behind=None):
+PROFILE_HALF_DEG = 6.0
+PROFILE_GROUP_BINS = 4
+
+
+def head_profile(with_angles, head_deg, first, last):
+    """(beams, [(group's first bin, mean or None)]): the mean intensity of the beams within
+    PROFILE_HALF_DEG of head angle head_deg, per group of PROFILE_GROUP_BINS bins from first to
+    last, each group's bins pooled over the beams long enough to hold them."""
+    chosen = [b for angle, _, b in with_angles
+              if off_side(math.degrees(angle) % 360.0, head_deg) <= PROFILE_HALF_DEG]
+    rows = []
+    for start in range(first, last + 1, PROFILE_GROUP_BINS):
+        end = min(start + PROFILE_GROUP_BINS, last + 1)
+        values = [b[k] for b in chosen for k in range(start, min(end, len(b)))]
+        rows.append((start, sum(values) / len(values) if values else None))
+    return len(chosen), rows
+
+
+def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None, behind=None,
+           profile=None):
     far_half, step_rad = manifest_sensor(directory)
     with_angles = load_beams(directory, with_angles=True)
     beams = [(size, b) for _, size, b in with_angles]
@@ -415,6 +437,12 @@ def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None,
         for low, high, n, peak, windows in behind_walls(with_angles, *behind):
             print(f"    {low:2d}-{high:2d}°: {n} cells, peak {peak:.1f}, " +
                   " / ".join(f"{w:.1f}" if w is not None else "none" for w in windows))
+    if profile is not None:
+        head_deg, first, last = profile[0], int(profile[1]), int(profile[2])
+        n, rows = head_profile(with_angles, head_deg, first, last)
+        print(f"  profile of the {n} beams within {PROFILE_HALF_DEG:g}° of {head_deg:g}° "
+              f"(first bin of each {PROFILE_GROUP_BINS}: their mean): " +
+              ", ".join(f"{k} " + (f"{m:.1f}" if m is not None else "none") for k, m in rows))
 
 
 if __name__ == "__main__":
@@ -435,6 +463,9 @@ if __name__ == "__main__":
     parser.add_argument("--behind-walls", type=int, nargs=2, metavar=("FIRST", "LAST"),
                         help="also report, per band of head angle off the sides' normals, each "
                              "head angle's mean peak in bins FIRST to LAST and the means past it")
+    parser.add_argument("--profile", type=float, nargs=3, metavar=("HEAD_DEG", "FIRST", "LAST"),
+                        help="also report the mean of the beams within 6 degrees of HEAD_DEG, "
+                             "per 4 bins from FIRST to LAST")
     args = parser.parse_args()
     if (args.crossing is None) != (args.from_m is None):
         parser.error("--crossing and --from go together")
@@ -447,5 +478,11 @@ if __name__ == "__main__":
     if args.behind_walls is not None and not 0 <= args.behind_walls[0] <= args.behind_walls[1]:
         parser.error(f"--behind-walls {args.behind_walls[0]} {args.behind_walls[1]}: expected "
                      "0 <= FIRST <= LAST")
+    if args.profile is not None and not (
+            0 <= args.profile[1] <= args.profile[2]
+            and all(v == int(v) for v in args.profile[1:])):
+        parser.error(f"--profile {args.profile[0]:g} {args.profile[1]:g} {args.profile[2]:g}: "
+                     "expected whole bins 0 <= FIRST <= LAST")
     for d in args.directories:
-        report(d, args.crossing, args.from_m, args.bins, args.lit, args.arc, args.behind_walls)
+        report(d, args.crossing, args.from_m, args.bins, args.lit, args.arc, args.behind_walls,
+               args.profile)

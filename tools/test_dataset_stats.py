@@ -207,6 +207,20 @@ def main():
         assert result.returncode != 0 and "expected 0 <= FIRST <= LAST" in result.stderr, \
             result.stderr
 
+        # A head angle's profile: of the walls' beams above, those within 6° of 38° are the ones
+        # at 40° and 41° (0° and 92° are not), two of each. Over bins 150-157 in groups of 4: bins
+        # 150-153 hold 180 (bin 150 at 40°) and 0 at 40°, and at 41° all 0 but bin 155's 90, so
+        # (180 · 2) / 16 = 22.5; bins 154-157 hold 0 at 40° and at 41° 90 at bin 155, then nothing
+        # past bin 159: (90 · 2) / 16 = 11.25, printed 11.2 (round half to even).
+        result = run(os.path.join(tmp, "walls"), "--profile", "38", "150", "157")
+        assert result.returncode == 0, result.stderr
+        assert "profile of the 4 beams within 6° of 38° (first bin of each 4: their mean): " \
+            "150 22.5, 154 11.2\n" in result.stdout, result.stdout
+        result = run(os.path.join(tmp, "walls"), "--profile", "38", "398", "402")
+        assert result.returncode == 0 and "398 0.0, 402 none" in result.stdout, result.stdout
+        result = run(os.path.join(tmp, "walls"), "--profile", "38", "157", "150")
+        assert result.returncode != 0 and "expected whole bins" in result.stderr, result.stderr
+
         # The fine texture: ten beams at consecutive head steps, beam b's bin k 100 + 10 (-1)^(k+b).
         # Each bin less its mean over the 31 bins around it is ±(10 + 10/31) (the window's odd one
         # out has the neighbours' sign), ±10 or so near the beam's end where the window is cut: along range the signs alternate (lag 1 and 3 near
@@ -246,7 +260,7 @@ def main():
         result = run(os.path.join(tmp, "bad"))
         assert result.returncode != 0, "a truncated file was accepted"
         assert "sweep_0000.bin: beam 0 truncated" in result.stderr, result.stderr
-    print("dataset_stats.py: shares, spreads, tail, arc, behind the walls, fine texture, a missing manifest and a "
+    print("dataset_stats.py: shares, spreads, tail, arc, behind the walls, a head angle's profile, fine texture, a missing manifest and a "
           "truncated file as expected")
 
 
