@@ -1118,11 +1118,11 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
 //  - back through the same mirrors: range L, weight pattern · s² · ρ cosⁿ, where s is the
 //    product of the specular fractions so far and pattern the two-way pattern of the way out
 //    and back (return_pattern);
-//  - straight back to the sonar if P_k is in view (an occlusion ray) and in the receive lobe:
-//    range R = (L + d)/2 with d = |P_k - sonar|, weight 2 · √pattern · p(P_k) · s · ρ (cos_i
-//    cos_s)^(n/2) · (R/d)^(S/10); p is the one-way pattern towards P_k, the factor 2 counts the
-//    reverse path (sonar → P_k → mirrors → sonar), equal by reciprocity, and (R/d)^(S/10) turns
-//    the monostatic spreading at R into the last leg's own.
+//  - straight back to the sonar if P_k is in view (an occlusion ray) and in the receive pattern
+//    (the back lobe's too): range R = (L + d)/2 with d = |P_k - sonar|, weight 2 · √pattern ·
+//    p(P_k) · s · ρ (cos_i cos_s)^(n/2) · (R/d)^(S/10); p is the one-way pattern towards P_k,
+//    the factor 2 counts the reverse path (sonar → P_k → mirrors → sonar), equal by
+//    reciprocity, and (R/d)^(S/10) turns the monostatic spreading at R into the last leg's own.
 void BeamSynthesizer::BeamJob::TraceMultipath() {
   const OneWayPattern one_way_pattern{R_world_beam_.transpose(), s_.pattern_k_h_, s_.pattern_k_v_,
                                       s_};
@@ -1155,7 +1155,7 @@ void BeamSynthesizer::BeamJob::TraceMultipath() {
     next_paths.clear();
     stream.clear();
     // Each path is read where it was and written where it goes: read back from a copy just
-    // made, its fields stalled on store forwarding (perf; 102 -> 92 ms a sweep, synthesis_bench).
+    // made, its fields stalled on store forwarding (perf annotate: a sixth of this loop's time).
     for (const MirrorPath& was : paths) {
       const Material& mirror = s_.materials_by_mesh_[was.hit.mesh];
       const double specular = was.specular * mirror.specular;
