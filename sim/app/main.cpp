@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -201,6 +202,22 @@ int Fidelity(const FidelityArgs& args) {
             << " (all bins), " << report.profile_correlation_usable
             << " (past self-reflection); mean |difference| " << report.profile_mean_abs_difference
             << " (past self-reflection)\n"
+            << "mean intensity by range [m], sim / real:";
+  for (std::size_t b = 0; b < sim::FidelityReport::kRangeBandsM.size(); ++b) {
+    const auto show = [](const std::optional<double>& v) {
+      std::ostringstream text;
+      if (v) {
+        text << std::fixed << std::setprecision(1) << *v;
+      } else {
+        text << "none";
+      }
+      return text.str();
+    };
+    std::cout << (b == 0 ? " " : ", ") << sim::FidelityReport::kRangeBandsM[b][0] << "-"
+              << sim::FidelityReport::kRangeBandsM[b][1] << " " << show(report.sim_band_means[b])
+              << " / " << show(report.real_band_means[b]);
+  }
+  std::cout << "\n"
             << "wall range: median difference " << report.median_wall_difference_bins
             << " bins over " << report.wall_angles_compared << " head angles\n"
             << "wall echo intensity, 10th/50th/90th percentile over beams: sim "

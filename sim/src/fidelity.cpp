@@ -440,6 +440,25 @@ cv::Mat SideBySide(const cv::Mat& left, const cv::Mat& right) {
   return joined;
 }
 
+// The mean of `profile` over the bins whose centres lie in each of FidelityReport::kRangeBandsM.
+std::array<std::optional<double>, FidelityReport::kRangeBandsM.size()> BandMeans(
+    std::span<const double> profile, double bin_size_m) {
+  std::array<std::optional<double>, FidelityReport::kRangeBandsM.size()> means{};
+  for (std::size_t band = 0; band < means.size(); ++band) {
+    const auto [from, to] = FidelityReport::kRangeBandsM[band];
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t k = 0; k < profile.size(); ++k) {
+      const double centre = (static_cast<double>(k) + 0.5) * bin_size_m;
+      if (centre < from || centre >= to) continue;
+      sum += profile[k];
+      ++count;
+    }
+    if (count > 0) means[band] = sum / static_cast<double>(count);
+  }
+  return means;
+}
+
 }  // namespace
 
 double PearsonCorrelation(std::span<const double> a, std::span<const double> b) {
@@ -520,6 +539,8 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
                                                     std::span(r.real_mean).subspan(usable));
   r.profile_mean_abs_difference = MeanAbsDifference(std::span(r.sim_mean).subspan(usable),
                                                     std::span(r.real_mean).subspan(usable));
+  r.sim_band_means = BandMeans(r.sim_mean, sensor.bin_size_m);
+  r.real_band_means = BandMeans(r.real_mean, sensor.bin_size_m);
   const StrongestBins sim_strongest = FindStrongestBins(sim, wall_min_range_m);
   const StrongestBins real_strongest = FindStrongestBins(real, wall_min_range_m);
   r.sim_wall_m = WallRanges(sim, sim_strongest, sensor);
@@ -621,6 +642,26 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   return r;
 }
 
+namespace {
+
+// The mean profiles by range band, for fidelity.json: one object per band, null where a run's
+// bins do not reach it.
+nlohmann::json RangeBandsJson(const FidelityReport& r) {
+  nlohmann::json bands = nlohmann::json::array();
+  const auto value = [](const std::optional<double>& v) {
+    return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+  };
+  for (std::size_t b = 0; b < FidelityReport::kRangeBandsM.size(); ++b) {
+    bands.push_back({{"from_m", FidelityReport::kRangeBandsM[b][0]},
+                     {"to_m", FidelityReport::kRangeBandsM[b][1]},
+                     {"sim", value(r.sim_band_means[b])},
+                     {"real", value(r.real_band_means[b])}});
+  }
+  return bands;
+}
+
+}  // namespace
+
 void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                           std::span<const mapping::Beam> sim_sweep,
                           std::span<const mapping::Beam> real_sweep,
@@ -704,6 +745,7 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"profile_correlation_all_bins", r.profile_correlation_all},
                  {"profile_correlation_usable_bins", r.profile_correlation_usable},
                  {"profile_mean_abs_difference_usable_bins", r.profile_mean_abs_difference},
+                 {"mean_by_range_band", RangeBandsJson(r)},
                  {"median_wall_range_difference_bins", r.median_wall_difference_bins},
                  {"wall_angles_compared", r.wall_angles_compared},
                  {"wall_peak_intensity_p10_p50_p90_sim", r.sim_wall_peak},

@@ -23,6 +23,13 @@ struct FidelityReport {
   /// Mean absolute difference of the two mean profiles over the usable bins [intensity]: the
   /// level, which a correlation ignores.
   double profile_mean_abs_difference = 0.0;
+  /// The two mean profiles by range: over the bins whose centres lie in each band of
+  /// kRangeBandsM [m, half-open], the mean of sim_mean and of real_mean; none for a band
+  /// without such a bin.
+  static constexpr std::array<std::array<double, 2>, 7> kRangeBandsM = {
+      {{0.4, 1.5}, {1.5, 2.0}, {2.0, 2.5}, {2.5, 3.0}, {3.0, 4.0}, {4.0, 4.5}, {4.5, 5.0}}};
+  std::array<std::optional<double>, kRangeBandsM.size()> sim_band_means{};
+  std::array<std::optional<double>, kRangeBandsM.size()> real_band_means{};
   /// Per head-angle step (index = angle / step): the median, over sweeps, of the range [m] of
   /// the strongest echo beyond `wall_min_range_m` (the wall, in a tank).
   std::vector<std::optional<double>> sim_wall_m;
