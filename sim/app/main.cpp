@@ -203,16 +203,16 @@ int Fidelity(const FidelityArgs& args) {
             << " (past self-reflection); mean |difference| " << report.profile_mean_abs_difference
             << " (past self-reflection)\n"
             << "mean intensity by range [m], sim / real:";
+  const auto show = [](const std::optional<double>& v) {
+    std::ostringstream text;
+    if (v) {
+      text << std::fixed << std::setprecision(1) << *v;
+    } else {
+      text << "none";
+    }
+    return text.str();
+  };
   for (std::size_t b = 0; b < sim::FidelityReport::kRangeBandsM.size(); ++b) {
-    const auto show = [](const std::optional<double>& v) {
-      std::ostringstream text;
-      if (v) {
-        text << std::fixed << std::setprecision(1) << *v;
-      } else {
-        text << "none";
-      }
-      return text.str();
-    };
     std::cout << (b == 0 ? " " : ", ") << sim::FidelityReport::kRangeBandsM[b][0] << "-"
               << sim::FidelityReport::kRangeBandsM[b][1] << " " << show(report.sim_band_means[b])
               << " / " << show(report.real_band_means[b]);
