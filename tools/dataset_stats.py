@@ -351,7 +351,7 @@ def head_profile(with_angles, head_deg, first, last):
     PROFILE_HALF_DEG of head angle head_deg, per group of PROFILE_GROUP_BINS bins from first to
     last, each group's bins pooled over the beams long enough to hold them."""
     chosen = [b for angle, _, b in with_angles
-              if off_side(math.degrees(angle) % 360.0, head_deg) <= PROFILE_HALF_DEG]
+              if off_side(head_cell(angle), head_deg) <= PROFILE_HALF_DEG]
     rows = []
     for start in range(first, last + 1, PROFILE_GROUP_BINS):
         end = min(start + PROFILE_GROUP_BINS, last + 1)
