@@ -12,10 +12,15 @@
 //   BM_Synthesis/1, /2  the whole synthesis (hits, backscatter, the vehicle's parts, the scene's
 //                       multipath: mirrored and occlusion rays, range spreading, noise,
 //                       quantisation) on 1 and 2 threads
+//   BM_RawEmbreeReplay  every ray BM_Synthesis/1 traces (its primaries, the vehicle's bundles,
+//                       mirrored and occlusion rays), recorded from one sweep and replayed
+//                       through Embree alone: /*_queries as the queries it made, /*_per_ray one
+//                       query per ray (the whole synthesis's comparison: traced_rays/s)
 // Per-run set-up is outside every timing, as a run does it once: the BVH (the raw rows' too) and
 // the synthesizer's tables (SceneSynthesizer); everything done per beam is inside.
-// Counters: primary rays per second (compare BM_SynthesisNoMultipath with the faster raw one) and,
-// for the synthesis, the real-time factor: the real sonar's time for the sweep over ours.
+// Counters: primary rays per second (compare BM_SynthesisNoMultipath with the faster raw one),
+// all rays traced per second (compare BM_Synthesis/1 with the replays) and, for the synthesis,
+// the real-time factor: the real sonar's time for the sweep over ours.
 #include <benchmark/benchmark.h>
 
 #include <map>
@@ -89,18 +94,58 @@ SweepRays DrawSweepRays(const BenchScene& bench) {
   return out;
 }
 
-// The scene and its sweep's rays, built on first use and kept for every row.
+// Every query the whole synthesis makes of Embree in one sweep (1 thread), recorded, with each
+// bundle's directions apart, as IntersectBundle takes them: the scene's queries and the vehicle
+// parts' (against their own BVH, kept here by the synthesizer that made them).
+struct SweepQueries {
+  struct Traced {
+    RayQueryLog log;
+    std::vector<std::vector<Eigen::Vector3f>> bundle_directions;  // per entry; empty if not one
+  };
+  BeamSynthesizer synthesizer;
+  Traced scene;
+  Traced vehicle;
+  std::size_t rays = 0;
+};
+
+void SplitBundles(SweepQueries::Traced& traced) {
+  for (const RayQueryLog::Entry& entry : traced.log.entries) {
+    std::vector<Eigen::Vector3f>& directions = traced.bundle_directions.emplace_back();
+    if (entry.query != RayQueryLog::Query::kBundle) continue;
+    for (const Ray& ray : entry.rays) directions.push_back(ray.direction);
+  }
+}
+
+std::unique_ptr<SweepQueries> RecordSweepQueries(const BenchScene& bench) {
+  auto out = std::make_unique<SweepQueries>(
+      SweepQueries{SceneSynthesizer(bench.scene, bench.tracer, kSeed), {}, {}, 0});
+  const RayTracer* vehicle = out->synthesizer.VehicleTracer();
+  bench.tracer.Record(&out->scene.log);
+  if (vehicle != nullptr) vehicle->Record(&out->vehicle.log);
+  const std::vector<SynthesizedBeam> beams = SimulateSweep(bench.scene, out->synthesizer, 1);
+  bench.tracer.Record(nullptr);
+  if (vehicle != nullptr) vehicle->Record(nullptr);
+  SplitBundles(out->scene);
+  SplitBundles(out->vehicle);
+  out->rays = out->scene.log.RayCount() + out->vehicle.log.RayCount();
+  return out;
+}
+
+// The scene, its sweep's primary rays and every query of its whole synthesis, built on first
+// use and kept for every row.
 struct Setup {
   BenchScene bench;
   SweepRays rays;
+  std::unique_ptr<SweepQueries> queries;
 };
 
 const Setup& TheSetup(const std::string& file) {
   static std::map<std::string, std::unique_ptr<Setup>> setups;
   std::unique_ptr<Setup>& setup = setups[file];
   if (!setup) {
-    setup = std::make_unique<Setup>(Setup{BenchScene(file), {}});
+    setup = std::make_unique<Setup>(Setup{BenchScene(file), {}, {}});
     setup->rays = DrawSweepRays(setup->bench);
+    setup->queries = RecordSweepQueries(setup->bench);
   }
   return *setup;
 }
@@ -146,6 +191,60 @@ void BM_RawEmbreeBundle(benchmark::State& state, const std::string& file) {
   }
   state.counters["rays/s"] = benchmark::Counter(
       PrimaryRaysPerSweep(setup.bench.scene) * state.iterations(), benchmark::Counter::kIsRate);
+}
+
+// Replays `traced` through `tracer`: each entry as the query it was (a coherent bundle, an
+// incoherent stream, an occlusion stream or one ray), or with `per_ray` each of its rays as a
+// query of its own (rtcIntersect1 or rtcOccluded1). Returns the hits and occluded rays found.
+std::size_t Replay(const RayTracer& tracer, const SweepQueries::Traced& traced, bool per_ray) {
+  using Query = RayQueryLog::Query;
+  thread_local std::vector<std::optional<Hit>> hits;
+  thread_local std::vector<bool> occluded;
+  std::size_t found = 0;
+  for (std::size_t e = 0; e < traced.log.entries.size(); ++e) {
+    const RayQueryLog::Entry& entry = traced.log.entries[e];
+    const bool occlusion =
+        entry.query == Query::kOccludedStream || entry.query == Query::kSingleOccluded;
+    if (per_ray || entry.query == Query::kSingle || entry.query == Query::kSingleOccluded) {
+      for (const Ray& ray : entry.rays) {
+        found += occlusion
+                     ? (tracer.Occluded(ray.origin, ray.direction, ray.max_distance) ? 1 : 0)
+                     : (tracer.Intersect(ray.origin, ray.direction, ray.max_distance) ? 1 : 0);
+      }
+      continue;
+    }
+    if (occlusion) {
+      tracer.OccludedStream(entry.rays, occluded);
+      for (const bool o : occluded) found += o ? 1 : 0;
+      continue;
+    }
+    hits.resize(entry.rays.size());
+    if (entry.query == Query::kBundle) {
+      tracer.IntersectBundle(entry.rays.front().origin, traced.bundle_directions[e],
+                             entry.rays.front().max_distance, hits);
+    } else {
+      tracer.IntersectStream(entry.rays, hits);
+    }
+    for (const auto& hit : hits) found += hit.has_value() ? 1 : 0;
+  }
+  return found;
+}
+
+// Raw Embree on every ray the whole synthesis traces in a sweep (BM_Synthesis/1's: primaries,
+// the vehicle's bundles, mirrored rays, occlusion rays, the beam's axis), recorded from it and
+// replayed: as the queries it made (`per_ray` false) or one query per ray.
+void BM_RawEmbreeReplay(benchmark::State& state, const std::string& file, bool per_ray) {
+  const Setup& setup = TheSetup(file);
+  const SweepQueries& queries = *setup.queries;
+  const RayTracer* vehicle = queries.synthesizer.VehicleTracer();
+  for (auto _ : state) {
+    std::size_t found = Replay(setup.bench.tracer, queries.scene, per_ray);
+    if (vehicle != nullptr) found += Replay(*vehicle, queries.vehicle, per_ray);
+    benchmark::DoNotOptimize(found);
+  }
+  state.counters["traced_rays/s"] = benchmark::Counter(
+      static_cast<double>(queries.rays) * static_cast<double>(state.iterations()),
+      benchmark::Counter::kIsRate);
 }
 
 void BM_Synthesis(benchmark::State& state, const std::string& file) {
@@ -196,9 +295,18 @@ BENCHMARK_CAPTURE(BM_RawEmbreeBundle, tank, kTank)->Unit(benchmark::kMillisecond
 BENCHMARK_CAPTURE(BM_SynthesisNoMultipath, tank, kTank)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK_CAPTURE(BM_RawEmbreeReplay, tank_queries, kTank, false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_RawEmbreeReplay, tank_per_ray, kTank, true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Synthesis, tank, kTank)
     ->Arg(1)
     ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_RawEmbreeReplay, tank_sidelobes_queries, kTankSidelobes, false)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Synthesis, tank_sidelobes, kTankSidelobes)
@@ -208,6 +316,9 @@ BENCHMARK_CAPTURE(BM_Synthesis, tank_sidelobes, kTankSidelobes)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_RawEmbree, seabed, kSeabed)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RawEmbreeBundle, seabed, kSeabed)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_RawEmbreeReplay, seabed_queries, kSeabed, false)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Synthesis, seabed, kSeabed)

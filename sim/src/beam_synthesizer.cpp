@@ -693,6 +693,15 @@ double CosPower(double c, double n) {
   return std::pow(c, n);
 }
 
+// An upper bound on exp(-x) within a factor of 2 and without exp(): 2^-⌊x log₂e⌋, built from
+// its exponent bits (0 past 2^-1000; infinity for x < 0, where it is not needed).
+double ExpBound(double x) {
+  const double octaves = std::floor(x * std::numbers::log2e);
+  if (!(octaves >= 0.0)) return std::numeric_limits<double>::infinity();
+  if (octaves >= 1000.0) return 0.0;
+  return std::bit_cast<double>(static_cast<std::uint64_t>(1023 - static_cast<int>(octaves)) << 52);
+}
+
 // A rough mirror's glint towards a receiver whose direction makes cos_alpha with the mirror
 // direction (Material::glint): g exp(-α²/2σ²); 0 without one.
 double Glint(const Material& m, double cos_alpha) {
@@ -718,6 +727,39 @@ double BeamSynthesizer::BackLobePattern(const Eigen::Vector3d& u, double blur) c
   // exp(-k θ²/2) per direction, each averaged over a Gaussian offset of variance `blur`.
   const double wide = 1.0 + back_k_ * blur;
   return back_level_ * std::exp(-0.5 * back_k_ * (phi * phi + epsilon * epsilon) / wide) / wide;
+}
+
+double BeamSynthesizer::OneWayPatternTowards(const Eigen::Vector3d& u, double blur) const {
+  if (u.x() <= 0.0) return BackLobePattern(u, blur);
+  const double k_h = pattern_k_h_;
+  const double k_v = pattern_k_v_;
+  const double theta = std::atan2(u.y(), u.x());
+  const double epsilon = std::asin(std::clamp(u.z(), -1.0, 1.0));
+  const double wide_h = 1.0 + k_h * blur;
+  const double wide_v = 1.0 + k_v * blur;
+  const double sidelobe = SidelobePattern(theta);
+  if (sidelobe <= 0.0) {
+    return std::exp(-0.5 * (k_h * theta * theta / wide_h + k_v * epsilon * epsilon / wide_v)) /
+           std::sqrt(wide_h * wide_v);
+  }
+  // The sidelobes' pedestal is far wider than any blur: added unblurred to the main lobe's
+  // two-way power, the one-way the square root of the sum.
+  const double main_h = std::exp(-k_h * theta * theta / wide_h) / wide_h;
+  return std::sqrt(main_h + sidelobe) * std::exp(-0.5 * k_v * epsilon * epsilon / wide_v) /
+         std::sqrt(wide_v);
+}
+
+double BeamSynthesizer::OneWayPatternBound(const Eigen::Vector3d& u) const {
+  const double across = u.x() * u.x() + u.y() * u.y();
+  if (u.x() <= 0.0) {
+    if (back_level_ <= 0.0) return 0.0;
+    if (across <= 0.0) return back_level_;
+    return back_level_ * ExpBound(0.5 * back_k_ * (u.y() * u.y() / across + u.z() * u.z()));
+  }
+  // The sidelobes' pedestal S adds to the two-way main lobe's power, at most 1 + S.
+  if (sidelobe_level_ > 0.0) return std::sqrt(1.0 + sidelobe_level_);
+  if (across <= 0.0) return 1.0;
+  return ExpBound(0.5 * (pattern_k_h_ * u.y() * u.y() / across + pattern_k_v_ * u.z() * u.z()));
 }
 
 double BeamSynthesizer::SidelobePattern(double theta) const {
@@ -864,34 +906,13 @@ class EchoDeposit {
 };
 
 // A beam's one-way pattern towards a world direction (unit), R_beam_world taking world
-// directions into the beam's frame (x along its axis, z up the fan): the back lobe's, if any,
-// outside the half-space ahead; with `blur` > 0 its mean over a 2-D Gaussian offset of that
-// variance per axis [rad²]:
-// for exp(-k θ²/2) per axis, exp(-k θ² / (2 (1 + k τ²))) / √(1 + k τ²). k_h and k_v are the
-// two-way pattern's exponents.
+// directions into the beam's frame (BeamSynthesizer::OneWayPatternTowards).
 struct OneWayPattern {
   Eigen::Matrix3d R_beam_world;
-  double k_h = 0.0;
-  double k_v = 0.0;
-  const BeamSynthesizer& synthesizer;  // its sidelobes (SidelobePattern), if any
+  const BeamSynthesizer& synthesizer;
 
   double operator()(const Eigen::Vector3d& towards, double blur = 0.0) const {
-    const Eigen::Vector3d u = R_beam_world * towards;
-    if (u.x() <= 0.0) return synthesizer.BackLobePattern(u, blur);
-    const double theta = std::atan2(u.y(), u.x());
-    const double epsilon = std::asin(std::clamp(u.z(), -1.0, 1.0));
-    const double wide_h = 1.0 + k_h * blur;
-    const double wide_v = 1.0 + k_v * blur;
-    const double sidelobe = synthesizer.SidelobePattern(theta);
-    if (sidelobe <= 0.0) {
-      return std::exp(-0.5 * (k_h * theta * theta / wide_h + k_v * epsilon * epsilon / wide_v)) /
-             std::sqrt(wide_h * wide_v);
-    }
-    // The sidelobes' pedestal is far wider than any blur: added unblurred to the main lobe's
-    // two-way power, the one-way the square root of the sum.
-    const double main_h = std::exp(-k_h * theta * theta / wide_h) / wide_h;
-    return std::sqrt(main_h + sidelobe) * std::exp(-0.5 * k_v * epsilon * epsilon / wide_v) /
-           std::sqrt(wide_v);
+    return synthesizer.OneWayPatternTowards(R_beam_world * towards, blur);
   }
 };
 
@@ -1126,8 +1147,7 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
 //    the factor 2 counts the reverse path (sonar → P_k → mirrors → sonar), equal by
 //    reciprocity, and (R/d)^(S/10) turns the monostatic spreading at R into the last leg's own.
 void BeamSynthesizer::BeamJob::TraceMultipath() {
-  const OneWayPattern one_way_pattern{R_world_beam_.transpose(), s_.pattern_k_h_, s_.pattern_k_v_,
-                                      s_};
+  const OneWayPattern one_way_pattern{R_world_beam_.transpose(), s_};
   // The two-way pattern of the way out and back along a mirror path ending at p's hit. Through
   // perfect mirrors the echo comes back along the way out: the ray's own two-way pattern.
   // Through rough ones the way back is a path of its own, each rough mirror tilting it
@@ -1213,10 +1233,17 @@ void BeamSynthesizer::BeamJob::TraceMultipath() {
       const double d = back.norm();
       const double range = 0.5 * (path + d);
       if (range > max_range || d < g_.bin_size_m) continue;
-      const double receive = one_way_pattern(-back / d);
-      // Culled on the largest its law can give: ρ for the diffuse part, g for the glint.
+      // Culled on the largest its law can give: ρ for the diffuse part, g for the glint. First
+      // on a bound of the receive pattern, which spares most returns from ahead its
+      // trigonometry and culls only what the pattern itself would (0.999 leaves rounding a
+      // margin); the weight keeps its own order of products, so its bits do not change.
+      const Eigen::Vector3d u = one_way_pattern.R_beam_world * (-back / d);
+      const double reach = 2.0 * std::sqrt(was.pattern) * was.specular;
+      const double largest = std::max(m.reflectivity, m.glint);
+      if (reach * s_.OneWayPatternBound(u) * largest < 0.999 * kNegligibleWeight) continue;
+      const double receive = s_.OneWayPatternTowards(u);
       const double weight = 2.0 * std::sqrt(was.pattern) * receive * was.specular;
-      if (weight * std::max(m.reflectivity, m.glint) < kNegligibleWeight) continue;
+      if (weight * largest < kNegligibleWeight) continue;
       const Eigen::Vector3f to_sonar = (back / d).cast<float>();
       const double cos_out = std::abs(hit.normal.dot(to_sonar));
       double glint = 0.0;  // towards the sonar from the mirror direction, if m glints
@@ -1251,6 +1278,7 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
                                static_cast<float>(max_range_))) {
     out_.truth.axis_hit_range_m = axis->distance;
   }
+  ++out_.traced_rays;
 
   out_.beam.intensities.resize(bins_);
   const double noise_power = std::pow(10.0, a_.noise_level_db / 10.0);

@@ -114,9 +114,20 @@ void CheckSizes(const char* what, std::size_t results, std::size_t rays) {
 
 }  // namespace
 
+std::size_t RayQueryLog::RayCount() const {
+  std::size_t rays = 0;
+  for (const Entry& entry : entries) rays += entry.rays.size();
+  return rays;
+}
+
+void RayTracer::Log(RayQueryLog::Query query, std::vector<Ray> rays) const {
+  log_->entries.push_back({.query = query, .rays = std::move(rays)});
+}
+
 std::optional<Hit> RayTracer::Intersect(const Eigen::Vector3f& origin,
                                         const Eigen::Vector3f& direction,
                                         float max_distance) const {
+  if (log_) Log(RayQueryLog::Query::kSingle, {{origin, direction, max_distance}});
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit query{};
@@ -129,6 +140,12 @@ void RayTracer::IntersectBundle(const Eigen::Vector3f& origin,
                                 std::span<const Eigen::Vector3f> directions, float max_distance,
                                 std::span<std::optional<Hit>> hits) const {
   CheckSizes("IntersectBundle", hits.size(), directions.size());
+  if (log_) {
+    std::vector<Ray> rays;
+    rays.reserve(directions.size());
+    for (const Eigen::Vector3f& d : directions) rays.push_back({origin, d, max_distance});
+    Log(RayQueryLog::Query::kBundle, std::move(rays));
+  }
   IntersectMany(scene_.get(), RTC_INTERSECT_CONTEXT_FLAG_COHERENT, hits,
                 [&](RTCRayHit& query, std::size_t i) {
                   SetQuery(query, origin, directions[i], max_distance, static_cast<unsigned>(i));
@@ -138,6 +155,7 @@ void RayTracer::IntersectBundle(const Eigen::Vector3f& origin,
 void RayTracer::IntersectStream(std::span<const Ray> rays,
                                 std::span<std::optional<Hit>> hits) const {
   CheckSizes("IntersectStream", hits.size(), rays.size());
+  if (log_) Log(RayQueryLog::Query::kStream, {rays.begin(), rays.end()});
   IntersectMany(scene_.get(), RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT, hits,
                 [&](RTCRayHit& query, std::size_t i) {
                   const Ray& ray = rays[i];
@@ -147,6 +165,7 @@ void RayTracer::IntersectStream(std::span<const Ray> rays,
 }
 
 void RayTracer::OccludedStream(std::span<const Ray> rays, std::vector<bool>& occluded) const {
+  if (log_) Log(RayQueryLog::Query::kOccludedStream, {rays.begin(), rays.end()});
   thread_local std::vector<RTCRay> queries;
   queries.resize(rays.size());
   for (std::size_t i = 0; i < rays.size(); ++i) {
@@ -164,6 +183,7 @@ void RayTracer::OccludedStream(std::span<const Ray> rays, std::vector<bool>& occ
 
 bool RayTracer::Occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
                          float max_distance) const {
+  if (log_) Log(RayQueryLog::Query::kSingleOccluded, {{origin, direction, max_distance}});
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay ray{};

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <iterator>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 
 #include "sonarbench/sim/random.hpp"
 
@@ -58,6 +60,10 @@ BeamSynthesizer SceneSynthesizer(const Scene& scene, const RayTracer& tracer, st
 std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const BeamSynthesizer& synthesizer,
                                            std::uint64_t seed, int threads, std::size_t first,
                                            std::size_t last) {
+  if (first > last) {
+    throw std::invalid_argument("SimulateBeams: beams [" + std::to_string(first) + ", " +
+                                std::to_string(last) + ") run backwards");
+  }
   std::vector<SynthesizedBeam> beams(last - first);
   const int n_threads = threads > 0 ? threads : omp_get_max_threads();
 #pragma omp parallel for num_threads(n_threads) schedule(dynamic, 8)

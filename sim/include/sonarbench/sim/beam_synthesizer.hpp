@@ -34,7 +34,8 @@ struct SynthesizedBeam {
   /// Noise-free echo power per bin [linear, relative to a perfect reflector at 1 m]; empty
   /// unless asked for (EchoPower::kKeep).
   std::vector<double> echo_power;
-  /// Rays traced for it: primaries, mirrored rays and occlusion rays (for speed reports).
+  /// Rays traced for it: primaries (and their vehicle's parts' bundle), mirrored rays,
+  /// occlusion rays and the axis's ray for the truth (for speed reports).
   std::size_t traced_rays = 0;
 };
 
@@ -112,6 +113,20 @@ class BeamSynthesizer {
   /// direction in the beam's frame (x along its axis) with u.x ≤ 0; with `blur` > 0 its mean
   /// over a 2-D Gaussian offset of that variance per axis [rad²]. 0 without a back lobe.
   [[nodiscard]] double BackLobePattern(const Eigen::Vector3d& u, double blur) const;
+
+  /// The beam's one-way pattern towards `u`, a unit direction in its frame (x along its axis, z
+  /// up the fan): ahead (u.x > 0) the main lobe's exp(-k θ²/2) in each direction, k the two-way
+  /// pattern's exponent and θ the azimuth or the elevation, with the sidelobes' pedestal added
+  /// to the two-way horizontal power if there are any; behind, BackLobePattern. With `blur` > 0,
+  /// its mean over a 2-D Gaussian offset of that variance per axis [rad²]: exp(-k θ² / (2 (1 +
+  /// k τ²))) / √(1 + k τ²) per direction.
+  [[nodiscard]] double OneWayPatternTowards(const Eigen::Vector3d& u, double blur = 0.0) const;
+
+  /// An upper bound on OneWayPatternTowards(u), unblurred, that needs no trigonometry, for
+  /// culling: the pattern's Gaussian exponent with sin²θ = u_y² / (u_x² + u_y²) for θ² and u_z²
+  /// for ε² (each no larger), e^-x bounded by 2^-⌊x log₂e⌋ (within a factor of 2); ahead with
+  /// sidelobes, √(1 + S) for their level S.
+  [[nodiscard]] double OneWayPatternBound(const Eigen::Vector3d& u) const;
 
   /// Maps a level [dB] to the 8-bit intensity the sonar would report: the AD window's step,
   /// under the receiver's ceiling (Acoustics::ad_knee, ad_ceiling), rounded.
@@ -244,6 +259,10 @@ class BeamSynthesizer {
   [[nodiscard]] Eigen::Vector3f SpreadMirror(const Eigen::Vector3f& mirror,
                                              const Eigen::Vector3f& normal,
                                              const Material& material, Rng& rng) const;
+
+  /// The vehicle parts' BVH, in the vehicle's frame, or null without parts (for recording its
+  /// queries: RayTracer::Record).
+  [[nodiscard]] const RayTracer* VehicleTracer() const { return vehicle_tracer_.get(); }
 
   /// Tabled 2-D Gaussian offsets: 64 radii (the Rayleigh distribution's quantiles at
   /// (i + ½)/64, up to 3.1 σ) × 64 evenly spaced directions.

@@ -29,7 +29,24 @@ struct Ray {
   float max_distance = 0.0f;
 };
 
-/// An Embree scene over a set of triangle meshes. Thread-safe for queries once constructed.
+/// The queries a RayTracer answered while recording (RayTracer::Record), in order, each with
+/// its rays: for replaying the same rays through Embree alone (synthesis_bench).
+struct RayQueryLog {
+  /// Which of RayTracer's queries an entry was: IntersectBundle, IntersectStream, OccludedStream,
+  /// Intersect or Occluded.
+  enum class Query { kBundle, kStream, kOccludedStream, kSingle, kSingleOccluded };
+  struct Entry {
+    Query query = Query::kSingle;
+    std::vector<Ray> rays;
+  };
+  std::vector<Entry> entries;
+
+  /// Rays over all entries.
+  [[nodiscard]] std::size_t RayCount() const;
+};
+
+/// An Embree scene over a set of triangle meshes. Thread-safe for queries once constructed,
+/// except while recording them.
 class RayTracer {
  public:
   explicit RayTracer(std::span<const TriangleMesh> meshes);
@@ -64,7 +81,14 @@ class RayTracer {
   [[nodiscard]] bool Occluded(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
                               float max_distance) const;
 
+  /// Appends every query answered from now on to `log` (nullptr stops recording). While it
+  /// records, the tracer must be queried from one thread only.
+  void Record(RayQueryLog* log) const { log_ = log; }
+
  private:
+  /// Appends a query to log_, if recording.
+  void Log(RayQueryLog::Query query, std::vector<Ray> rays) const;
+
   struct DeviceDeleter {
     void operator()(RTCDeviceTy* device) const { rtcReleaseDevice(device); }
   };
@@ -73,6 +97,7 @@ class RayTracer {
   };
   std::unique_ptr<RTCDeviceTy, DeviceDeleter> device_;
   std::unique_ptr<RTCSceneTy, SceneDeleter> scene_;
+  mutable RayQueryLog* log_ = nullptr;
 };
 
 }  // namespace sonarbench::sim
