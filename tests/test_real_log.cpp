@@ -587,7 +587,7 @@ TEST(Fidelity, NearRangeIsMeasuredPerHeadAngle) {
 
 // The real log's statistics that the guard below holds the simulated tank to, as `sonarbench
 // fidelity scenes/cras-tank.yaml ../shared/data/cras-tank-static/dataset_static.mat` measures
-// them (its "real" side; README, "Fidelity"), recorded here so that the guard runs where the log
+// them (its "real" side; docs/fidelity.md), recorded here so that the guard runs where the log
 // is not (CI's fresh clone); RecordedRealLogStatisticsAreTheLogs checks them against the log.
 struct RealTank {
   static constexpr double kRingingMean = 97.07;  // bins 5-22
@@ -617,9 +617,9 @@ struct RealTank {
 // the walls' median strongest echo 146-149; the bands within 6.3 of the real ones, 2.7-3.0 on
 // average; the near range's mean 17.5-18.1 and spread across head angles 15.0-15.8 (before the
 // back lobe: 0.589-0.603, 0.338-0.349, 2.14-2.15, 5.7, 2.2-2.8, 15.4-16.0, 15.1-15.9). Each bound
-// sits outside that spread and inside what a lost piece of the model gives (README,
-// "Fidelity"): the self-reflection under the speckle (mean 120, ping spread 1.2), one look of
-// speckle (0.70 and contrast 0.51), no receiver jitter (spread 1.6), no skirts (median 167), the
+// sits outside that spread and inside what a lost piece of the model gives
+// (docs/fidelity.md): the self-reflection under the speckle (mean 120, ping spread 1.2), one look
+// of speckle (0.70 and contrast 0.51), no receiver jitter (spread 1.6), no skirts (median 167), the
 // gain 2 dB off (every band ≈ 13 units), no vehicle parts (the near range's mean 6.4 without
 // them and their tail all round; 8.3 across head angles with the model's mean tail instead).
 TEST(Fidelity, SimulatedTankStaysNearTheRealLogsRecordedStatistics) {

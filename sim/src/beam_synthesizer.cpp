@@ -1312,7 +1312,7 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
   };
   // A glint is the sonar's mirror image, sound that came straight back: it has the pulse's
   // skirts like any echo, but feeds no reverberation and no second trip (the real tank is quiet
-  // behind walls met squarely: README, "Fidelity", behind the walls).
+  // behind walls met squarely: docs/fidelity.md, behind the walls).
   if (s_.scene_glints_) add_apart(scratch_.glint_spreader, true);
   // The vehicle's echoes are heard as they are: the real log's show no skirts, second trip or
   // reverberation (behind the SHAD's own echo at 0.3 m its beams at head angle 0° are silent

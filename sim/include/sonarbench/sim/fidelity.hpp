@@ -59,7 +59,7 @@ struct FidelityReport {
   /// 270°: a tank square to head angle 0), and over those kCornerFromDeg-45° off it (towards the
   /// corners), each averaged over the offsets kBehindFirst..kBehindLast past the strongest echo.
   /// The real tank is quiet behind walls met squarely and loud towards its corners; a tail that
-  /// every echo feeds alike is not (README, "Fidelity", behind the walls).
+  /// every echo feeds alike is not (docs/fidelity.md, behind the walls).
   std::array<double, 2> sim_behind_walls{};  // {met squarely, towards the corners}
   std::array<double, 2> real_behind_walls{};
   static constexpr double kSquareDeg = 20.0;
