@@ -121,13 +121,16 @@ void ExpectCorrelatedOverTheWindow(int window, Draw draw) {
 
 // Beams one head step apart share all but one sector: over 64 pairs of sequences of 16384
 // (sectors 0 .. 2R+1 of a place seeded from seed_base + pair; beam A hears 0 .. 2R, beam B
-// 1 .. 2R+1), their factors correlate by ρ², ρ = Σ w_d w_{d+1}, bin for bin: the mean within 5
-// standard errors plus 4/n (a false alarm under 1e-5). Returns beam A's factors 4 windows apart
-// (independent), for a test of their distribution.
+// 1 .. 2R+1, and with `own` each its own last, w's last weight), their factors correlate by ρ²,
+// ρ = Σ w_d w_{d+1} over the shared weights, bin for bin: the mean within 5 standard errors plus
+// 4/n (a false alarm under 1e-5). Returns beam A's factors 4 windows apart (independent), for a
+// test of their distribution.
 std::vector<double> ExpectNeighboursShareSectors(const std::vector<double>& w, int window,
-                                                 int looks, std::uint64_t seed_base) {
+                                                 int looks, std::uint64_t seed_base,
+                                                 bool own = false) {
+  const std::size_t shared = w.size() - (own ? 1 : 0);
   double rho = 0.0;
-  for (std::size_t d = 0; d + 1 < w.size(); ++d) rho += w[d] * w[d + 1];
+  for (std::size_t d = 0; d + 1 < shared; ++d) rho += w[d] * w[d + 1];
   constexpr int kPairs = 64;
   constexpr std::size_t kLength = 16384;
   std::vector<double> a(kLength);
@@ -136,9 +139,15 @@ std::vector<double> ExpectNeighboursShareSectors(const std::vector<double>& w, i
   std::vector<double> independent;
   for (int pair = 0; pair < kPairs; ++pair) {
     std::vector<std::uint64_t> place;
-    for (std::size_t d = 0; d < w.size() + 1; ++d) place.push_back(DeriveSeed(seed_base + pair, d));
-    BeamSynthesizer::SectorSpeckle(a, window, w, std::span(place).first(w.size()), looks);
-    BeamSynthesizer::SectorSpeckle(b, window, w, std::span(place).subspan(1), looks);
+    for (std::size_t d = 0; d < shared + 1; ++d) place.push_back(DeriveSeed(seed_base + pair, d));
+    std::vector<std::uint64_t> seeds_a(place.begin(), place.begin() + shared);
+    std::vector<std::uint64_t> seeds_b(place.begin() + 1, place.end());
+    if (own) {
+      seeds_a.push_back(DeriveSeed(seed_base + pair, 1000));
+      seeds_b.push_back(DeriveSeed(seed_base + pair, 1001));
+    }
+    BeamSynthesizer::SectorSpeckle(a, window, w, seeds_a, looks);
+    BeamSynthesizer::SectorSpeckle(b, window, w, seeds_b, looks);
     for (std::size_t k = 0; k < kLength; k += 4 * static_cast<std::size_t>(window)) {
       independent.push_back(a[k]);
     }
@@ -1676,6 +1685,35 @@ TEST(BeamSynthesis, NeighbouringBeamsShareTheirSectorsSpeckle) {
   EXPECT_EQ(direct, sector);
 
   const std::vector<double> independent = ExpectNeighboursShareSectors(w, kWindow, 1, 1000);
+  const auto n = static_cast<double>(independent.size());
+  EXPECT_LT(KsDistance(independent, [](double v) { return 1.0 - std::exp(-v); }),
+            1.949 / std::sqrt(n) + 1.0 / BeamSynthesizer::kSpecklePhases);
+}
+
+// With Acoustics::speckle_own_share ν each head step hears ν of its speckle's power on its own:
+//  - the weights are the sectors' times √(1 - ν), then √ν, the beam's own: squares summing to 1;
+//  - two beams one sector apart, each with its own last seed, correlate by ((1 - ν) ρ)², ρ the
+//    sectors' Σ w_d w_{d+1} without it (64 pairs, as above), and each beam's factors stay
+//    exponential of mean 1 (KS, as above).
+TEST(BeamSynthesis, EachHeadStepHearsItsOwnShareOfTheSpeckle) {
+  SensorModel micron = QuietSensor();
+  const std::vector<TriangleMesh> none;
+  const RayTracer tracer(none);
+  const std::vector<double> sectors = BeamSynthesizer(micron, tracer, {Material{}}).SectorWeights();
+  constexpr double kOwn = 0.3;
+  micron.acoustics.speckle_own_share = kOwn;
+  const std::vector<double> w = BeamSynthesizer(micron, tracer, {Material{}}).SectorWeights();
+  ASSERT_EQ(w.size(), sectors.size() + 1);
+  double squares = 0.0;
+  for (std::size_t d = 0; d < w.size(); ++d) {
+    squares += w[d] * w[d];
+    if (d < sectors.size()) {
+      EXPECT_NEAR(w[d], std::sqrt(1.0 - kOwn) * sectors[d], 1e-15);
+    }
+  }
+  EXPECT_NEAR(w.back(), std::sqrt(kOwn), 1e-15);
+  EXPECT_NEAR(squares, 1.0, 1e-12);
+  const std::vector<double> independent = ExpectNeighboursShareSectors(w, 4, 1, 3000, true);
   const auto n = static_cast<double>(independent.size());
   EXPECT_LT(KsDistance(independent, [](double v) { return 1.0 - std::exp(-v); }),
             1.949 / std::sqrt(n) + 1.0 / BeamSynthesizer::kSpecklePhases);

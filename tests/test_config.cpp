@@ -266,29 +266,6 @@ TEST(SceneFile, ReverberationIsTheScenes) {
   }
 }
 
-// The place's angular correlation needs the place's speckle: set without it (the sensor model
-// has none), the scene is refused, naming the key, its line and what it needs.
-TEST(SceneFile, AngularCorrelationNeedsThePlacesSpeckle) {
-  for (const std::string extra : {"", "  speckle_correlation_m: 0.05\n  speckle: false\n"}) {
-    test::TempDir dir;
-    const std::string path = (dir.path() / "bad.yaml").string();
-    std::ofstream(path)
-        << "name: x\nsensor_model: " << test::SourcePath("sensor-models/shad-micron.yaml")
-        << "\nsweeps: 1\nsonar_acoustics:\n"
-        << "  speckle_angular_correlation_deg: 7.2\n"
-        << extra << "materials:\n  - {name: rock, reflectivity: 0.5}\n"
-        << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
-        << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
-    EXPECT_TRUE(ThrowsInputErrorWith(
-        [&] { (void)sim::LoadScene(path); },
-        {"bad.yaml:5:", "'sonar_acoustics.speckle_angular_correlation_deg'", "the place's speckle",
-         extra.empty() ? "got speckle_correlation_m 0" : "got speckle: false"}))
-        << extra;
-  }
-  const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
-  EXPECT_EQ(tank.sensor.acoustics.speckle_angular_correlation_deg, 3.0);
-}
-
 // A scene on the Micron whose sonar_acoustics (from line 5) are `acoustics` is refused, the
 // message naming line 5 of the file and each of `expected`.
 void ExpectSonarAcousticsRefused(const std::string& acoustics,
@@ -304,6 +281,39 @@ void ExpectSonarAcousticsRefused(const std::string& acoustics,
   std::vector<std::string> parts = {"bad.yaml:5:"};
   parts.insert(parts.end(), expected.begin(), expected.end());
   EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, parts)) << acoustics;
+}
+
+// The place's angular correlation and the head step's own share of its speckle need the place's
+// speckle: set without it (the sensor model has none), the scene is refused, naming the key, its
+// line and what it needs; a share of 1 or more (nothing left to share) too.
+TEST(SceneFile, AngularCorrelationAndOwnShareNeedThePlacesSpeckle) {
+  for (const std::string key : {"speckle_angular_correlation_deg: 7.2", "speckle_own_share: 0.2"}) {
+    for (const std::string extra : {"", "  speckle_correlation_m: 0.05\n  speckle: false\n"}) {
+      test::TempDir dir;
+      const std::string path = (dir.path() / "bad.yaml").string();
+      std::ofstream(path) << "name: x\nsensor_model: "
+                          << test::SourcePath("sensor-models/shad-micron.yaml")
+                          << "\nsweeps: 1\nsonar_acoustics:\n  " << key << "\n"
+                          << extra << "materials:\n  - {name: rock, reflectivity: 0.5}\n"
+                          << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: "
+                             "rock}\n"
+                          << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+      EXPECT_TRUE(ThrowsInputErrorWith(
+          [&] { (void)sim::LoadScene(path); },
+          {"bad.yaml:5:", "'sonar_acoustics." + key.substr(0, key.find(':')) + "'",
+           "the place's speckle",
+           extra.empty() ? "got speckle_correlation_m 0" : "got speckle: false"}))
+          << key << extra;
+    }
+  }
+  ExpectSonarAcousticsRefused("  speckle_own_share: 1\n  speckle_correlation_m: 0.05\n",
+                              {"'sonar_acoustics.speckle_own_share'", "'1'"});
+  const sim::SensorModel micron =
+      sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
+  EXPECT_EQ(micron.acoustics.speckle_own_share, 0.0);
+  const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  EXPECT_EQ(tank.sensor.acoustics.speckle_angular_correlation_deg, 7.2);
+  EXPECT_EQ(tank.sensor.acoustics.speckle_own_share, 0.16);
 }
 
 // The speckle's looks and window are the tank's (the sensor model keeps one look over the

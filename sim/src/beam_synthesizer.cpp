@@ -99,6 +99,11 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
     }
     for (double& w : sector_weights_) w = std::sqrt(w / total);
     if (acoustics.speckle_angular_correlation_deg > 0.0) CorrelateSectors();
+    // The beam's own scatterers' share, after the sectors' (SeedPlace seeds it last).
+    if (const double own = acoustics.speckle_own_share; own > 0.0) {
+      for (double& w : sector_weights_) w *= std::sqrt(1.0 - own);
+      sector_weights_.push_back(std::sqrt(own));
+    }
   }
   if (sensor_.acoustics.second_trip_db > -100.0) {
     second_trip_ = std::pow(10.0, sensor_.acoustics.second_trip_db / 10.0);
@@ -1029,7 +1034,8 @@ class BeamSynthesizer::BeamJob {
 
 void BeamSynthesizer::BeamJob::SeedPlace() {
   std::vector<std::uint64_t>& sector_seeds = scratch_.sector_seeds;
-  const int sector_reach = static_cast<int>(s_.sector_weights_.size() / 2);
+  const bool own = a_.speckle_own_share > 0.0;
+  const int sector_reach = static_cast<int>((s_.sector_weights_.size() - (own ? 1 : 0)) / 2);
   sector_seeds.resize(s_.sector_weights_.size());
   if (a_.speckle_correlation_m <= 0.0) return;
   const double step = g_.step_angle_rad;
@@ -1056,6 +1062,7 @@ void BeamSynthesizer::BeamJob::SeedPlace() {
     sector_seeds[static_cast<std::size_t>(d + sector_reach)] =
         DeriveSeed(place_of(azimuth + d), 0x737065636bULL);  // "speck"
   }
+  if (own) sector_seeds.back() = DeriveSeed(place_of(azimuth), 0x6f776eULL);  // "own"
 }
 
 void BeamSynthesizer::BeamJob::MeetVehicle() {

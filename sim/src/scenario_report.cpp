@@ -92,6 +92,7 @@ nlohmann::json SensorJson(const SensorModel& s) {
             {"speckle_window_m", a.speckle_window_m},
             {"speckle_correlation_m", a.speckle_correlation_m},
             {"speckle_angular_correlation_deg", a.speckle_angular_correlation_deg},
+            {"speckle_own_share", a.speckle_own_share},
             {"reverberation_length_m", a.reverberation_length_m},
             {"reverberation_db", a.reverberation_db},
             {"second_trip_db", a.second_trip_db},

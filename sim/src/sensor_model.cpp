@@ -49,6 +49,7 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("speckle_correlation_m", a.speckle_correlation_m, InRange(0.0, 1000.0));
   node.Optional("speckle_angular_correlation_deg", a.speckle_angular_correlation_deg,
                 InRange(0.0, 30.0));
+  node.Optional("speckle_own_share", a.speckle_own_share, InRange(0.0, 0.99));
   node.Optional("reverberation_length_m", a.reverberation_length_m, InRange(0.0, 1000.0));
   node.Optional("reverberation_db", a.reverberation_db, InRange(-100.0, 20.0));
   node.Optional("second_trip_db", a.second_trip_db, InRange(-100.0, 20.0));
@@ -81,12 +82,14 @@ void CheckAcoustics(YamlReader& node, const Acoustics& merged,
     node.Fail("speckle_looks",
               "speckle: true (looks of a speckle that is off), got speckle: false");
   }
-  if (merged.speckle_angular_correlation_deg > 0.0 &&
-      !(merged.speckle && merged.speckle_correlation_m > 0.0)) {
-    node.Fail("speckle_angular_correlation_deg",
-              std::string("the place's speckle to correlate (speckle: true and "
-                          "speckle_correlation_m > 0), got ") +
-                  (merged.speckle ? "speckle_correlation_m 0" : "speckle: false"));
+  for (const auto& [key, value] :
+       {std::pair{"speckle_angular_correlation_deg", merged.speckle_angular_correlation_deg},
+        std::pair{"speckle_own_share", merged.speckle_own_share}}) {
+    if (value > 0.0 && !(merged.speckle && merged.speckle_correlation_m > 0.0)) {
+      node.Fail(key, std::string("the place's speckle (speckle: true and "
+                                 "speckle_correlation_m > 0), got ") +
+                         (merged.speckle ? "speckle_correlation_m 0" : "speckle: false"));
+    }
   }
   for (const auto& [key, spread] :
        {std::pair{"self_reflection_ping_spread_db", merged.self_reflection_ping_spread_db},

@@ -108,6 +108,14 @@ struct Acoustics {
   /// along arcs of about this angle rather than changing from beam to beam as the pattern's
   /// overlap alone makes it. 0, the default: independent sectors. Needs speckle_correlation_m.
   double speckle_angular_correlation_deg = 0.0;
+  /// With the place's speckle, the share of its power [0, 1) each head step hears on its own,
+  /// shared with no other: the transducer turns about an axis its face is off, so neighbouring
+  /// head steps hear the scatterers they share from phase centres a fraction of a wavelength
+  /// apart, and their coherent sums differ by more than the pattern's overlap makes them. Frozen
+  /// per head step like the rest of the place's speckle (the head comes back to the same angle
+  /// each sweep). Neighbouring beams' speckle then correlates by (1 - this)² times what the
+  /// sectors alone give. 0, the default: none. Needs speckle_correlation_m.
+  double speckle_own_share = 0.0;
   /// The reverberation of a closed place (a tank): every echo feeds a diffuse tail heard after
   /// it, decaying exponentially with range, e-folding over `reverberation_length_m` [m] (0: no
   /// tail, the default), holding in all `reverberation_db` [dB] of the echo's power. A
