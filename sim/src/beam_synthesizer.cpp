@@ -1245,11 +1245,12 @@ void BeamSynthesizer::BeamJob::TraceMultipath() {
       // trigonometry and culls only what the pattern itself would (0.999 leaves rounding a
       // margin); the weight keeps its own order of products, so its bits do not change.
       const Eigen::Vector3d u = one_way_pattern.R_beam_world * (-back / d);
-      const double reach = 2.0 * std::sqrt(was.pattern) * was.specular;
+      const double way_out = 2.0 * std::sqrt(was.pattern);  // both ways round the path
       const double largest = std::max(m.reflectivity, m.glint);
-      if (reach * s_.OneWayPatternBound(u) * largest < 0.999 * kNegligibleWeight) continue;
-      const double receive = s_.OneWayPatternTowards(u);
-      const double weight = 2.0 * std::sqrt(was.pattern) * receive * was.specular;
+      if (way_out * was.specular * s_.OneWayPatternBound(u) * largest < 0.999 * kNegligibleWeight) {
+        continue;
+      }
+      const double weight = way_out * s_.OneWayPatternTowards(u) * was.specular;
       if (weight * largest < kNegligibleWeight) continue;
       const Eigen::Vector3f to_sonar = (back / d).cast<float>();
       const double cos_out = std::abs(hit.normal.dot(to_sonar));
