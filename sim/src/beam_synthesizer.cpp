@@ -540,14 +540,17 @@ void SectorSpeckleLook(std::span<double> factors, int window,
   const std::size_t length = factors.size() + size - 1;
   // A sector's phasors, kept per thread and look for the next beams: a static sonar's
   // neighbouring beams share all but one of their sectors. Keyed by seed and length, so what a
-  // beam gets does not depend on which beams the thread did before.
+  // beam gets does not depend on which beams the thread did before. The least recently used
+  // goes first: a beam's own sector (Acoustics::speckle_own_share), which no other beam hears,
+  // then leaves after one beam instead of pushing out sectors the next beam needs.
   struct Sector {
     std::uint64_t seed = 0;
+    std::uint64_t used = 0;  // the cache's clock when last asked for; 0 if never
     std::vector<std::complex<double>> phasors;
   };
   struct Cache {
     std::vector<Sector> sectors;
-    std::size_t next_slot = 0;
+    std::uint64_t clock = 0;
   };
   thread_local std::vector<Cache> caches;
   if (caches.size() <= static_cast<std::size_t>(look)) {
@@ -561,11 +564,17 @@ void SectorSpeckleLook(std::span<double> factors, int window,
       [&](std::uint64_t sector_seed) -> const std::vector<std::complex<double>>& {
     const std::uint64_t seed =
         look == 0 ? sector_seed : DeriveSeed(sector_seed, static_cast<std::uint64_t>(look));
-    for (const Sector& sector : cache.sectors) {
-      if (sector.seed == seed && sector.phasors.size() == length) return sector.phasors;
+    ++cache.clock;
+    Sector* oldest = &cache.sectors.front();
+    for (Sector& sector : cache.sectors) {
+      if (sector.seed == seed && sector.phasors.size() == length) {
+        sector.used = cache.clock;
+        return sector.phasors;
+      }
+      if (sector.used < oldest->used) oldest = &sector;
     }
-    Sector& sector = cache.sectors[cache.next_slot];
-    cache.next_slot = (cache.next_slot + 1) % cache.sectors.size();
+    Sector& sector = *oldest;
+    sector.used = cache.clock;
     sector.seed = seed;
     sector.phasors.resize(length);
     Rng rng(seed);
