@@ -289,21 +289,10 @@ void ExpectSonarAcousticsRefused(const std::string& acoustics,
 TEST(SceneFile, AngularCorrelationAndOwnShareNeedThePlacesSpeckle) {
   for (const std::string key : {"speckle_angular_correlation_deg: 7.2", "speckle_own_share: 0.2"}) {
     for (const std::string extra : {"", "  speckle_correlation_m: 0.05\n  speckle: false\n"}) {
-      test::TempDir dir;
-      const std::string path = (dir.path() / "bad.yaml").string();
-      std::ofstream(path) << "name: x\nsensor_model: "
-                          << test::SourcePath("sensor-models/shad-micron.yaml")
-                          << "\nsweeps: 1\nsonar_acoustics:\n  " << key << "\n"
-                          << extra << "materials:\n  - {name: rock, reflectivity: 0.5}\n"
-                          << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: "
-                             "rock}\n"
-                          << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
-      EXPECT_TRUE(ThrowsInputErrorWith(
-          [&] { (void)sim::LoadScene(path); },
-          {"bad.yaml:5:", "'sonar_acoustics." + key.substr(0, key.find(':')) + "'",
-           "the place's speckle",
-           extra.empty() ? "got speckle_correlation_m 0" : "got speckle: false"}))
-          << key << extra;
+      ExpectSonarAcousticsRefused(
+          "  " + key + "\n" + extra,
+          {"'sonar_acoustics." + key.substr(0, key.find(':')) + "'", "the place's speckle",
+           extra.empty() ? "got speckle_correlation_m 0" : "got speckle: false"});
     }
   }
   ExpectSonarAcousticsRefused("  speckle_own_share: 1\n  speckle_correlation_m: 0.05\n",

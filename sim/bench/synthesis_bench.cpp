@@ -122,7 +122,7 @@ std::unique_ptr<SweepQueries> RecordSweepQueries(const BenchScene& bench) {
   const RayTracer* vehicle = out->synthesizer.VehicleTracer();
   bench.tracer.Record(&out->scene.log);
   if (vehicle != nullptr) vehicle->Record(&out->vehicle.log);
-  const std::vector<SynthesizedBeam> beams = SimulateSweep(bench.scene, out->synthesizer, 1);
+  (void)SimulateSweep(bench.scene, out->synthesizer, 1);
   bench.tracer.Record(nullptr);
   if (vehicle != nullptr) vehicle->Record(nullptr);
   SplitBundles(out->scene);
