@@ -103,6 +103,27 @@ TEST(YamlReader, FailAtAKeyLeavesTheMappingIntact) {
   EXPECT_EQ(message.find("'c'"), std::string::npos) << message;
 }
 
+// A value that should be a mapping and is not, or is missing, is one mistake, reported once:
+// the keys then read from it, its checks and its unknown keys add nothing.
+TEST(YamlReader, AValueThatIsNotAMappingIsReportedOnce) {
+  YamlReader reader = YamlReader::FromString("a: 5\nb: x\n", "scene.yaml");
+  int c = 0;
+  for (const char* key : {"a", "d"}) {
+    YamlReader child = reader.Child(key);
+    child.Required("c", c);
+    child.Fail("", "a bound");
+    child.RejectUnknownKeys();
+  }
+  int b = 0;
+  reader.Required("b", b);  // a mistake of its own: still reported
+  reader.RejectUnknownKeys();
+  const std::string message = test::InputErrorOf([&] { reader.ThrowIfErrors(); });
+  EXPECT_EQ(message,
+            "scene.yaml:1:4: key 'a': expected a mapping, got '5'\n"
+            "scene.yaml:1:1: key 'd': missing (expected a mapping)\n"
+            "scene.yaml:2:4: key 'b': expected an integer, got 'x'");
+}
+
 TEST(YamlReader, SyntaxErrorNamesFileAndLine) {
   EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("a: [1, 2\nb: 3\n"); },
                                    {"scene.yaml:", "invalid YAML"}));
@@ -131,16 +152,62 @@ TEST(SceneFile, BadSceneNamesItsFileAndKey) {
       ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, {path, "'sweeps'", "got '-3'"}));
 }
 
-TEST(SceneFile, UnknownMaterialIsNamed) {
+// The message a small scene (one material, one mesh, the trajectory) is refused with.
+std::string SmallSceneRefusal(const std::string& material, const std::string& mesh,
+                              const std::string& trajectory) {
   test::TempDir dir;
   const std::string path = (dir.path() / "bad.yaml").string();
   std::ofstream(path) << "name: x\nsensor_model: "
                       << test::SourcePath("sensor-models/shad-micron.yaml")
-                      << "\nsweeps: 1\nmaterials:\n  - {name: rock, reflectivity: 0.5}\n"
-                      << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: mud}\n"
-                      << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
-  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
-                                   {"bad.yaml:7:", "'meshes[0].material'", "'mud'"}));
+                      << "\nsweeps: 1\nmaterials:\n  - " << material << "\nmeshes:\n  - " << mesh
+                      << "\ntrajectory: " << trajectory << "\n";
+  return test::InputErrorOf([&] { (void)sim::LoadScene(path); });
+}
+
+// `message` is one error, the one that holds `expected`.
+::testing::AssertionResult IsTheOneError(const std::string& message, const std::string& expected) {
+  if (message.find(expected) == std::string::npos || message.find('\n') != std::string::npos) {
+    return ::testing::AssertionFailure() << "expected only \"" << expected << "\"; message was:\n"
+                                         << message;
+  }
+  return ::testing::AssertionSuccess();
+}
+
+constexpr const char* kRock = "{name: rock, reflectivity: 0.5}";
+constexpr const char* kPlane = "{name: m, type: plane, size_m: [1, 1, 0], material: rock}";
+constexpr const char* kStatic = "{type: static, position_m: [0, 0, 0]}";
+
+// A mesh whose type is not one is reported by its type alone: its size or file is neither
+// asked for nor unknown, since which it should have is what the type would say. So is a
+// trajectory's: its position is neither asked for nor unknown.
+TEST(SceneFile, AMeshOfNoKnownTypeIsReportedByItsTypeAlone) {
+  EXPECT_TRUE(IsTheOneError(
+      SmallSceneRefusal(kRock, "{name: m, type: plain, size_m: [1, 1, 0], material: rock}",
+                        kStatic),
+      "bad.yaml:7:21: key 'meshes[0].type': expected one of: tank, box, plane, height_field, "
+      "file, got 'plain'"));
+  EXPECT_TRUE(
+      IsTheOneError(SmallSceneRefusal(kRock, kPlane, "{type: still, position_m: [0, 0, 0]}"),
+                    "key 'trajectory.type': expected one of: static, waypoints, got 'still'"));
+}
+
+// A check across keys waits for their values: a glint's spread that is refused is reported as
+// refused, not again as the default 0 the glint's check would see; a material whose name is
+// refused is not reported again as missing by the mesh that names it.
+TEST(SceneFile, ARefusedValueIsNotReportedAgainByTheChecksOnIt) {
+  EXPECT_TRUE(IsTheOneError(
+      SmallSceneRefusal("{name: rock, reflectivity: 0.5, glint: 0.3, specular_spread_deg: wide}",
+                        kPlane, kStatic),
+      "key 'materials[0].specular_spread_deg': expected a finite number, got 'wide'"));
+  EXPECT_TRUE(IsTheOneError(SmallSceneRefusal("{name: [rock], reflectivity: 0.5}", kPlane, kStatic),
+                            "key 'materials[0].name': expected a string, got a list"));
+}
+
+TEST(SceneFile, UnknownMaterialIsNamed) {
+  EXPECT_TRUE(IsTheOneError(
+      SmallSceneRefusal(kRock, "{name: m, type: plane, size_m: [1, 1, 0], material: mud}", kStatic),
+      "bad.yaml:7:57: key 'meshes[0].material': the name of a material under 'materials', got "
+      "'mud'"));
 }
 
 // A scene's sonar_acoustics replaces only the keys it names; the rest come from the model.
@@ -645,6 +712,20 @@ TEST(SceneFile, VehiclePartsAreReadAndRefusedWithReasons) {
                       {"clash.yaml:10:", "'vehicle[0].name'", "not used before", "'bed'"}));
   EXPECT_TRUE(refused("mud.yaml", "{name: p, type: plane, size_m: [1, 1, 0], material: mud}",
                       {"mud.yaml:10:", "'vehicle[0].material'", "'mud'"}));
+  // An unknown material is reported alone, not also as the scene's first one, a mirror here.
+  const std::string glass_first =
+      WriteText(dir, "glass_first.yaml",
+                "name: x\nsensor_model: " + model +
+                    "\nsweeps: 1\nmaterials:\n  - {name: glass, reflectivity: 0.1, specular: 0.5}\n"
+                    "meshes: [{name: bed, type: plane, size_m: [9, 9, 0], material: glass}]\n"
+                    "trajectory: {type: static, position_m: [0, 0, 1]}\n"
+                    "vehicle:\n  - {name: p, type: plane, size_m: [1, 1, 0], material: mud}\n");
+  const std::string message = test::InputErrorOf([&] { (void)sim::LoadScene(glass_first); });
+  EXPECT_NE(message.find("key 'vehicle[0].material': the name of a material under 'materials', "
+                         "got 'mud'"),
+            std::string::npos)
+      << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
 }
 
 TEST(SceneFile, MissingFileIsAnInputError) {

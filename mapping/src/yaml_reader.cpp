@@ -109,10 +109,10 @@ struct Decoder<std::vector<double>> {
 YamlReader::YamlReader(YAML::Node node, std::shared_ptr<State> state, std::string path)
     : node_(std::move(node)), state_(std::move(state)), path_(std::move(path)) {
   if (!node_.IsMap()) {
-    state_->errors.push_back(Where(node_) + ": " +
-                             (path_.empty() ? std::string("document") : "key '" + path_ + "'") +
-                             ": expected a mapping, got " + Describe(node_));
+    Record(Where(node_) + ": " + (path_.empty() ? std::string("document") : "key '" + path_ + "'") +
+           ": expected a mapping, got " + Describe(node_));
     node_ = YAML::Node(YAML::NodeType::Map);
+    not_a_mapping_ = true;
     return;
   }
   // yaml-cpp keeps duplicate keys and silently answers lookups with the first: report them.
@@ -120,8 +120,8 @@ YamlReader::YamlReader(YAML::Node node, std::shared_ptr<State> state, std::strin
   for (const auto& item : node_) {
     const std::string key = item.first.Scalar();
     if (!seen.insert(key).second) {
-      state_->errors.push_back(Where(item.first) + ": key '" + KeyPath(key) +
-                               "': duplicate key (each key may appear once)");
+      Record(Where(item.first) + ": key '" + KeyPath(key) +
+             "': duplicate key (each key may appear once)");
     }
   }
 }
@@ -188,7 +188,7 @@ void YamlReader::Fail(const std::string& key, const std::string& expected) {
   for (const auto& item : node_) {
     if (item.first.Scalar() == key) at.reset(item.second);
   }
-  state_->errors.push_back(Where(at) + ": key '" + KeyPath(key) + "': " + expected);
+  Record(Where(at) + ": key '" + KeyPath(key) + "': " + expected, Kind::kCheck);
 }
 
 template <typename T>
@@ -196,14 +196,14 @@ void YamlReader::Read(const std::string& key, const YAML::Node& value, T& out,
                       const Check<T>& check) {
   const auto decoded = Decoder<T>::Decode(value);
   if (!decoded) {
-    state_->errors.push_back(Where(value) + ": key '" + KeyPath(key) + "': expected " +
-                             Decoder<T>::kWhat + ", got " + Describe(value));
+    Record(Where(value) + ": key '" + KeyPath(key) + "': expected " + Decoder<T>::kWhat + ", got " +
+           Describe(value));
     return;
   }
   if (check) {
     if (const auto expected = check(*decoded)) {
-      state_->errors.push_back(Where(value) + ": key '" + KeyPath(key) + "': expected " +
-                               *expected + ", got " + Describe(value));
+      Record(Where(value) + ": key '" + KeyPath(key) + "': expected " + *expected + ", got " +
+             Describe(value));
       return;
     }
   }
@@ -214,8 +214,8 @@ template <typename T>
 void YamlReader::Required(const std::string& key, T& out, Check<T> check) {
   const YAML::Node value = Lookup(key);
   if (!value.IsDefined()) {
-    state_->errors.push_back(Where(node_) + ": key '" + KeyPath(key) + "': missing (expected " +
-                             Decoder<T>::kWhat + ")");
+    Record(Where(node_) + ": key '" + KeyPath(key) + "': missing (expected " + Decoder<T>::kWhat +
+           ")");
     return;
   }
   Read(key, value, out, check);
@@ -231,9 +231,10 @@ void YamlReader::Optional(const std::string& key, T& out, Check<T> check) {
 YamlReader YamlReader::Child(const std::string& key) {
   const YAML::Node value = Lookup(key);
   if (!value.IsDefined()) {
-    state_->errors.push_back(Where(node_) + ": key '" + KeyPath(key) +
-                             "': missing (expected a mapping)");
-    return YamlReader(YAML::Node(YAML::NodeType::Map), state_, KeyPath(key));
+    Record(Where(node_) + ": key '" + KeyPath(key) + "': missing (expected a mapping)");
+    YamlReader missing(YAML::Node(YAML::NodeType::Map), state_, KeyPath(key));
+    missing.not_a_mapping_ = true;  // none of its keys is missing too
+    return missing;
   }
   return YamlReader(value, state_, KeyPath(key));
 }
@@ -248,8 +249,8 @@ std::vector<YamlReader> YamlReader::Sequence(const std::string& key) {
   const YAML::Node value = Lookup(key);
   std::vector<YamlReader> out;
   if (!value.IsDefined() || !value.IsSequence() || value.size() == 0) {
-    state_->errors.push_back(Where(value.IsDefined() ? value : node_) + ": key '" + KeyPath(key) +
-                             "': expected a non-empty list of mappings, got " + Describe(value));
+    Record(Where(value.IsDefined() ? value : node_) + ": key '" + KeyPath(key) +
+           "': expected a non-empty list of mappings, got " + Describe(value));
     return out;
   }
   for (std::size_t i = 0; i < value.size(); ++i) {
@@ -264,11 +265,22 @@ void YamlReader::RejectUnknownKeys() {
     if (!used_.contains(key)) {
       std::string known;
       for (const auto& k : used_) known += (known.empty() ? "" : ", ") + k;
-      state_->errors.push_back(Where(item.first) + ": key '" + KeyPath(key) +
-                               "': unknown key (known here: " + known + ")");
+      Record(Where(item.first) + ": key '" + KeyPath(key) + "': unknown key (known here: " + known +
+             ")");
     }
   }
 }
+
+void YamlReader::Record(std::string message, Kind kind) {
+  // A value that is not a mapping was reported as such; its keys and checks would only report
+  // that again in other words. A check across values may rest on a refused one's default (a
+  // glint's spread, a material's name): it waits until every value reads.
+  if (not_a_mapping_ || (kind == Kind::kCheck && state_->value_refused)) return;
+  if (kind == Kind::kRead) state_->value_refused = true;
+  state_->errors.push_back(std::move(message));
+}
+
+void YamlReader::Ignore(const std::string& key) { used_.insert(key); }
 
 void YamlReader::ThrowIfErrors() const {
   if (state_->errors.empty()) return;

@@ -32,7 +32,14 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
            : type == "box"          ? MeshSpec::Type::kBox
            : type == "height_field" ? MeshSpec::Type::kHeightField
                                     : MeshSpec::Type::kFile;
-  if (m.type == MeshSpec::Type::kFile) {
+  if (type.empty()) {
+    // The type was refused (or missing): which of these keys belong is unknown, so none is
+    // read and none is reported as unknown.
+    for (const char* key :
+         {"file", "scale", "size_m", "cell_m", "amplitude_m", "wavelength_m", "roughness_m"}) {
+      node.Ignore(key);
+    }
+  } else if (m.type == MeshSpec::Type::kFile) {
     node.Required("file", m.file);
     node.Optional("scale", m.scale,
                   YamlReader::Check<std::array<double, 3>>(
@@ -66,8 +73,11 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
       found = true;
     }
   }
-  if (!found && !material.empty()) {
-    node.Fail("material", "the name of a material under 'materials', got '" + material + "'");
+  if (!found) {
+    m.material = materials.size();  // none: no check on the material's properties follows
+    if (!material.empty()) {
+      node.Fail("material", "the name of a material under 'materials', got '" + material + "'");
+    }
   }
   node.RejectUnknownKeys();
   return m;
@@ -77,7 +87,10 @@ Trajectory ReadTrajectory(YamlReader& node) {
   Trajectory t;
   std::string type;
   node.Required("type", type, OneOf({"static", "waypoints"}));
-  if (type == "static") {
+  if (type.empty()) {
+    // The type was refused (or missing): its keys are neither read nor reported as unknown.
+    for (const char* key : {"position_m", "rpy_deg", "waypoints"}) node.Ignore(key);
+  } else if (type == "static") {
     Waypoint w;
     std::array<double, 3> position{0, 0, 0};
     std::array<double, 3> rpy_deg{0, 0, 0};
@@ -234,8 +247,8 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
         item.Fail("material",
                   "a material with specular 0 (the multipath is not traced off the "
                   "vehicle), got '" +
-                      scene.materials[part.material].name + "' with " +
-                      std::to_string(scene.materials[part.material].specular));
+                      scene.materials[part.material].name + "' with specular " +
+                      FormatMetricValue(scene.materials[part.material].specular));
       }
       scene.vehicle.push_back(std::move(part));
     }

@@ -15,7 +15,10 @@ namespace sonarbench {
 /// Reads one YAML mapping into a config struct, strictly: unknown keys, duplicate keys, missing
 /// required keys, wrong types and out-of-range values are all collected, each as
 /// "file:line:column: key 'a.b.c': expected ..., got ...", and thrown together as one
-/// InputError by ThrowIfErrors() on the root reader. Keys absent from an optional read keep the
+/// InputError by ThrowIfErrors() on the root reader. A value that should be a mapping and is not
+/// is reported once: nothing read from it after that adds an error. Checks recorded with Fail()
+/// are reported only while every value read so far was taken: one across keys would otherwise
+/// report a refused value's default. Keys absent from an optional read keep the
 /// struct's in-class default, so the struct stays the one source of truth for defaults.
 class YamlReader {
  public:
@@ -45,8 +48,13 @@ class YamlReader {
   [[nodiscard]] bool Has(const std::string& key) const;
   /// The keys of this mapping, in file order (for mappings keyed by name, such as criteria).
   [[nodiscard]] std::vector<std::string> Keys() const;
-  /// Records an error at `key` (or at this node when `key` is empty).
+  /// Records an error at `key` (or at this node when `key` is empty): a check of values read,
+  /// dropped when a value was refused before it.
   void Fail(const std::string& key, const std::string& expected);
+
+  /// Takes `key` as known without reading it: for keys whose meaning depends on a value that was
+  /// refused (a mesh's size under a `type` that is not one), so that they are not also reported.
+  void Ignore(const std::string& key);
 
   /// Reports every key of this mapping that no Required/Optional/Child call asked for. Call it
   /// once per reader after reading all of its keys.
@@ -62,9 +70,14 @@ class YamlReader {
   struct State {
     std::string file;
     std::vector<std::string> errors;
+    bool value_refused = false;  // a value was not taken (wrong type, range, key, shape)
   };
+  enum class Kind { kRead, kCheck };  // an error reading a value, or a check on values read
   YamlReader(YAML::Node node, std::shared_ptr<State> state, std::string path);
 
+  /// Adds an error, unless this reader's value was not a mapping (reported already) or it is a
+  /// check and a value was refused.
+  void Record(std::string message, Kind kind = Kind::kRead);
   [[nodiscard]] std::string Where(const YAML::Node& node) const;
   [[nodiscard]] std::string KeyPath(const std::string& key) const;
   [[nodiscard]] YAML::Node Lookup(const std::string& key);
@@ -75,6 +88,7 @@ class YamlReader {
   std::shared_ptr<State> state_;
   std::string path_;
   std::set<std::string> used_;
+  bool not_a_mapping_ = false;
 };
 
 // Checks for the common cases.
