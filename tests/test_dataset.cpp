@@ -85,6 +85,12 @@ TEST(Tum, RoundTripsAPoseAndNamesTheBadLine) {
               (void)mapping::ReadTum(path.string());
             }).find("p.tum:2: expected 8"),
             std::string::npos);
+  // A damaged line is quoted printable and short: its bytes as \xNN, cut after 80.
+  std::ofstream(path) << "0 0.1 0.4\xfa" << std::string(5000, '7') << "\n";
+  const std::string damaged = test::InputErrorOf([&] { (void)mapping::ReadTum(path.string()); });
+  EXPECT_NE(damaged.find("got '0 0.1 0.4\\xfa777"), std::string::npos) << damaged;
+  EXPECT_NE(damaged.find("7777'..."), std::string::npos) << damaged;
+  EXPECT_LT(damaged.size(), path.string().size() + 200) << damaged;
   std::ofstream(path) << "0 0 0 0 0 0 0 2\n";
   EXPECT_NE(test::InputErrorOf([&] { (void)mapping::ReadTum(path.string()); }).find("norm"),
             std::string::npos);

@@ -140,8 +140,8 @@ std::vector<StampedPose> ReadTum(const std::string& path) {
     if (!fields || (fields >> rest) ||
         !std::all_of(std::begin(v), std::end(v), [](double x) { return std::isfinite(x); })) {
       throw InputError(path + ":" + std::to_string(number) +
-                       ": expected 8 finite numbers 'time tx ty tz qx qy qz qw', got '" + line +
-                       "'");
+                       ": expected 8 finite numbers 'time tx ty tz qx qy qz qw', got " +
+                       Quoted(line));
     }
     const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     if (std::abs(q.norm() - 1.0) > 1e-6) {

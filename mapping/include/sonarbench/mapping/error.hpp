@@ -1,7 +1,9 @@
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace sonarbench {
 
@@ -11,5 +13,9 @@ class InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+/// `text` quoted for a message: bytes outside printable ASCII as \xNN, and past `max` bytes cut
+/// with "..." (a damaged file's line may be binary, or megabytes without a newline).
+[[nodiscard]] std::string Quoted(std::string_view text, std::size_t max = 80);
 
 }  // namespace sonarbench
