@@ -144,6 +144,88 @@ namespace {
 // Scenes may extend one another this deep at most (a chain longer than this is surely a loop).
 constexpr std::size_t kMaxExtends = 8;
 
+// A scene's materials, by name: with a base, one the base has is replaced and a new one added.
+void ReadMaterials(YamlReader& root, bool extending, std::vector<Material>& materials) {
+  if (extending && !root.Has("materials")) return;
+  for (YamlReader& item : root.Sequence("materials")) {
+    Material m;
+    item.Required("name", m.name);
+    item.Required("reflectivity", m.reflectivity, InRange(0.0, 1.0));
+    item.Optional("backscatter_exponent", m.backscatter_exponent, InRange(0.0, 100.0));
+    item.Optional("specular", m.specular, InRange(0.0, 1.0));
+    double spread_deg = 0.0;
+    item.Optional("specular_spread_deg", spread_deg, InRange(0.0, 30.0));
+    m.specular_spread_rad = spread_deg * kDegToRad;
+    item.Optional("glint", m.glint, InRange(0.0, 1.0));
+    if (m.glint > 0.0 && m.specular_spread_rad <= 0.0) {
+      item.Fail("glint", "specular_spread_deg > 0 (the lobe the glint falls over), got 0");
+    }
+    item.RejectUnknownKeys();
+    const auto same = std::find_if(materials.begin(), materials.end(),
+                                   [&](const Material& b) { return b.name == m.name; });
+    if (same != materials.end() && extending) {
+      *same = m;
+    } else {
+      materials.push_back(m);
+    }
+  }
+}
+
+// A scene's meshes and vehicle parts, added to its base's: their names must be new in both lists.
+void ReadMeshes(YamlReader& root, bool extending, Scene& scene) {
+  const auto name_used = [&](const std::string& name) {
+    const auto same = [&](const MeshSpec& m) { return m.name == name; };
+    return std::ranges::any_of(scene.meshes, same) || std::ranges::any_of(scene.vehicle, same);
+  };
+  if (!extending || root.Has("meshes")) {
+    for (YamlReader& item : root.Sequence("meshes")) {
+      MeshSpec mesh = ReadMesh(item, scene.materials);
+      if (name_used(mesh.name)) {
+        item.Fail("name", "a mesh name not used before in the scene, got '" + mesh.name + "'");
+      }
+      scene.meshes.push_back(std::move(mesh));
+    }
+  }
+  if (root.Has("vehicle")) {
+    for (YamlReader& item : root.Sequence("vehicle")) {
+      for (const char* key : {"truth", "fill"}) {
+        if (item.Has(key)) {
+          item.Fail(key, std::string("no '") + key + "' key: a vehicle part is never ground truth");
+        }
+      }
+      MeshSpec part = ReadMesh(item, scene.materials);
+      part.truth = false;
+      if (name_used(part.name)) {
+        item.Fail("name", "a mesh name not used before in the scene, got '" + part.name + "'");
+      }
+      if (part.material < scene.materials.size() && scene.materials[part.material].specular > 0.0) {
+        item.Fail("material",
+                  "a material with specular 0 (the multipath is not traced off the "
+                  "vehicle), got '" +
+                      scene.materials[part.material].name + "' with specular " +
+                      FormatMetricValue(scene.materials[part.material].specular));
+      }
+      scene.vehicle.push_back(std::move(part));
+    }
+  }
+}
+
+// A scene's navigation error, over its base's.
+void ReadNavigation(YamlReader& nav, NavigationError& n) {
+  nav.Optional("drift_m_per_s", n.drift_m_per_s);
+  nav.Optional("position_noise_m", n.position_noise_m, InRange(0.0, 100.0));
+  // Only the keys given change the base's (a round trip through degrees could move it).
+  const auto read_degrees = [&](const char* key, double low, double high, double& out_rad) {
+    if (!nav.Has(key)) return;
+    double degrees = 0.0;
+    nav.Required(key, degrees, InRange(low, high));
+    out_rad = degrees * kDegToRad;
+  };
+  read_degrees("heading_drift_deg_per_s", -90.0, 90.0, n.heading_drift_rad_per_s);
+  read_degrees("heading_noise_deg", 0.0, 90.0, n.heading_noise_rad);
+  nav.RejectUnknownKeys();
+}
+
 // LoadScene, with the files being extended (the chain) that led to `path`.
 Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
   YamlReader root = YamlReader::FromFile(path);
@@ -190,88 +272,15 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
     scene.start_head_angle_rad = start_deg * kDegToRad;
   }
 
-  // Materials by name: one the base has is replaced, a new one added.
-  if (!base || root.Has("materials")) {
-    for (YamlReader& item : root.Sequence("materials")) {
-      Material m;
-      item.Required("name", m.name);
-      item.Required("reflectivity", m.reflectivity, InRange(0.0, 1.0));
-      item.Optional("backscatter_exponent", m.backscatter_exponent, InRange(0.0, 100.0));
-      item.Optional("specular", m.specular, InRange(0.0, 1.0));
-      double spread_deg = 0.0;
-      item.Optional("specular_spread_deg", spread_deg, InRange(0.0, 30.0));
-      m.specular_spread_rad = spread_deg * kDegToRad;
-      item.Optional("glint", m.glint, InRange(0.0, 1.0));
-      if (m.glint > 0.0 && m.specular_spread_rad <= 0.0) {
-        item.Fail("glint", "specular_spread_deg > 0 (the lobe the glint falls over), got 0");
-      }
-      item.RejectUnknownKeys();
-      const auto same = std::find_if(scene.materials.begin(), scene.materials.end(),
-                                     [&](const Material& b) { return b.name == m.name; });
-      if (same != scene.materials.end() && base) {
-        *same = m;
-      } else {
-        scene.materials.push_back(m);
-      }
-    }
-  }
-  // Meshes and vehicle parts are added to the base's; their names must be new in both lists.
+  ReadMaterials(root, base.has_value(), scene.materials);
   const std::size_t base_meshes = scene.meshes.size();
   const std::size_t base_vehicle = scene.vehicle.size();
-  const auto name_used = [&](const std::string& name) {
-    const auto same = [&](const MeshSpec& m) { return m.name == name; };
-    return std::ranges::any_of(scene.meshes, same) || std::ranges::any_of(scene.vehicle, same);
-  };
-  if (!base || root.Has("meshes")) {
-    for (YamlReader& item : root.Sequence("meshes")) {
-      MeshSpec mesh = ReadMesh(item, scene.materials);
-      if (name_used(mesh.name)) {
-        item.Fail("name", "a mesh name not used before in the scene, got '" + mesh.name + "'");
-      }
-      scene.meshes.push_back(std::move(mesh));
-    }
-  }
-  if (root.Has("vehicle")) {
-    for (YamlReader& item : root.Sequence("vehicle")) {
-      for (const char* key : {"truth", "fill"}) {
-        if (item.Has(key)) {
-          item.Fail(key, std::string("no '") + key + "' key: a vehicle part is never ground truth");
-        }
-      }
-      MeshSpec part = ReadMesh(item, scene.materials);
-      part.truth = false;
-      if (name_used(part.name)) {
-        item.Fail("name", "a mesh name not used before in the scene, got '" + part.name + "'");
-      }
-      if (part.material < scene.materials.size() && scene.materials[part.material].specular > 0.0) {
-        item.Fail("material",
-                  "a material with specular 0 (the multipath is not traced off the "
-                  "vehicle), got '" +
-                      scene.materials[part.material].name + "' with specular " +
-                      FormatMetricValue(scene.materials[part.material].specular));
-      }
-      scene.vehicle.push_back(std::move(part));
-    }
-  }
+  ReadMeshes(root, base.has_value(), scene);
   if (!base || root.Has("trajectory")) {
     YamlReader trajectory = root.Child("trajectory");
     scene.trajectory = ReadTrajectory(trajectory);
   }
-  if (auto nav = root.OptionalChild("navigation")) {
-    NavigationError& n = scene.navigation;
-    nav->Optional("drift_m_per_s", n.drift_m_per_s);
-    nav->Optional("position_noise_m", n.position_noise_m, InRange(0.0, 100.0));
-    // Only the keys given change the base's (a round trip through degrees could move it).
-    const auto read_degrees = [&](const char* key, double low, double high, double& out_rad) {
-      if (!nav->Has(key)) return;
-      double degrees = 0.0;
-      nav->Required(key, degrees, InRange(low, high));
-      out_rad = degrees * kDegToRad;
-    };
-    read_degrees("heading_drift_deg_per_s", -90.0, 90.0, n.heading_drift_rad_per_s);
-    read_degrees("heading_noise_deg", 0.0, 90.0, n.heading_noise_rad);
-    nav->RejectUnknownKeys();
-  }
+  if (auto nav = root.OptionalChild("navigation")) ReadNavigation(*nav, scene.navigation);
   std::optional<Eigen::Isometry3d> T_vehicle_sonar;
   if (auto mounting = root.OptionalChild("sonar_mounting")) {
     T_vehicle_sonar = ReadPose(*mounting);
