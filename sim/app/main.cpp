@@ -457,11 +457,10 @@ int main(int argc, char** argv) {
       "Map a recorded log with the production mapper: INPUT is a sonarbench dataset directory "
       "(from `simulate` or `import`; its manifest's sensor is used) or a real MSIS log in MATLAB "
       ".mat form (the CRAS lab's parsedData layout; the vehicle static at the origin), or a folder "
-      "holding one such log. Writes "
-      "map.bt "
-      "and map.ot (octovis), map_top.png (occupied cells from above), polar.png and fan.png (the "
-      "first sweep) and report.json into --out. The sensor is the SHAD Micron and the mapper "
-      "uses its defaults unless --scene, --sensor or --mapping say otherwise.");
+      "holding one such log. Writes map.bt and map.ot (octovis), map_top.png (occupied cells "
+      "from above), polar.png and fan.png (the first sweep) and report.json into --out. The "
+      "sensor is the SHAD Micron and the mapper uses its defaults unless --scene, --sensor or "
+      "--mapping say otherwise.");
   map_cmd
       ->add_option("input", map.input,
                    "A dataset directory, a .mat log, or a folder holding one .mat log")
@@ -490,13 +489,13 @@ int main(int argc, char** argv) {
       "Compare a simulated scene with a real log of the same place: mean intensity against range "
       "(correlation), the strongest echo's range per head angle (median difference in bins) and "
       "its intensity (percentiles), the profile around it (the tail behind the walls; and its "
-      "front, over the beams whose strongest echo is the simulated wall) and around "
-      "twice its range (the second trip), "
-      "intensity histograms (intersection), the texture along range and across beams "
-      "(correlations), and the first sweeps side by side (sim left, real right). Writes "
-      "fidelity.json, profile.csv/.png, wall_range.csv, wall_profile.csv, "
-      "direct_wall_profile.csv, second_trip_profile.csv, histogram.csv, "
-      "polar.png and fan.png into --out.");
+      "front, over the beams whose strongest echo is the simulated wall) and around twice its "
+      "range (the second trip), intensity histograms (intersection), the texture along range "
+      "and across beams (correlations), and the first sweeps side by side (sim left, real "
+      "right). Writes fidelity.json, profile.csv/.png, wall_range.csv, wall_profile.csv, "
+      "direct_wall_profile.csv, second_trip_profile.csv, histogram.csv, by_head_angle.csv (the "
+      "self-reflection's and the near range's mean per head angle), polar.png and fan.png into "
+      "--out.");
   fidelity_cmd->add_option("scene", fidelity.scene, "Scene YAML file")
       ->required()
       ->check(CLI::ExistingFile);
