@@ -70,6 +70,14 @@ TEST(YamlReader, DuplicateKeyIsAnError) {
   EXPECT_TRUE(
       ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nresolution_m: 0.2\n"); },
                            {"scene.yaml:2:1", "'resolution_m'", "duplicate key"}));
+  // A mapping of many duplicates (two list items run together) is one message.
+  EXPECT_EQ(test::InputErrorOf([] {
+              (void)ReadMapping(
+                  "resolution_m: 0.1\nrays_vertical: 8\nresolution_m: 0.2\nrays_vertical: 9\n"
+                  "rays_horizontal: 4\nrays_horizontal: 4\n");
+            }),
+            "scene.yaml:3:1: key 'resolution_m': duplicate key (each key may appear once; so are "
+            "'rays_vertical', 'rays_horizontal')");
 }
 
 TEST(YamlReader, ReportsEveryBadFieldAtOnce) {

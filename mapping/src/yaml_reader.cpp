@@ -115,14 +115,24 @@ YamlReader::YamlReader(YAML::Node node, std::shared_ptr<State> state, std::strin
     not_a_mapping_ = true;
     return;
   }
-  // yaml-cpp keeps duplicate keys and silently answers lookups with the first: report them.
+  // yaml-cpp keeps duplicate keys and silently answers lookups with the first: report them, in
+  // one message (a lost "- " merges two list items into one mapping of many duplicates).
   std::set<std::string> seen;
+  std::optional<YAML::Node> first;
+  std::string others;
   for (const auto& item : node_) {
     const std::string key = item.first.Scalar();
-    if (!seen.insert(key).second) {
-      Record(Where(item.first) + ": key '" + KeyPath(key) +
-             "': duplicate key (each key may appear once)");
+    if (seen.insert(key).second) continue;
+    if (!first) {
+      first = item.first;
+    } else {
+      others += (others.empty() ? "; so are '" : "', '") + key;
     }
+  }
+  if (first) {
+    Record(Where(*first) + ": key '" + KeyPath(first->Scalar()) +
+           "': duplicate key (each key may appear once" + (others.empty() ? "" : others + "'") +
+           ")");
   }
 }
 
