@@ -124,7 +124,7 @@ YamlReader::YamlReader(YAML::Node node, std::shared_ptr<State> state, std::strin
     const std::string key = item.first.Scalar();
     if (seen.insert(key).second) continue;
     if (!first) {
-      first = item.first;
+      first.emplace(item.first);
     } else {
       others += (others.empty() ? "; so are '" : "', '") + key;
     }
