@@ -462,6 +462,41 @@ TEST(Cli, MissingSceneAndBadOptionsExitTwo) {
   EXPECT_EQ(RunCli("frobnicate"), 2);
 }
 
+// A seed is a decimal integer from 0 to 2^64 - 1: "-1" and one past the top are refused, not
+// wrapped or saturated.
+TEST(Cli, SeedsOutsideTheirRangeExitTwo) {
+  const std::string scene = test::SourcePath("scenes/cras-tank.yaml");
+  for (const std::string seed : {"-1", "18446744073709551616", "12abc"}) {
+    std::string output;
+    EXPECT_EQ(RunCli("run " + scene + " --no-progress --seed " + seed, &output), 2) << seed;
+    EXPECT_NE(output.find("--seed: expected an integer from 0 to 18446744073709551615, got '" +
+                          seed + "'"),
+              std::string::npos)
+        << output;
+  }
+}
+
+// An --out that is a file is refused before any work, by every command that writes one; one
+// that cannot be made is refused as bad input too.
+TEST(Cli, AnOutputDirectoryThatIsAFileExitsTwo) {
+  test::TempDir dir;
+  const auto scene = TankSceneWithCriteria(dir.path(), "");
+  const std::string file = scene.string();
+  for (const std::string& command :
+       {"run " + file + " --no-progress", "map " + dir.path().string(), "sweep " + file,
+        "fidelity " + file + " " + file, "simulate " + file}) {
+    std::string output;
+    EXPECT_EQ(RunCli(command + " --out " + file, &output), 2) << command;
+    EXPECT_NE(output.find(file + ": exists and is not a directory"), std::string::npos)
+        << command << "\n"
+        << output;
+  }
+  std::string output;
+  const std::string blocked = file + "/out";  // under a file: cannot be made
+  EXPECT_EQ(RunCli("simulate " + file + " --out " + blocked, &output), 2) << output;
+  EXPECT_NE(output.find(blocked + ": "), std::string::npos) << output;
+}
+
 TEST(Cli, HelpExplainsEachSubcommand) {
   std::string output;
   EXPECT_EQ(RunCli("--help", &output), 0);

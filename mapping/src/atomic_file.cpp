@@ -39,6 +39,23 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
   }
 }
 
+void CheckOutputDirectory(const std::string& dir) {
+  std::error_code error;
+  if (std::filesystem::exists(dir, error) && !std::filesystem::is_directory(dir, error)) {
+    throw InputError(dir + ": exists and is not a directory (expected an output directory)");
+  }
+}
+
+void CreateOutputDirectory(const std::string& dir) {
+  CheckOutputDirectory(dir);
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) {
+    throw InputError(dir + ": cannot be made the output directory (" + error.message() +
+                     "; expected a path where a directory can be made)");
+  }
+}
+
 std::string ReadFileBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot be read");

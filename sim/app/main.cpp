@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <charconv>
 #include <chrono>
 #include <cstdint>
 #include <cstdlib>
@@ -132,6 +133,7 @@ struct MapArgs {
 };
 
 int Map(const MapArgs& args) {
+  sonarbench::CheckOutputDirectory(args.out);
   sonarbench::mapping::SensorGeometry sensor;
   sonarbench::mapping::MapperConfig config;
   if (!args.scene.empty()) {
@@ -183,6 +185,7 @@ std::string HeadAngleLine(const std::string& what,
 
 int Fidelity(const FidelityArgs& args) {
   namespace sim = sonarbench::sim;
+  sonarbench::CheckOutputDirectory(args.out);
   const sim::Scene scene = sim::LoadScene(args.scene);
   const sonarbench::mapping::MatLog log = sonarbench::mapping::ReadMatLog(args.log);
   const auto meshes = sim::BuildSceneMeshes(scene);
@@ -335,6 +338,7 @@ struct SweepArgs {
 
 int Sweep(const SweepArgs& args) {
   namespace sim = sonarbench::sim;
+  sonarbench::CheckOutputDirectory(args.out);
   const sim::Scene scene = sim::LoadScene(args.scene);
   sim::StudyOptions options;
   options.seed = args.seed;
@@ -386,6 +390,24 @@ int Import(const ImportArgs& args) {
 }
 
 // The --threads option every subcommand has.
+// -s/--seed: a decimal integer from 0 to 2^64 - 1, checked as text (CLI11 would take "-1" as
+// 2^64 - 1 and a seed past the top as the top).
+void AddSeedOption(CLI::App* command, std::optional<std::uint64_t>& seed,
+                   const std::string& description) {
+  command->add_option("-s,--seed", seed, description)
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            std::uint64_t value = 0;
+            const char* end = text.data() + text.size();
+            const auto [stop, error] = std::from_chars(text.data(), end, value);
+            if (text.empty() || error != std::errc() || stop != end) {
+              return "expected an integer from 0 to 18446744073709551615, got '" + text + "'";
+            }
+            return "";
+          },
+          "UINT64"));
+}
+
 void AddThreadsOption(CLI::App* command, int& threads) {
   command
       ->add_option("-j,--threads", threads,
@@ -395,6 +417,7 @@ void AddThreadsOption(CLI::App* command, int& threads) {
 }
 
 int Run(const RunArgs& args) {
+  sonarbench::CheckOutputDirectory(args.out);
   const sonarbench::sim::Scene scene = sonarbench::sim::LoadScene(args.scene);
   sonarbench::sim::RunOptions options;
   options.seed = args.seed;
@@ -412,8 +435,11 @@ int Run(const RunArgs& args) {
 
 // A run that broke still leaves a junit.xml saying so, for the CI system that collects it.
 void WriteErrorJunit(const RunArgs& args, std::string_view type, const std::string& message) {
+  // Not where the output directory itself is refused: that error was the message.
+  std::error_code unusable;
+  std::filesystem::create_directories(args.out, unusable);
+  if (unusable) return;
   try {
-    std::filesystem::create_directories(args.out);
     const std::string xml = sonarbench::sim::ErrorJunitXml(
         std::filesystem::path(args.scene).stem().string(), type, message);
     sonarbench::WriteFileAtomically((std::filesystem::path(args.out) / "junit.xml").string(),
@@ -444,8 +470,7 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   run_cmd->add_option("-o,--out", run.out, "Output directory (created if needed)")
       ->capture_default_str();
-  run_cmd->add_option("-s,--seed", run.seed,
-                      "Seed of every random draw; overrides the scene's 'seed'");
+  AddSeedOption(run_cmd, run.seed, "Seed of every random draw; overrides the scene's 'seed'");
   AddThreadsOption(run_cmd, run.threads);
   run_cmd->add_flag("--no-progress", run.no_progress,
                     "Never show the progress line (it shows only on a terminal, and never when "
@@ -503,7 +528,7 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   fidelity_cmd->add_option("-o,--out", fidelity.out, "Output directory")->capture_default_str();
-  fidelity_cmd->add_option("-s,--seed", fidelity.seed, "Overrides the scene's seed");
+  AddSeedOption(fidelity_cmd, fidelity.seed, "Overrides the scene's seed");
   AddThreadsOption(fidelity_cmd, fidelity.threads);
   fidelity_cmd
       ->add_option("--wall-min-range", fidelity.wall_min_range_m,
@@ -523,7 +548,7 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   simulate_cmd->add_option("-o,--out", simulate.out, "Dataset directory")->required();
-  simulate_cmd->add_option("-s,--seed", simulate.seed, "Overrides the scene's seed");
+  AddSeedOption(simulate_cmd, simulate.seed, "Overrides the scene's seed");
   AddThreadsOption(simulate_cmd, simulate.threads);
   simulate_cmd->add_flag("--force", simulate.force,
                          "Replace an existing dataset (never deletes a directory that is not one)");
@@ -547,7 +572,7 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   sweep_cmd->add_option("-o,--out", sweep.out, "Study directory")->required();
-  sweep_cmd->add_option("-s,--seed", sweep.seed, "Overrides the scene's seed");
+  AddSeedOption(sweep_cmd, sweep.seed, "Overrides the scene's seed");
   sweep_cmd->add_option("--sweeps", sweep.sweeps, "Overrides the scene's sweeps (fewer: quicker)")
       ->check(CLI::Range(1, 100000));
   sweep_cmd

@@ -54,8 +54,7 @@ std::optional<std::string> StoredConfig(const fs::path& file) {
 // configuration is already there (nothing to do).
 bool PrepareDirectory(const std::string& dir, const std::string& config, bool force) {
   const fs::path root(dir);
-  if (fs::exists(root) && !fs::is_directory(root))
-    throw InputError(dir + ": exists and is not a directory");
+  CheckOutputDirectory(dir);
   const auto complete = StoredConfig(root / "manifest.json");
   const auto partial = StoredConfig(root / kPartialMarker);
   const bool is_dataset = complete || partial;
@@ -76,6 +75,7 @@ bool PrepareDirectory(const std::string& dir, const std::string& config, bool fo
                      ": holds a partial dataset of another configuration; pass --force to "
                      "replace it");
   }
+  CreateOutputDirectory(dir);
   for (const char* sub : {"beams", "images", "truth", "poses"}) fs::create_directories(root / sub);
   // Temporary files of a killed run are never whole: remove them.
   for (const auto& entry : fs::recursive_directory_iterator(root)) {

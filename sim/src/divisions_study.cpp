@@ -208,6 +208,7 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
                       "/coverage_beams " + std::to_string(options.coverage_beams) + "/items " +
                       std::to_string(options.items.size()));
   const fs::path root(dir);
+  CheckOutputDirectory(dir);
   if (options.force) {
     for (const char* f :
          {"divisions.csv", "coverage_vs_divisions.png", "time_vs_divisions.png", "study.json"}) {
@@ -215,6 +216,7 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
     }
     fs::remove_all(root / "items");
   }
+  CreateOutputDirectory(dir);
   fs::create_directories(root / "items");
 
   const std::vector<StudyItem> items =

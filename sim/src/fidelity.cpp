@@ -668,7 +668,7 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                           const mapping::SensorGeometry& sensor, const std::string& scene_file,
                           const std::string& log_file) {
   namespace fs = std::filesystem;
-  fs::create_directories(out_dir);
+  CreateOutputDirectory(out_dir);
   const fs::path dir(out_dir);
   std::ostringstream profile;
   profile << "bin,range_m,sim_mean,real_mean\n";

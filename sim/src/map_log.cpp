@@ -72,7 +72,7 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
 
 void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) {
   namespace fs = std::filesystem;
-  fs::create_directories(out_dir);
+  CreateOutputDirectory(out_dir);
   const fs::path dir(out_dir);
   result.mapper->WriteBinary((dir / "map.bt").string());
   result.mapper->WriteFull((dir / "map.ot").string());

@@ -411,7 +411,7 @@ std::string ErrorJunitXml(std::string_view scenario, std::string_view error_type
 void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
                           const ScenarioResult& result) {
   namespace fs = std::filesystem;
-  fs::create_directories(out_dir);
+  CreateOutputDirectory(out_dir);
   const fs::path dir(out_dir);
   result.mapper->WriteBinary((dir / "map.bt").string());
   const std::vector<Image> images = RenderImages(result);

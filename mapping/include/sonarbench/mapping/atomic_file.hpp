@@ -11,6 +11,14 @@ namespace sonarbench {
 /// and leaves any previous `path` untouched; throws std::runtime_error naming the file.
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+/// Refuses `dir` as a command's output directory, before any work, when something other than a
+/// directory is in its way: throws InputError naming it.
+void CheckOutputDirectory(const std::string& dir);
+
+/// Creates the output directory `dir` and its parents; throws InputError naming it and why when
+/// it cannot be (a file in the way, no permission).
+void CreateOutputDirectory(const std::string& dir);
+
 /// The whole content of `path`; throws InputError naming it when it cannot be read.
 [[nodiscard]] std::string ReadFileBytes(const std::string& path);
 
