@@ -476,6 +476,19 @@ TEST(Cli, SeedsOutsideTheirRangeExitTwo) {
   }
 }
 
+// The fidelity command's --wall-min-range is a range the sonar reaches: NaN, infinity, 0 and one
+// past its 5 m are refused (past it the report was all zeros, as if walls matched).
+TEST(Cli, FidelityRefusesAWallRangeTheSonarDoesNotReach) {
+  const std::string scene = test::SourcePath("scenes/cras-tank.yaml");
+  for (const std::string range : {"nan", "inf", "0", "5.5"}) {
+    std::string output;
+    EXPECT_EQ(RunCli("fidelity " + scene + " " + scene + " --wall-min-range " + range, &output), 2)
+        << range;
+    EXPECT_NE(output.find("--wall-min-range"), std::string::npos) << output;
+    EXPECT_NE(output.find(range), std::string::npos) << output;
+  }
+}
+
 // An --out that is a file is refused before any work, by every command that writes one; one
 // that cannot be made is refused as bad input too.
 TEST(Cli, AnOutputDirectoryThatIsAFileExitsTwo) {

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <charconv>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -187,6 +188,12 @@ int Fidelity(const FidelityArgs& args) {
   namespace sim = sonarbench::sim;
   sonarbench::CheckOutputDirectory(args.out);
   const sim::Scene scene = sim::LoadScene(args.scene);
+  if (const double range = scene.sensor.geometry.MaxRangeM(); args.wall_min_range_m >= range) {
+    std::ostringstream message;
+    message << "--wall-min-range " << args.wall_min_range_m << ": expected less than the sonar's "
+            << range << " m range (no echo lies past it)";
+    throw sonarbench::InputError(message.str());
+  }
   const sonarbench::mapping::MatLog log = sonarbench::mapping::ReadMatLog(args.log);
   const auto meshes = sim::BuildSceneMeshes(scene);
   const sim::RayTracer tracer(meshes);
@@ -533,7 +540,18 @@ int main(int argc, char** argv) {
   fidelity_cmd
       ->add_option("--wall-min-range", fidelity.wall_min_range_m,
                    "Strongest echoes are sought beyond this range [m] (past the floor's)")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            double value = 0.0;
+            const char* end = text.data() + text.size();
+            const auto [stop, error] = std::from_chars(text.data(), end, value);
+            if (text.empty() || error != std::errc() || stop != end || !std::isfinite(value) ||
+                value <= 0.0) {
+              return "expected a range in metres, finite and above 0, got '" + text + "'";
+            }
+            return "";
+          },
+          "METRES"))
       ->capture_default_str();
 
   SimulateArgs simulate;
