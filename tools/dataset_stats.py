@@ -5,6 +5,7 @@ simulated run with a real log bin by bin where `sonarbench fidelity` gives only 
     python3 tools/dataset_stats.py DIR [DIR ...] [--crossing T --from R] [--bins FIRST LAST]
                                    [--lit FIRST LAST] [--arc HEAD_DEG BIN]
                                    [--behind-walls FIRST LAST] [--profile HEAD_DEG FIRST LAST]
+                                   [--sectors FIRST LAST]
 
 DIR is what `sonarbench simulate SCENE --out DIR` or `sonarbench import LOG.mat --out DIR`
 wrote. For each, per range band: the mean intensity, the share of bins at 0 and at 150 or
@@ -45,7 +46,10 @@ bins 10-29, 30-69 and 70-129 past that peak; averaged per 5° band of head angle
 side's normal (0°, 90°, 180°, 270°: a tank square to the sonar's axes). With --profile HEAD_DEG
 FIRST LAST, what the beams pointing one way hear against range: the mean intensity of the beams
 within 6° of head angle HEAD_DEG, per group of 4 bins from FIRST to LAST (the last group may be
-shorter; bins past a beam's end left out). Standard library only.
+shorter; bins past a beam's end left out). With --sectors FIRST LAST, where a vehicle's parts
+echo: per 9° of head angle from 0° (five head steps), the mean intensity per group of 6 bins from
+FIRST to LAST (bins past a beam's end left out; sectors without beams left out). Standard library
+only.
 """
 import argparse
 import glob
@@ -344,6 +348,8 @@ def behind_walls(with_angles, first, last):
 
 PROFILE_HALF_DEG = 6.0
 PROFILE_GROUP_BINS = 4
+SECTOR_DEG = 9.0  # five head steps of 1.8°
+SECTOR_GROUP_BINS = 6
 
 
 def head_profile(with_angles, head_deg, first, last):
@@ -360,8 +366,26 @@ def head_profile(with_angles, head_deg, first, last):
     return len(chosen), rows
 
 
+def sector_rows(with_angles, first, last):
+    """[(sector's first degree, [mean or None per group])]: per SECTOR_DEG of head angle from 0°,
+    the mean intensity per group of SECTOR_GROUP_BINS bins from first to last, each group's bins
+    pooled over the sector's beams long enough to hold them; sectors without beams left out."""
+    sectors = {}
+    for angle, _, b in with_angles:
+        sectors.setdefault(int(head_cell(angle) // SECTOR_DEG), []).append(b)
+    rows = []
+    for sector in sorted(sectors):
+        means = []
+        for start in range(first, last + 1, SECTOR_GROUP_BINS):
+            end = min(start + SECTOR_GROUP_BINS, last + 1)
+            values = [b[k] for b in sectors[sector] for k in range(start, min(end, len(b)))]
+            means.append(sum(values) / len(values) if values else None)
+        rows.append((sector * SECTOR_DEG, means))
+    return rows
+
+
 def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None, behind=None,
-           profile=None):
+           profile=None, sectors=None):
     far_half, step_rad = manifest_sensor(directory)
     with_angles = load_beams(directory, with_angles=True)
     beams = [(size, b) for _, size, b in with_angles]
@@ -443,6 +467,14 @@ def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None,
         print(f"  profile of the {n} beams within {PROFILE_HALF_DEG:g}° of {head_deg:g}° "
               f"(first bin of each {PROFILE_GROUP_BINS}: their mean): " +
               ", ".join(f"{k} " + (f"{m:.1f}" if m is not None else "none") for k, m in rows))
+    if sectors is not None:
+        first, last = sectors
+        print(f"  by {SECTOR_DEG:g}° of head angle, the mean per {SECTOR_GROUP_BINS} bins from bin "
+              f"{first} (" + " ".join(str(k) for k in range(first, last + 1, SECTOR_GROUP_BINS)) +
+              "):")
+        for low, means in sector_rows(with_angles, first, last):
+            print(f"    {low:5.1f}°: " +
+                  " ".join(f"{m:5.1f}" if m is not None else " none" for m in means))
 
 
 if __name__ == "__main__":
@@ -466,6 +498,9 @@ if __name__ == "__main__":
     parser.add_argument("--profile", type=float, nargs=3, metavar=("HEAD_DEG", "FIRST", "LAST"),
                         help="also report the mean of the beams within 6 degrees of HEAD_DEG, "
                              "per 4 bins from FIRST to LAST")
+    parser.add_argument("--sectors", type=int, nargs=2, metavar=("FIRST", "LAST"),
+                        help="also report, per 9 degrees of head angle, the mean per 6 bins from "
+                             "FIRST to LAST (where a vehicle's parts echo, bins 28-63)")
     args = parser.parse_args()
     if (args.crossing is None) != (args.from_m is None):
         parser.error("--crossing and --from go together")
@@ -483,6 +518,8 @@ if __name__ == "__main__":
             and all(v == int(v) for v in args.profile[1:])):
         parser.error(f"--profile {args.profile[0]:g} {args.profile[1]:g} {args.profile[2]:g}: "
                      "expected whole bins 0 <= FIRST <= LAST")
+    if args.sectors is not None and not 0 <= args.sectors[0] <= args.sectors[1]:
+        parser.error(f"--sectors {args.sectors[0]} {args.sectors[1]}: expected 0 <= FIRST <= LAST")
     for d in args.directories:
         report(d, args.crossing, args.from_m, args.bins, args.lit, args.arc, args.behind_walls,
-               args.profile)
+               args.profile, args.sectors)

@@ -221,6 +221,21 @@ def main():
         result = run(os.path.join(tmp, "walls"), "--profile", "38", "157", "150")
         assert result.returncode != 0 and "expected whole bins" in result.stderr, result.stderr
 
+        # By sector of head angle: the walls' beams at 0° (sector 0°), 40° and 41° (sector 36°)
+        # and 92° (sector 90°), two of each. Over bins 150-161 in groups of 6: at 0° bins 130-169
+        # hold 30, so 30.0 and 30.0; at 92° nothing past its peak at 100, 0.0; at 36°, bins
+        # 150-155 hold 180 (bin 150 at 40°) and 90 (bin 155 at 41°), the rest 0: (180 + 90) · 2 /
+        # 24 = 22.5; bins 156-161 hold 100 at bins 160-161 at 40° and nothing past the 160-bin
+        # beam's end at 41°: 100 · 2 · 2 / (2 · 6 + 2 · 4) = 20.0.
+        result = run(os.path.join(tmp, "walls"), "--sectors", "150", "161")
+        assert result.returncode == 0, result.stderr
+        assert "by 9° of head angle, the mean per 6 bins from bin 150 (150 156):\n" \
+            "      0.0°:  30.0  30.0\n     36.0°:  22.5  20.0\n     90.0°:   0.0   0.0\n" \
+            in result.stdout, result.stdout
+        result = run(os.path.join(tmp, "walls"), "--sectors", "161", "150")
+        assert result.returncode != 0 and "expected 0 <= FIRST <= LAST" in result.stderr, \
+            result.stderr
+
         # The fine texture: ten beams at consecutive head steps, beam b's bin k 100 + 10 (-1)^(k+b).
         # Each bin less its mean over the 31 bins around it is ±(10 + 10/31) (the window's odd one
         # out has the neighbours' sign), ±10 or so near the beam's end where the window is cut: along range the signs alternate (lag 1 and 3 near
@@ -260,7 +275,7 @@ def main():
         result = run(os.path.join(tmp, "bad"))
         assert result.returncode != 0, "a truncated file was accepted"
         assert "sweep_0000.bin: beam 0 truncated" in result.stderr, result.stderr
-    print("dataset_stats.py: shares, spreads, tail, arc, behind the walls, a head angle's profile, fine texture, a missing manifest and a "
+    print("dataset_stats.py: shares, spreads, tail, arc, behind the walls, a head angle's profile, sectors, fine texture, a missing manifest and a "
           "truncated file as expected")
 
 
