@@ -211,6 +211,16 @@ TEST(SceneFile, ARefusedValueIsNotReportedAgainByTheChecksOnIt) {
                             "key 'materials[0].name': expected a string, got a list"));
 }
 
+// Two materials of one name in one file are refused (the mesh naming it would get either); a
+// scene that extends another may still replace the base's.
+TEST(SceneFile, AMaterialNamedTwiceInOneFileIsRefused) {
+  EXPECT_TRUE(IsTheOneError(
+      SmallSceneRefusal("{name: rock, reflectivity: 0.5}\n  - {name: rock, reflectivity: 0.1}",
+                        kPlane, kStatic),
+      "bad.yaml:6:12: key 'materials[1].name': a material name not used before in this file, got "
+      "'rock'"));
+}
+
 TEST(SceneFile, UnknownMaterialIsNamed) {
   EXPECT_TRUE(IsTheOneError(
       SmallSceneRefusal(kRock, "{name: m, type: plane, size_m: [1, 1, 0], material: mud}", kStatic),

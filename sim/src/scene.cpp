@@ -144,9 +144,11 @@ namespace {
 // Scenes may extend one another this deep at most (a chain longer than this is surely a loop).
 constexpr std::size_t kMaxExtends = 8;
 
-// A scene's materials, by name: with a base, one the base has is replaced and a new one added.
+// A scene's materials, by name: with a base, one the base has is replaced and a new one added;
+// a name the file itself gave already is refused (which of the two would count is anyone's guess).
 void ReadMaterials(YamlReader& root, bool extending, std::vector<Material>& materials) {
   if (extending && !root.Has("materials")) return;
+  std::vector<std::string> names;
   for (YamlReader& item : root.Sequence("materials")) {
     Material m;
     item.Required("name", m.name);
@@ -161,6 +163,10 @@ void ReadMaterials(YamlReader& root, bool extending, std::vector<Material>& mate
       item.Fail("glint", "specular_spread_deg > 0 (the lobe the glint falls over), got 0");
     }
     item.RejectUnknownKeys();
+    if (std::ranges::find(names, m.name) != names.end()) {
+      item.Fail("name", "a material name not used before in this file, got '" + m.name + "'");
+    }
+    names.push_back(m.name);
     const auto same = std::find_if(materials.begin(), materials.end(),
                                    [&](const Material& b) { return b.name == m.name; });
     if (same != materials.end() && extending) {
