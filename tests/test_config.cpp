@@ -138,7 +138,8 @@ TEST(YamlReader, SyntaxErrorNamesFileAndLine) {
 }
 
 TEST(SceneFile, ShippedScenesLoad) {
-  for (const char* name : {"scenes/cras-tank.yaml", "scenes/seabed.yaml"}) {
+  for (const char* name : {"scenes/cras-tank.yaml", "scenes/seabed.yaml",
+                           "scenes/trials/cras-tank-vehicle-spots.yaml"}) {
     SCOPED_TRACE(name);
     const sim::Scene scene = sim::LoadScene(test::SourcePath(name));
     EXPECT_FALSE(scene.meshes.empty());
