@@ -396,7 +396,6 @@ int Import(const ImportArgs& args) {
   return 0;
 }
 
-// The --threads option every subcommand has.
 // -s/--seed: a decimal integer from 0 to 2^64 - 1, checked as text (CLI11 would take "-1" as
 // 2^64 - 1 and a seed past the top as the top).
 void AddSeedOption(CLI::App* command, std::optional<std::uint64_t>& seed,
@@ -415,6 +414,7 @@ void AddSeedOption(CLI::App* command, std::optional<std::uint64_t>& seed,
           "UINT64"));
 }
 
+// The --threads option every subcommand has.
 void AddThreadsOption(CLI::App* command, int& threads) {
   command
       ->add_option("-j,--threads", threads,
