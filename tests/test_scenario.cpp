@@ -504,10 +504,13 @@ TEST(Cli, AnOutputDirectoryThatIsAFileExitsTwo) {
         << command << "\n"
         << output;
   }
-  std::string output;
   const std::string blocked = file + "/out";  // under a file: cannot be made
-  EXPECT_EQ(RunCli("simulate " + file + " --out " + blocked, &output), 2) << output;
-  EXPECT_NE(output.find(blocked + ": "), std::string::npos) << output;
+  for (const std::string& command : {"simulate " + file, "run " + file + " --no-progress"}) {
+    std::string output;
+    EXPECT_EQ(RunCli(command + " --out " + blocked, &output), 2) << output;
+    EXPECT_NE(output.find(blocked + ": cannot be made the output directory"), std::string::npos)
+        << output;
+  }
 }
 
 TEST(Cli, HelpExplainsEachSubcommand) {

@@ -424,7 +424,8 @@ void AddThreadsOption(CLI::App* command, int& threads) {
 }
 
 int Run(const RunArgs& args) {
-  sonarbench::CheckOutputDirectory(args.out);
+  // Made before any work: a run writes its junit.xml there even when the scene is refused.
+  sonarbench::CreateOutputDirectory(args.out);
   const sonarbench::sim::Scene scene = sonarbench::sim::LoadScene(args.scene);
   sonarbench::sim::RunOptions options;
   options.seed = args.seed;
