@@ -352,18 +352,25 @@ SECTOR_DEG = 9.0  # five head steps of 1.8°
 SECTOR_GROUP_BINS = 6
 
 
+def group_means(beams, first, last, size):
+    """[(group's first bin, mean or None)]: the mean intensity of beams per group of `size` bins
+    from first to last (the last group may be shorter), each group's bins pooled over the beams
+    long enough to hold them."""
+    rows = []
+    for start in range(first, last + 1, size):
+        end = min(start + size, last + 1)
+        values = [b[k] for b in beams for k in range(start, min(end, len(b)))]
+        rows.append((start, sum(values) / len(values) if values else None))
+    return rows
+
+
 def head_profile(with_angles, head_deg, first, last):
     """(beams, [(group's first bin, mean or None)]): the mean intensity of the beams within
     PROFILE_HALF_DEG of head angle head_deg, per group of PROFILE_GROUP_BINS bins from first to
     last, each group's bins pooled over the beams long enough to hold them."""
     chosen = [b for angle, _, b in with_angles
               if off_side(head_cell(angle), head_deg) <= PROFILE_HALF_DEG]
-    rows = []
-    for start in range(first, last + 1, PROFILE_GROUP_BINS):
-        end = min(start + PROFILE_GROUP_BINS, last + 1)
-        values = [b[k] for b in chosen for k in range(start, min(end, len(b)))]
-        rows.append((start, sum(values) / len(values) if values else None))
-    return len(chosen), rows
+    return len(chosen), group_means(chosen, first, last, PROFILE_GROUP_BINS)
 
 
 def sector_rows(with_angles, first, last):
@@ -373,15 +380,9 @@ def sector_rows(with_angles, first, last):
     sectors = {}
     for angle, _, b in with_angles:
         sectors.setdefault(int(head_cell(angle) // SECTOR_DEG), []).append(b)
-    rows = []
-    for sector in sorted(sectors):
-        means = []
-        for start in range(first, last + 1, SECTOR_GROUP_BINS):
-            end = min(start + SECTOR_GROUP_BINS, last + 1)
-            values = [b[k] for b in sectors[sector] for k in range(start, min(end, len(b)))]
-            means.append(sum(values) / len(values) if values else None)
-        rows.append((sector * SECTOR_DEG, means))
-    return rows
+    return [(sector * SECTOR_DEG,
+             [m for _, m in group_means(sectors[sector], first, last, SECTOR_GROUP_BINS)])
+            for sector in sorted(sectors)]
 
 
 def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None, behind=None,

@@ -396,6 +396,16 @@ int Import(const ImportArgs& args) {
   return 0;
 }
 
+// An option's text as a T, whole and in T's range; nullopt otherwise.
+template <typename T>
+std::optional<T> ParsedWhole(const std::string& text) {
+  T value{};
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value);
+  if (text.empty() || error != std::errc() || stop != end) return std::nullopt;
+  return value;
+}
+
 // -s/--seed: a decimal integer from 0 to 2^64 - 1, checked as text (CLI11 would take "-1" as
 // 2^64 - 1 and a seed past the top as the top).
 void AddSeedOption(CLI::App* command, std::optional<std::uint64_t>& seed,
@@ -403,13 +413,8 @@ void AddSeedOption(CLI::App* command, std::optional<std::uint64_t>& seed,
   command->add_option("-s,--seed", seed, description)
       ->check(CLI::Validator(
           [](std::string& text) -> std::string {
-            std::uint64_t value = 0;
-            const char* end = text.data() + text.size();
-            const auto [stop, error] = std::from_chars(text.data(), end, value);
-            if (text.empty() || error != std::errc() || stop != end) {
-              return "expected an integer from 0 to 18446744073709551615, got '" + text + "'";
-            }
-            return "";
+            if (ParsedWhole<std::uint64_t>(text)) return "";
+            return "expected an integer from 0 to 18446744073709551615, got '" + text + "'";
           },
           "UINT64"));
 }
@@ -543,14 +548,9 @@ int main(int argc, char** argv) {
                    "Strongest echoes are sought beyond this range [m] (past the floor's)")
       ->check(CLI::Validator(
           [](std::string& text) -> std::string {
-            double value = 0.0;
-            const char* end = text.data() + text.size();
-            const auto [stop, error] = std::from_chars(text.data(), end, value);
-            if (text.empty() || error != std::errc() || stop != end || !std::isfinite(value) ||
-                value <= 0.0) {
-              return "expected a range in metres, finite and above 0, got '" + text + "'";
-            }
-            return "";
+            const std::optional<double> range = ParsedWhole<double>(text);
+            if (range && std::isfinite(*range) && *range > 0.0) return "";
+            return "expected a range in metres, finite and above 0, got '" + text + "'";
           },
           "METRES"))
       ->capture_default_str();
