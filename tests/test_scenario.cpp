@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "sonarbench/sim/scenario.hpp"
 #include "sonarbench/sim/scenario_report.hpp"
@@ -495,9 +496,12 @@ TEST(Cli, AnOutputDirectoryThatIsAFileExitsTwo) {
   test::TempDir dir;
   const auto scene = TankSceneWithCriteria(dir.path(), "");
   const std::string file = scene.string();
-  for (const std::string& command :
-       {"run " + file + " --no-progress", "map " + dir.path().string(), "sweep " + file,
-        "fidelity " + file + " " + file, "simulate " + file}) {
+  // Each command refuses its --out before reading its input (`map`'s directory holds no
+  // dataset, `fidelity`'s log is not a .mat file).
+  const std::vector<std::string> commands = {"run " + file + " --no-progress",
+                                             "map " + dir.path().string(), "sweep " + file,
+                                             "fidelity " + file + " " + file, "simulate " + file};
+  for (const std::string& command : commands) {
     std::string output;
     EXPECT_EQ(RunCli(command + " --out " + file, &output), 2) << command;
     EXPECT_NE(output.find(file + ": exists and is not a directory"), std::string::npos)
@@ -505,10 +509,11 @@ TEST(Cli, AnOutputDirectoryThatIsAFileExitsTwo) {
         << output;
   }
   const std::string blocked = file + "/out";  // under a file: cannot be made
-  for (const std::string& command : {"simulate " + file, "run " + file + " --no-progress"}) {
+  for (const std::string& command : commands) {
     std::string output;
-    EXPECT_EQ(RunCli(command + " --out " + blocked, &output), 2) << output;
+    EXPECT_EQ(RunCli(command + " --out " + blocked, &output), 2) << command;
     EXPECT_NE(output.find(blocked + ": cannot be made the output directory"), std::string::npos)
+        << command << "\n"
         << output;
   }
 }

@@ -40,9 +40,29 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
 }
 
 void CheckOutputDirectory(const std::string& dir) {
+  namespace fs = std::filesystem;
   std::error_code error;
-  if (std::filesystem::exists(dir, error) && !std::filesystem::is_directory(dir, error)) {
-    throw InputError(dir + ": exists and is not a directory (expected an output directory)");
+  if (fs::exists(dir, error)) {
+    if (!fs::is_directory(dir, error)) {
+      throw InputError(dir + ": exists and is not a directory (expected an output directory)");
+    }
+    return;
+  }
+  // The directory would be made in its nearest existing ancestor: that must be a directory
+  // this process may write in.
+  fs::path ancestor = fs::absolute(dir, error).parent_path();
+  while (!ancestor.empty() && !fs::exists(ancestor, error) && ancestor != ancestor.root_path()) {
+    ancestor = ancestor.parent_path();
+  }
+  std::string why;
+  if (!fs::is_directory(ancestor, error)) {
+    why = " is not a directory";
+  } else if (::access(ancestor.c_str(), W_OK | X_OK) != 0) {
+    why = ": no permission to make a directory in it";
+  }
+  if (!why.empty()) {
+    throw InputError(dir + ": cannot be made the output directory (" + ancestor.string() + why +
+                     "; expected a path where a directory can be made)");
   }
 }
 

@@ -12,7 +12,8 @@ namespace sonarbench {
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 /// Refuses `dir` as a command's output directory, before any work, when something other than a
-/// directory is in its way: throws InputError naming it.
+/// directory is in its way, or when it does not exist and its nearest existing ancestor is not a
+/// directory this process may write in: throws InputError naming it. Makes nothing.
 void CheckOutputDirectory(const std::string& dir);
 
 /// Creates the output directory `dir` and its parents; throws InputError naming it and why when
