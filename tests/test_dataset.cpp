@@ -167,27 +167,29 @@ TEST_F(TankDataset, ReadsBackTheSimulatedBeamsAndPoses) {
     EXPECT_EQ(dataset.beams[b].head_angle_rad, expected[b].head_angle_rad);
     EXPECT_TRUE(dataset.beams[b].T_world_sonar.isApprox(expected[b].T_world_sonar, 1e-8));
   }
-  // The per-beam truth: beam 200 (sweep 1's first) looks along -x, as the scene starts at 180°.
-  // Its axis meets the -x wall at 4.36/2 + 0.10 m; its nearest hit is the floor plane (0.0005 m)
-  // seen by the fan's lowest rays: at 17.5° down, or up to one ray stratum (35°/160) higher.
+  // The per-beam truth: beam 388 of sweep 1 (which starts at 180°, a head step of 1.8°) looks at
+  // 158.4°, between the vehicle's parts (its scene's comments). Its axis meets the -x wall at
+  // (4.36/2 + 0.10) / cos(21.6°) m; its nearest hit is the floor plane (0.0005 m) seen by the
+  // fan's lowest rays: at 17.5° down, or up to one ray stratum (35°/160) higher.
   std::ifstream truth(out / "truth/sweep_0001.csv");
   std::string header;
   std::getline(truth, header);
   EXPECT_EQ(header, "beam,time_s,head_angle_rad,first_hit_range_m,first_hit_mesh,axis_hit_range_m");
-  std::string line;
-  std::getline(truth, line);
-  std::stringstream fields(line);
   std::vector<std::string> f;
-  for (std::string field; std::getline(fields, field, ',');) f.push_back(field);
-  ASSERT_EQ(f.size(), 6u) << line;
-  EXPECT_EQ(f[0], "200");
-  EXPECT_NEAR(std::stod(f[2]), M_PI, 1e-6);
+  for (std::string line; f.empty() && std::getline(truth, line);) {
+    if (!line.starts_with("388,")) continue;
+    std::stringstream fields(line);
+    for (std::string field; std::getline(fields, field, ',');) f.push_back(field);
+  }
+  ASSERT_EQ(f.size(), 6u) << "beam 388's line";
+  const double head = (180.0 + 188 * 1.8 - 360.0) * M_PI / 180;
+  EXPECT_NEAR(std::stod(f[2]), head, 1e-6);
   EXPECT_EQ(f[4], "floor");
-  const double height = expected[200].T_world_sonar.translation().z() - 0.0005;
+  const double height = expected[388].T_world_sonar.translation().z() - 0.0005;
   const double edge = 17.5 * M_PI / 180;
   EXPECT_GE(std::stod(f[3]), height / std::sin(edge) - 1e-6);
   EXPECT_LE(std::stod(f[3]), height / std::sin(edge - 35.0 / 160 * M_PI / 180));
-  EXPECT_NEAR(std::stod(f[5]), 4.36 / 2 + 0.10, 1e-5);
+  EXPECT_NEAR(std::stod(f[5]), (4.36 / 2 + 0.10) / -std::cos(head), 1e-5);
 }
 
 TEST_F(TankDataset, ShardsAndResumedRunsGiveTheSameBytesAsOneRun) {

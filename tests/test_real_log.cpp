@@ -615,19 +615,18 @@ struct RealTank {
 // The fidelity guard: the tank scene, simulated as the main job does (its seed, 27 sweeps), stays
 // near the real log's recorded statistics. Seeds 1-5 gave: the self-reflection's mean 95.5-97.6,
 // its spreads 6.19-6.22 from ping to ping and 9.41-10.18 across head angles; the fine texture's
-// range correlation 0.593-0.607, contrast 0.338-0.349 and correlation across 1 / 2 / 3 head steps
-// 0.635-0.655 / 0.514-0.544 / 0.398-0.436; the sweep-to-sweep spread 2.22-2.24; the walls' median
-// strongest echo 146-150; the bands within 6.6 of the real ones, 2.8-3.1 on average; the near
-// range's mean 17.4-18.2 and spread across head angles 14.5-15.7 (before each head step's own
-// share of the speckle: 0.591-0.608, 0.337-0.349, the texture across head steps not guarded,
-// 2.23-2.24, 146-149, 6.3, 2.7-3.0, 17.5-18.1, 15.0-15.8). Each bound sits outside that spread
-// and inside what a lost piece of the model gives (docs/fidelity.md): the self-reflection under
-// the speckle (mean 120, ping spread 1.2), one look of speckle (0.70 and contrast 0.51), no own
-// share (0.90 / 0.75 / 0.59 across head steps) or the scattering alike over 3° instead of 7.2°
-// (0.58 / 0.35 / 0.16; 0.82 / 0.51 / 0.25 without the own share either), no receiver jitter
-// (spread 1.6), no skirts (median 167), the gain 2 dB off (every band ≈ 13 units), no vehicle parts
-// (the near range's mean 6.4 without them and their tail all round; 8.3 across head angles with the
-// model's mean tail instead).
+// range correlation 0.594-0.608, contrast 0.332-0.342 and correlation across 1 / 2 / 3 head steps
+// 0.635-0.655 / 0.512-0.542 / 0.396-0.434; the sweep-to-sweep spread 2.17-2.18; the walls' median
+// strongest echo 148-150; the bands within 5.8 of the real ones, 2.3-2.8 on average; the near
+// range's mean 15.9-16.9 and spread across head angles 20.7-22.3 (earlier figures:
+// docs/history.md). Each bound sits outside that spread and inside what a lost piece of the model
+// gives (docs/fidelity.md): the self-reflection under the speckle (mean 120, ping spread 1.2), one
+// look of speckle (0.70 and contrast 0.51), no own share (0.90 / 0.75 / 0.59 across head steps) or
+// the scattering alike over 3° instead of 7.2° (0.58 / 0.35 / 0.16; 0.82 / 0.51 / 0.25 without the
+// own share either), no receiver jitter (spread 1.6), no skirts (median 167), the gain 2 dB off
+// (every band ≈ 13 units), no vehicle parts (the near range's mean 6.4 without them and their tail
+// all round; 8.3 across head angles with the model's mean tail instead), the parts without those
+// at the real log's spots (15.1 across head angles).
 TEST(Fidelity, SimulatedTankStaysNearTheRealLogsRecordedStatistics) {
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   const auto meshes = sim::BuildSceneMeshes(scene);
@@ -652,7 +651,7 @@ TEST(Fidelity, SimulatedTankStaysNearTheRealLogsRecordedStatistics) {
   EXPECT_NEAR(r.sim_sweep_spread / RealTank::kSweepSpread, 1.0, 0.2);
   EXPECT_NEAR(r.sim_wall_peak[1], RealTank::kWallPeakMedian, 15.0);
   EXPECT_NEAR(r.sim_near_range.mean, RealTank::kNearRangeMean, 5.0);
-  EXPECT_GT(r.sim_near_range.angle_spread, 0.5 * RealTank::kNearRangeAngleSpread);
+  EXPECT_GT(r.sim_near_range.angle_spread, 0.75 * RealTank::kNearRangeAngleSpread);
   double total = 0.0;
   constexpr std::size_t kGuarded = RealTank::kBandMeans.size() - 1;  // not 4.5-5 m
   for (std::size_t b = 0; b < kGuarded; ++b) {
