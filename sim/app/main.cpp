@@ -462,35 +462,31 @@ void WriteErrorJunit(const RunArgs& args, std::string_view type, const std::stri
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{
-      "sonarbench: simulate a mechanical scanning imaging sonar, map its beams into an OctoMap, "
-      "and score the map against ground truth."};
-  app.require_subcommand(1);
-
-  RunArgs run;
-  CLI::App* run_cmd = app.add_subcommand(
+// `sonarbench run`: its options, filled into `args` when parsed.
+CLI::App* AddRunCommand(CLI::App& app, RunArgs& args) {
+  CLI::App* command = app.add_subcommand(
       "run",
       "Run a scenario end to end: simulate every sweep of SCENE, map them, score the map against "
       "the scene's ground truth and its criteria, and write report.json, junit.xml, report.html, "
       "map.bt (open it in octovis), polar.png (the first sweep, beams x bins), fan.png, "
       "map_top.png and map_side.png into --out. Exit status 0 when the criteria pass, 1 when "
       "they fail, 2 on bad input, 3 on an internal error.");
-  run_cmd->add_option("scene", run.scene, "Scene YAML file (see scenes/)")
+  command->add_option("scene", args.scene, "Scene YAML file (see scenes/)")
       ->required()
       ->check(CLI::ExistingFile);
-  run_cmd->add_option("-o,--out", run.out, "Output directory (created if needed)")
+  command->add_option("-o,--out", args.out, "Output directory (created if needed)")
       ->capture_default_str();
-  AddSeedOption(run_cmd, run.seed, "Seed of every random draw; overrides the scene's 'seed'");
-  AddThreadsOption(run_cmd, run.threads);
-  run_cmd->add_flag("--no-progress", run.no_progress,
+  AddSeedOption(command, args.seed, "Seed of every random draw; overrides the scene's 'seed'");
+  AddThreadsOption(command, args.threads);
+  command->add_flag("--no-progress", args.no_progress,
                     "Never show the progress line (it shows only on a terminal, and never when "
                     "the CI environment variable is set)");
+  return command;
+}
 
-  MapArgs map;
-  CLI::App* map_cmd = app.add_subcommand(
+// `sonarbench map`: its options, filled into `args` when parsed.
+CLI::App* AddMapCommand(CLI::App& app, MapArgs& args) {
+  CLI::App* command = app.add_subcommand(
       "map",
       "Map a recorded log with the production mapper: INPUT is a sonarbench dataset directory "
       "(from `simulate` or `import`; its manifest's sensor is used) or a real MSIS log in MATLAB "
@@ -499,30 +495,33 @@ int main(int argc, char** argv) {
       "from above), polar.png and fan.png (the first sweep) and report.json into --out. The "
       "sensor is the SHAD Micron and the mapper uses its defaults unless --scene, --sensor or "
       "--mapping say otherwise.");
-  map_cmd
-      ->add_option("input", map.input,
+  command
+      ->add_option("input", args.input,
                    "A dataset directory, a .mat log, or a folder holding one .mat log")
       ->required()
       ->check(CLI::ExistingPath);
-  map_cmd->add_option("-o,--out", map.out, "Output directory (created if needed)")
+  command->add_option("-o,--out", args.out, "Output directory (created if needed)")
       ->capture_default_str();
   auto* scene_opt =
-      map_cmd
-          ->add_option("--scene", map.scene,
+      command
+          ->add_option("--scene", args.scene,
                        "Take the sensor model and the mapping section from this scene")
           ->check(CLI::ExistingFile);
-  map_cmd->add_option("--sensor", map.sensor, "Sensor model YAML (its geometry is used)")
+  command->add_option("--sensor", args.sensor, "Sensor model YAML (its geometry is used)")
       ->check(CLI::ExistingFile)
       ->excludes(scene_opt);
-  map_cmd
-      ->add_option("--mapping", map.mapping,
+  command
+      ->add_option("--mapping", args.mapping,
                    "YAML file of mapping parameters (the keys of a scene's 'mapping' section)")
       ->check(CLI::ExistingFile)
       ->excludes(scene_opt);
-  AddThreadsOption(map_cmd, map.threads);
+  AddThreadsOption(command, args.threads);
+  return command;
+}
 
-  FidelityArgs fidelity;
-  CLI::App* fidelity_cmd = app.add_subcommand(
+// `sonarbench fidelity`: its options, filled into `args` when parsed.
+CLI::App* AddFidelityCommand(CLI::App& app, FidelityArgs& args) {
+  CLI::App* command = app.add_subcommand(
       "fidelity",
       "Compare a simulated scene with a real log of the same place: mean intensity against range "
       "(correlation), the strongest echo's range per head angle (median difference in bins) and "
@@ -534,17 +533,13 @@ int main(int argc, char** argv) {
       "direct_wall_profile.csv, second_trip_profile.csv, histogram.csv, by_head_angle.csv (the "
       "self-reflection's and the near range's mean per head angle), polar.png and fan.png into "
       "--out.");
-  fidelity_cmd->add_option("scene", fidelity.scene, "Scene YAML file")
-      ->required()
-      ->check(CLI::ExistingFile);
-  fidelity_cmd->add_option("log", fidelity.log, "Real log (.mat)")
-      ->required()
-      ->check(CLI::ExistingFile);
-  fidelity_cmd->add_option("-o,--out", fidelity.out, "Output directory")->capture_default_str();
-  AddSeedOption(fidelity_cmd, fidelity.seed, "Overrides the scene's seed");
-  AddThreadsOption(fidelity_cmd, fidelity.threads);
-  fidelity_cmd
-      ->add_option("--wall-min-range", fidelity.wall_min_range_m,
+  command->add_option("scene", args.scene, "Scene YAML file")->required()->check(CLI::ExistingFile);
+  command->add_option("log", args.log, "Real log (.mat)")->required()->check(CLI::ExistingFile);
+  command->add_option("-o,--out", args.out, "Output directory")->capture_default_str();
+  AddSeedOption(command, args.seed, "Overrides the scene's seed");
+  AddThreadsOption(command, args.threads);
+  command
+      ->add_option("--wall-min-range", args.wall_min_range_m,
                    "Strongest echoes are sought beyond this range [m] (past the floor's)")
       ->check(CLI::Validator(
           [](std::string& text) -> std::string {
@@ -554,32 +549,36 @@ int main(int argc, char** argv) {
           },
           "METRES"))
       ->capture_default_str();
+  return command;
+}
 
-  SimulateArgs simulate;
-  CLI::App* simulate_cmd = app.add_subcommand(
+// `sonarbench simulate`: its options, filled into `args` when parsed.
+CLI::App* AddSimulateCommand(CLI::App& app, SimulateArgs& args) {
+  CLI::App* command = app.add_subcommand(
       "simulate",
       "Simulate SCENE into a dataset directory (format: docs/dataset-format.md): beams of every "
       "sweep in binary, a polar PNG per sweep, per-beam ground truth, sonar and vehicle poses "
       "(TUM), the truth occupancy (.bt) and manifest.json with the sha256 of every file. Writes "
       "are atomic; a rerun resumes where a killed one stopped; an existing dataset is replaced "
       "only with --force. `sonarbench map DIR` maps it.");
-  simulate_cmd->add_option("scene", simulate.scene, "Scene YAML file")
-      ->required()
-      ->check(CLI::ExistingFile);
-  simulate_cmd->add_option("-o,--out", simulate.out, "Dataset directory")->required();
-  AddSeedOption(simulate_cmd, simulate.seed, "Overrides the scene's seed");
-  AddThreadsOption(simulate_cmd, simulate.threads);
-  simulate_cmd->add_flag("--force", simulate.force,
-                         "Replace an existing dataset (never deletes a directory that is not one)");
-  simulate_cmd->add_option(
-      "--shard", simulate.shard,
+  command->add_option("scene", args.scene, "Scene YAML file")->required()->check(CLI::ExistingFile);
+  command->add_option("-o,--out", args.out, "Dataset directory")->required();
+  AddSeedOption(command, args.seed, "Overrides the scene's seed");
+  AddThreadsOption(command, args.threads);
+  command->add_flag("--force", args.force,
+                    "Replace an existing dataset (never deletes a directory that is not one)");
+  command->add_option(
+      "--shard", args.shard,
       "K/N: write only sweeps s with s mod N = K-1 (cluster array jobs; default from "
       "SLURM_ARRAY_TASK_ID/_MIN/_COUNT). Beams are seeded by hashing their index, so shards "
       "give the same bytes as one run");
-  simulate_cmd->add_flag("--no-progress", simulate.no_progress, "Never show the progress line");
+  command->add_flag("--no-progress", args.no_progress, "Never show the progress line");
+  return command;
+}
 
-  SweepArgs sweep;
-  CLI::App* sweep_cmd = app.add_subcommand(
+// `sonarbench sweep`: its options, filled into `args` when parsed.
+CLI::App* AddSweepCommand(CLI::App& app, SweepArgs& args) {
+  CLI::App* command = app.add_subcommand(
       "sweep",
       "The coverage-vs-divisions study (the seed paper's figures 9 and 10): simulate SCENE once, "
       "then for each setting of horizontal x vertical ray divisions (H 1..64 at V 64, V 1..128 at "
@@ -587,37 +586,58 @@ int main(int argc, char** argv) {
       "precision, recall and coverage, and the mapping time. Writes items/item_NNN.json per "
       "setting, then divisions.csv, coverage_vs_divisions.png, time_vs_divisions.png and "
       "study.json into --out. Resumable; --shard splits the settings across array jobs.");
-  sweep_cmd->add_option("scene", sweep.scene, "Scene YAML file")
-      ->required()
-      ->check(CLI::ExistingFile);
-  sweep_cmd->add_option("-o,--out", sweep.out, "Study directory")->required();
-  AddSeedOption(sweep_cmd, sweep.seed, "Overrides the scene's seed");
-  sweep_cmd->add_option("--sweeps", sweep.sweeps, "Overrides the scene's sweeps (fewer: quicker)")
+  command->add_option("scene", args.scene, "Scene YAML file")->required()->check(CLI::ExistingFile);
+  command->add_option("-o,--out", args.out, "Study directory")->required();
+  AddSeedOption(command, args.seed, "Overrides the scene's seed");
+  command->add_option("--sweeps", args.sweeps, "Overrides the scene's sweeps (fewer: quicker)")
       ->check(CLI::Range(1, 100000));
-  sweep_cmd
-      ->add_option("--coverage-beams", sweep.coverage_beams,
+  command
+      ->add_option("--coverage-beams", args.coverage_beams,
                    "Beams of the first sweep whose exact volume is measured")
       ->check(CLI::Range(1, 10000))
       ->capture_default_str();
-  AddThreadsOption(sweep_cmd, sweep.threads);
-  sweep_cmd->add_flag("--force", sweep.force, "Discard the items of an earlier study in --out");
-  sweep_cmd->add_option("--shard", sweep.shard,
-                        "K/N: run only settings i with i mod N = K-1 (default from SLURM_ARRAY_*)");
-  sweep_cmd->add_flag("--no-progress", sweep.no_progress, "Never show the progress line");
+  AddThreadsOption(command, args.threads);
+  command->add_flag("--force", args.force, "Discard the items of an earlier study in --out");
+  command->add_option("--shard", args.shard,
+                      "K/N: run only settings i with i mod N = K-1 (default from SLURM_ARRAY_*)");
+  command->add_flag("--no-progress", args.no_progress, "Never show the progress line");
+  return command;
+}
 
-  ImportArgs import;
-  CLI::App* import_cmd = app.add_subcommand(
+// `sonarbench import`: its options, filled into `args` when parsed.
+CLI::App* AddImportCommand(CLI::App& app, ImportArgs& args) {
+  CLI::App* command = app.add_subcommand(
       "import",
       "Write a real .mat log as a dataset directory (the format `simulate` writes, without "
       "truth), so `sonarbench map DIR` and other tools read both the same way.");
-  import_cmd->add_option("log", import.log, "Real log (.mat)")
-      ->required()
+  command->add_option("log", args.log, "Real log (.mat)")->required()->check(CLI::ExistingFile);
+  command->add_option("-o,--out", args.out, "Dataset directory")->required();
+  command->add_option("--sensor", args.sensor, "Sensor model YAML (default: the SHAD Micron)")
       ->check(CLI::ExistingFile);
-  import_cmd->add_option("-o,--out", import.out, "Dataset directory")->required();
-  import_cmd->add_option("--sensor", import.sensor, "Sensor model YAML (default: the SHAD Micron)")
-      ->check(CLI::ExistingFile);
-  import_cmd->add_flag("--force", import.force, "Replace an existing dataset");
+  command->add_flag("--force", args.force, "Replace an existing dataset");
+  return command;
+}
 
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "sonarbench: simulate a mechanical scanning imaging sonar, map its beams into an OctoMap, "
+      "and score the map against ground truth."};
+  app.require_subcommand(1);
+
+  RunArgs run;
+  CLI::App* run_cmd = AddRunCommand(app, run);
+  MapArgs map;
+  CLI::App* map_cmd = AddMapCommand(app, map);
+  FidelityArgs fidelity;
+  CLI::App* fidelity_cmd = AddFidelityCommand(app, fidelity);
+  SimulateArgs simulate;
+  CLI::App* simulate_cmd = AddSimulateCommand(app, simulate);
+  SweepArgs sweep;
+  CLI::App* sweep_cmd = AddSweepCommand(app, sweep);
+  ImportArgs import;
+  CLI::App* import_cmd = AddImportCommand(app, import);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
