@@ -138,9 +138,9 @@ TEST(YamlReader, SyntaxErrorNamesFileAndLine) {
 }
 
 TEST(SceneFile, ShippedScenesLoad) {
-  for (const char* name : {"scenes/cras-tank.yaml", "scenes/seabed.yaml",
-                           "scenes/trials/cras-tank-sidelobes.yaml",
-                           "scenes/trials/cras-tank-receiver-knee.yaml"}) {
+  for (const char* name :
+       {"scenes/cras-tank.yaml", "scenes/seabed.yaml", "scenes/trials/cras-tank-sidelobes.yaml",
+        "scenes/trials/cras-tank-receiver-knee.yaml"}) {
     SCOPED_TRACE(name);
     const sim::Scene scene = sim::LoadScene(test::SourcePath(name));
     EXPECT_FALSE(scene.meshes.empty());

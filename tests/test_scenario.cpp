@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sonarbench/sim/scenario.hpp"
@@ -503,20 +504,15 @@ TEST(Cli, AnOutputDirectoryThatIsAFileExitsTwo) {
   const std::vector<std::string> commands = {"run " + file + " --no-progress",
                                              "map " + dir.path().string(), "sweep " + file,
                                              "fidelity " + file + " " + file, "simulate " + file};
-  for (const std::string& command : commands) {
-    std::string output;
-    EXPECT_EQ(RunCli(command + " --out " + file, &output), 2) << command;
-    EXPECT_NE(output.find(file + ": exists and is not a directory"), std::string::npos)
-        << command << "\n"
-        << output;
-  }
   const std::string blocked = file + "/out";  // under a file: cannot be made
-  for (const std::string& command : commands) {
-    std::string output;
-    EXPECT_EQ(RunCli(command + " --out " + blocked, &output), 2) << command;
-    EXPECT_NE(output.find(blocked + ": cannot be made the output directory"), std::string::npos)
-        << command << "\n"
-        << output;
+  for (const auto& [out, says] :
+       {std::pair{file, file + ": exists and is not a directory"},
+        std::pair{blocked, blocked + ": cannot be made the output directory"}}) {
+    for (const std::string& command : commands) {
+      std::string output;
+      EXPECT_EQ(RunCli(command + " --out " + out, &output), 2) << command;
+      EXPECT_NE(output.find(says), std::string::npos) << command << "\n" << output;
+    }
   }
 }
 
