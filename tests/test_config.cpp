@@ -283,8 +283,9 @@ TEST(SceneFile, BadSonarAcousticsAreNamed) {
 }
 
 // A material's mirror roughness is read in degrees and kept in radians, its glint as a
-// fraction (none on the tank's walls: tried, not fitted; the vehicle's nose glints); out of
-// range, or a glint without the spread it falls over, is named.
+// fraction of a perfect reflector's echo (none on the tank's walls: tried, not fitted; the
+// vehicle's nose glints); out of range, a glint without the spread it falls over, or one whose
+// lobe would send more sound than the surface meets (over 1/(2σ²): 102.588 at σ = 4°), is named.
 TEST(SceneFile, SpecularSpreadIsReadInDegrees) {
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   ASSERT_FALSE(scene.materials.empty());
@@ -300,11 +301,14 @@ TEST(SceneFile, SpecularSpreadIsReadInDegrees) {
   const std::pair<std::string, std::vector<std::string>> cases[] = {
       {"reflectivity: 0.5, specular_spread_deg: 45",
        {"'materials[0].specular_spread_deg'", "'45'"}},
-      {"reflectivity: 0.5, specular_spread_deg: 4, glint: 1.5", {"'materials[0].glint'", "'1.5'"}},
+      {"reflectivity: 0.5, specular_spread_deg: 4, glint: -0.5",
+       {"'materials[0].glint'", "a number >= 0", "'-0.5'"}},
+      {"reflectivity: 0.5, specular_spread_deg: 4, glint: 103",
+       {"'materials[0].glint'", "at most 1/(2σ²) = 102.588 for specular_spread_deg 4", "got 103"}},
       {"reflectivity: 0.5, glint: 0.1",
        {"'materials[0].glint'", "specular_spread_deg > 0", "got 0"}}};
-  for (const auto& [material, expected] : cases) {
-    test::TempDir dir;
+  test::TempDir dir;
+  const auto scene_with = [&](const std::string& material) {
     const std::string path = (dir.path() / "bad.yaml").string();
     std::ofstream(path)
         << "name: x\nsensor_model: " << test::SourcePath("sensor-models/shad-micron.yaml")
@@ -312,10 +316,19 @@ TEST(SceneFile, SpecularSpreadIsReadInDegrees) {
         << "  - {name: rock, " << material << "}\n"
         << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
         << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
+    return path;
+  };
+  for (const auto& [material, expected] : cases) {
     std::vector<std::string> parts = {"bad.yaml:5:"};
     parts.insert(parts.end(), expected.begin(), expected.end());
-    EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, parts)) << material;
+    EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(scene_with(material)); }, parts))
+        << material;
   }
+  // Under the bound, a glint brighter than a perfect diffuse reflector is a smooth surface's.
+  EXPECT_EQ(sim::LoadScene(scene_with("reflectivity: 0.5, specular_spread_deg: 4, glint: 102.5"))
+                .materials.front()
+                .glint,
+            102.5);
 }
 
 // The tank's reverberation, second trip, pulse skirts and level jitter are the scene's (the

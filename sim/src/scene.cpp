@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <optional>
+#include <sstream>
 
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/mesh_file.hpp"
@@ -144,6 +145,12 @@ namespace {
 // Scenes may extend one another this deep at most (a chain longer than this is surely a loop).
 constexpr std::size_t kMaxExtends = 8;
 
+// The most a rough mirror of spread σ [rad] can glint, as a fraction of a perfect (Lambertian)
+// reflector's echo: the lobe g exp(-α²/2σ²) of a reflector sending I(α) = g P/π exp(-α²/2σ²)
+// per steradian of the power P it meets carries g P/π · 2πσ² at most (∫ exp(-α²/2σ²) dΩ ≤ 2πσ²),
+// so it sends no more than P while g ≤ 1/(2σ²).
+double MostGlint(double spread_rad) { return 0.5 / (spread_rad * spread_rad); }
+
 // A scene's materials, by name: with a base, one the base has is replaced and a new one added;
 // a name the file itself gave already is refused (which of the two would count is anyone's guess).
 void ReadMaterials(YamlReader& root, bool extending, std::vector<Material>& materials) {
@@ -158,9 +165,14 @@ void ReadMaterials(YamlReader& root, bool extending, std::vector<Material>& mate
     double spread_deg = 0.0;
     item.Optional("specular_spread_deg", spread_deg, InRange(0.0, 30.0));
     m.specular_spread_rad = spread_deg * kDegToRad;
-    item.Optional("glint", m.glint, InRange(0.0, 1.0));
+    item.Optional("glint", m.glint, NonNegative());
     if (m.glint > 0.0 && m.specular_spread_rad <= 0.0) {
       item.Fail("glint", "specular_spread_deg > 0 (the lobe the glint falls over), got 0");
+    } else if (const double most = MostGlint(m.specular_spread_rad); m.glint > most) {
+      std::ostringstream expected;
+      expected << "at most 1/(2σ²) = " << most << " for specular_spread_deg " << spread_deg
+               << " (all the incident sound sent into the glint's lobe), got " << m.glint;
+      item.Fail("glint", expected.str());
     }
     item.RejectUnknownKeys();
     if (std::ranges::find(names, m.name) != names.end()) {

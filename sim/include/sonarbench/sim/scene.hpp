@@ -28,8 +28,11 @@ struct Material {
   /// way back is tilted independently of its way out.
   double specular_spread_rad = 0.0;
   /// The rough mirror's glint: what it sends towards the receiver around its mirror direction,
-  /// as a fraction of a perfect reflector's echo [0-1]: g · exp(-α²/2σ²), α the angle between
-  /// the mirror direction and the way to the receiver, σ specular_spread_rad (so it needs one).
+  /// as a fraction of a perfect reflector's echo: g · exp(-α²/2σ²), α the angle between the
+  /// mirror direction and the way to the receiver, σ specular_spread_rad (so it needs one). A
+  /// smooth surface sends more than a perfect diffuse one towards its mirror direction: g is at
+  /// most 1/(2σ²), where the lobe holds all the sound the surface meets (25.6 for σ = 8°; a
+  /// lobe holding the specular fraction s alone, s/(2σ²)).
   /// Heard wherever the diffuse backscatter is: at normal incidence, and where mirror paths
   /// turn back to the sonar (a corner of two walls and the floor sends sound straight back).
   /// The sonar's mirror image, not sound scattered into the place: it takes the pulse's skirts
