@@ -458,6 +458,43 @@ TEST(Cli, SimulateWritesADatasetThatMapReads) {
   EXPECT_NE(output.find("no manifest.json"), std::string::npos) << output;
 }
 
+// `map --score` scores a log's map against a scene as `run` scores its own simulation: a dataset
+// of the scene, mapped from its own poses, gets the metrics `run` reports, count for count. A
+// .mat log is static, so it can be placed only at a scene's static sonar (rocks-slope's moves;
+// the check comes before the log is read); --score needs the scene.
+TEST(Cli, MapScoresALogAgainstASceneAsRunScoresItsSimulation) {
+  test::TempDir dir;
+  const auto scene = TankSceneWithCriteria(dir.path(), "");
+  const auto run = dir.path() / "run";
+  const auto ds = dir.path() / "ds";
+  const auto map = dir.path() / "map";
+  std::string output;
+  ASSERT_EQ(RunCli("run " + scene.string() + " --out " + run.string(), &output), 0) << output;
+  ASSERT_EQ(RunCli("simulate " + scene.string() + " --out " + ds.string(), &output), 0) << output;
+  ASSERT_EQ(
+      RunCli("map " + ds.string() + " --scene " + scene.string() + " --score --out " + map.string(),
+             &output),
+      0)
+      << output;
+  EXPECT_NE(output.find("against " + scene.string() + ": occupied precision"), std::string::npos)
+      << output;
+  const auto scored = nlohmann::json::parse(ReadFile(map / "report.json"))["metrics"];
+  const auto simulated = nlohmann::json::parse(ReadFile(run / "report.json"))["metrics"];
+  EXPECT_GT(scored["counts"]["true_positive_cells"].get<std::size_t>(), 0u);
+  EXPECT_EQ(scored, simulated);
+
+  EXPECT_EQ(RunCli("map " + ds.string() + " --score --out " + map.string(), &output), 2);
+  EXPECT_NE(output.find("--score requires --scene"), std::string::npos) << output;
+  const std::string moving = test::SourcePath("scenes/rocks-slope.yaml");
+  EXPECT_EQ(
+      RunCli("map " + scene.string() + " --scene " + moving + " --score --out " + map.string(),
+             &output),
+      2);
+  EXPECT_NE(output.find("rocks-slope.yaml: the sonar moves along the scene's trajectory"),
+            std::string::npos)
+      << output;
+}
+
 TEST(Cli, MissingSceneAndBadOptionsExitTwo) {
   std::string output;
   EXPECT_EQ(RunCli("run /nonexistent.yaml", &output), 2);

@@ -92,16 +92,22 @@ class ProgressLine {
   std::chrono::steady_clock::time_point last_print_;
 };
 
+// "occupied precision P (tp/occupied), recall R (..), coverage C (..)": a map's scores.
+std::string MetricsLine(const sonarbench::sim::MapMetrics& m) {
+  std::ostringstream line;
+  line << "occupied precision " << m.occupied_precision << " (" << m.true_positive_cells << "/"
+       << m.occupied_cells << "), recall " << m.occupied_recall << " (" << m.observed_occupied_cells
+       << "/" << m.observable_cells << "), coverage " << m.coverage << " ("
+       << m.known_observable_cells << "/" << m.observable_cells << ")";
+  return line.str();
+}
+
 void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::ScenarioResult& r,
                   const std::string& out) {
-  const auto& m = r.metrics;
   const auto& t = r.timings;
   const auto& v = r.verdict;
   std::cout << "beams " << r.beams << ", seed " << r.seed << ", threads " << r.threads << "\n"
-            << "occupied precision " << m.occupied_precision << " (" << m.true_positive_cells << "/"
-            << m.occupied_cells << "), recall " << m.occupied_recall << " ("
-            << m.observed_occupied_cells << "/" << m.observable_cells << "), coverage "
-            << m.coverage << " (" << m.known_observable_cells << "/" << m.observable_cells << ")\n"
+            << MetricsLine(r.metrics) << "\n"
             << "timing [s]: scene " << t.build_scene_s << ", simulate " << t.simulate_s << ", map "
             << t.map_s << ", ground truth " << t.ground_truth_s << ", score " << t.score_s << "\n"
             << "wrote " << out << "/report.json, junit.xml, report.html, map.bt and images\n";
@@ -130,6 +136,7 @@ struct MapArgs {
   std::string scene;
   std::string sensor;
   std::string mapping;
+  bool score = false;
   int threads = 0;
 };
 
@@ -149,12 +156,24 @@ int Map(const MapArgs& args) {
     reader.ThrowIfErrors();
   }
   config.threads = args.threads;
-  const auto result = sonarbench::sim::MapLog(args.input, sensor, config);
+  // A .mat log scored against the scene is mapped from the scene's sonar pose.
+  std::optional<sonarbench::sim::Scene> scene;
+  std::optional<Eigen::Isometry3d> mat_log_pose;
+  if (args.score) {
+    scene = sonarbench::sim::LoadScene(args.scene);
+    const bool dataset = std::filesystem::is_directory(args.input) &&
+                         sonarbench::sim::MatLogInDirectory(args.input).empty();
+    if (!dataset) mat_log_pose = sonarbench::sim::StaticSonarPose(*scene);
+  }
+  auto result = sonarbench::sim::MapLog(args.input, sensor, config, mat_log_pose);
+  if (scene) result.metrics = sonarbench::sim::ScoreLogMap(result, *scene);
   sonarbench::sim::WriteLogMapOutputs(args.out, result);
   const auto& t = result.totals;
   std::cout << result.beams << " beams (" << result.truncated_beams << " truncated) in "
-            << result.sweeps << " sweeps; " << t.beams_with_obstacle << " with an obstacle\n"
-            << "timing [s]: import " << result.import_s << ", map " << result.map_s << "\n"
+            << result.sweeps << " sweeps; " << t.beams_with_obstacle << " with an obstacle\n";
+  if (result.metrics)
+    std::cout << "against " << args.scene << ": " << MetricsLine(*result.metrics) << "\n";
+  std::cout << "timing [s]: import " << result.import_s << ", map " << result.map_s << "\n"
             << "wrote " << args.out
             << "/report.json, map.bt, map.ot, map_top.png, polar.png, fan.png\n";
   return 0;
@@ -515,6 +534,13 @@ CLI::App* AddMapCommand(CLI::App& app, MapArgs& args) {
                    "YAML file of mapping parameters (the keys of a scene's 'mapping' section)")
       ->check(CLI::ExistingFile)
       ->excludes(scene_opt);
+  command
+      ->add_flag("--score", args.score,
+                 "Score the map against the --scene's surfaces as `run` scores a simulated one "
+                 "(precision, recall, coverage; report.json's metrics). A .mat log, static at its "
+                 "origin, is mapped from the scene's sonar pose, which must not move; a dataset's "
+                 "beams keep their poses")
+      ->needs(scene_opt);
   AddThreadsOption(command, args.threads);
   return command;
 }

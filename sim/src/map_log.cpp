@@ -10,8 +10,12 @@
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mat_log.hpp"
 #include "sonarbench/sim/images.hpp"
+#include "sonarbench/sim/mesh.hpp"
+#include "sonarbench/sim/ray_tracer.hpp"
 #include "sonarbench/sim/report.hpp"
+#include "sonarbench/sim/scenario_report.hpp"
 #include "sonarbench/sim/score.hpp"
+#include "sonarbench/sim/simulation.hpp"
 
 namespace sonarbench::sim {
 
@@ -36,7 +40,8 @@ std::string MatLogInDirectory(const std::string& input) {
 }
 
 LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
-                    const mapping::MapperConfig& config) {
+                    const mapping::MapperConfig& config,
+                    const std::optional<Eigen::Isometry3d>& mat_log_pose) {
   LogMapResult result;
   result.input = input;
   auto start = std::chrono::steady_clock::now();
@@ -54,12 +59,19 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
     result.truncated_beams = log.truncated_beams;
     result.source = "mat";
     if (!log_file.empty()) result.input = log_file;
+    if (mat_log_pose) {
+      for (mapping::Beam& beam : beams) beam.T_world_sonar = *mat_log_pose;
+    }
+  }
+  for (const mapping::Beam& beam : beams) {
+    result.poses.push_back({beam.T_world_sonar, beam.head_angle_rad});
   }
   auto now = std::chrono::steady_clock::now();
   result.import_s = std::chrono::duration<double>(now - start).count();
   result.beams = beams.size();
 
   start = now;
+  result.sensor = geometry;
   result.mapper = std::make_unique<mapping::Mapper>(config, geometry);
   result.totals = result.mapper->IntegrateSweeps(beams);
   const auto per_sweep = static_cast<std::size_t>(geometry.BeamsPerSweep());
@@ -68,6 +80,32 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
                             beams.begin() + static_cast<long>(std::min(per_sweep, beams.size())));
   result.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+Eigen::Isometry3d StaticSonarPose(const Scene& scene) {
+  const std::size_t beams = static_cast<std::size_t>(scene.sweeps) *
+                            static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
+  const Eigen::Isometry3d first = ScheduleBeam(scene, 0).pose.T_world_sonar;
+  for (std::size_t b = 1; b < beams; ++b) {
+    if (!ScheduleBeam(scene, b).pose.T_world_sonar.isApprox(first, 1e-12)) {
+      throw InputError(scene.file + ": the sonar moves along the scene's trajectory (beam " +
+                       std::to_string(b) +
+                       "); a .mat log is static and can be scored only against a scene whose "
+                       "sonar is, or simulate and map the scene as a dataset");
+    }
+  }
+  return first;
+}
+
+MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene) {
+  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
+  const RayTracer tracer(meshes);
+  const octomap::OcTree& map = result.mapper->tree();
+  const Acoustics& a = scene.sensor.acoustics;
+  return ScoreMap(map, VoxelizeMeshes(meshes, map),
+                  ObservableSurfaceCells(tracer, result.poses, result.sensor, 2 * a.rays_horizontal,
+                                         2 * a.rays_vertical, map),
+                  meshes);
 }
 
 void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) {
@@ -113,6 +151,7 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) 
                    {"map_top", "map_top.png"},
                    {"polar", "polar.png"},
                    {"fan", "fan.png"}}}});
+  if (result.metrics) report["metrics"] = MetricsJson(*result.metrics);
   WriteJson((dir / "report.json").string(), report);
 }
 

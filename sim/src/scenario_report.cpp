@@ -278,6 +278,28 @@ void WriteText(const std::string& path, const std::string& text) {
 
 }  // namespace
 
+nlohmann::json MetricsJson(const MapMetrics& m) {
+  return {{"occupied_precision", m.occupied_precision},
+          {"occupied_recall", m.occupied_recall},
+          {"occupied_f1", m.occupied_f1},
+          {"coverage", m.coverage},
+          {"coverage_absolute", m.coverage_absolute},
+          {"free_accuracy", m.free_accuracy},
+          {"per_mesh", PerMeshJson(m)},
+          {"surface_distance",
+           {{"map_to_mesh", DistanceJson(m.map_to_mesh)},
+            {"mesh_to_map", DistanceJson(m.mesh_to_map)}}},
+          {"counts",
+           {{"truth_cells", m.truth_cells},
+            {"observable_cells", m.observable_cells},
+            {"occupied_cells", m.occupied_cells},
+            {"free_cells", m.free_cells},
+            {"true_positive_cells", m.true_positive_cells},
+            {"observed_occupied_cells", m.observed_occupied_cells},
+            {"known_observable_cells", m.known_observable_cells},
+            {"free_on_surface_cells", m.free_on_surface_cells}}}};
+}
+
 nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& result) {
   const MapMetrics& m = result.metrics;
   const StageTimings& t = result.timings;
@@ -302,26 +324,7 @@ nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& resu
                    {"start_head_angle_deg", scene.start_head_angle_rad * kRadToDeg},
                    {"sensor", SensorJson(scene.sensor)},
                    {"mapping", MappingJson(result.mapper->config())}}},
-                 {"metrics",
-                  {{"occupied_precision", m.occupied_precision},
-                   {"occupied_recall", m.occupied_recall},
-                   {"occupied_f1", m.occupied_f1},
-                   {"coverage", m.coverage},
-                   {"coverage_absolute", m.coverage_absolute},
-                   {"free_accuracy", m.free_accuracy},
-                   {"per_mesh", PerMeshJson(m)},
-                   {"surface_distance",
-                    {{"map_to_mesh", DistanceJson(m.map_to_mesh)},
-                     {"mesh_to_map", DistanceJson(m.mesh_to_map)}}},
-                   {"counts",
-                    {{"truth_cells", m.truth_cells},
-                     {"observable_cells", m.observable_cells},
-                     {"occupied_cells", m.occupied_cells},
-                     {"free_cells", m.free_cells},
-                     {"true_positive_cells", m.true_positive_cells},
-                     {"observed_occupied_cells", m.observed_occupied_cells},
-                     {"known_observable_cells", m.known_observable_cells},
-                     {"free_on_surface_cells", m.free_on_surface_cells}}}}},
+                 {"metrics", MetricsJson(m)},
                  {"mapping_totals",
                   {{"beams", result.mapping_totals.beams},
                    {"beams_with_obstacle", result.mapping_totals.beams_with_obstacle},

@@ -1,10 +1,15 @@
 #pragma once
 
+#include <Eigen/Geometry>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "sonarbench/mapping/mapper.hpp"
+#include "sonarbench/sim/ground_truth.hpp"
+#include "sonarbench/sim/scene.hpp"
+#include "sonarbench/sim/score.hpp"
 
 namespace sonarbench::sim {
 
@@ -21,6 +26,12 @@ struct LogMapResult {
   mapping::BatchStats totals;
   std::unique_ptr<mapping::Mapper> mapper;
   std::vector<mapping::Beam> first_sweep;
+  /// The beams' geometry: the log's own for a dataset, else the one MapLog was given.
+  mapping::SensorGeometry sensor;
+  /// Every beam's pose as mapped.
+  std::vector<BeamPose> poses;
+  /// The map scored against a scene's surfaces (ScoreLogMap), if it was.
+  std::optional<MapMetrics> metrics;
 };
 
 /// The `.mat` log to read when `input` is a directory that is not a dataset (no manifest.json)
@@ -30,13 +41,28 @@ struct LogMapResult {
 
 /// Reads a real `.mat` log (a file, or a folder holding just one, see MatLogInDirectory) or a
 /// dataset directory (mapping::ReadDataset; its own sensor geometry replaces `sensor`) and maps it
-/// sweep by sweep (BeamsPerSweep() consecutive beams each; the last sweep may be partial). Throws
-/// InputError for input that is not a readable log.
-[[nodiscard]] LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
-                                  const mapping::MapperConfig& config);
+/// sweep by sweep (BeamsPerSweep() consecutive beams each; the last sweep may be partial). A
+/// `.mat` log's vehicle is static at its own origin: with `mat_log_pose` every beam of one is
+/// mapped from that sonar pose instead (a scene's, to score it against the scene); a dataset's
+/// beams keep their own. Throws InputError for input that is not a readable log.
+[[nodiscard]] LogMapResult MapLog(
+    const std::string& input, const mapping::SensorGeometry& sensor,
+    const mapping::MapperConfig& config,
+    const std::optional<Eigen::Isometry3d>& mat_log_pose = std::nullopt);
 
-/// Writes `map.bt`, `map.ot`, `map_top.png`, `polar.png`, `fan.png` and `report.json` into
-/// `out_dir`, each atomically, the report last.
+/// The static sonar pose of `scene` (its first beam's), where a `.mat` log of the place is mapped
+/// to score it against the scene. Throws InputError when the scene's sonar moves: a static log
+/// cannot be placed along a trajectory.
+[[nodiscard]] Eigen::Isometry3d StaticSonarPose(const Scene& scene);
+
+/// Scores `result`'s map against `scene`'s surfaces as `sonarbench run` scores a simulated one
+/// (ScoreMap): the truth voxelised from the scene's meshes, the cells a perfect sensor could see
+/// from the poses the log's beams were mapped from, rays twice as dense as the scene's sensor
+/// samples each beam, over the log's own beam geometry.
+[[nodiscard]] MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene);
+
+/// Writes `map.bt`, `map.ot`, `map_top.png`, `polar.png`, `fan.png` and `report.json` (with the
+/// scores under "metrics" if the map was scored) into `out_dir`, each atomically, the report last.
 void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result);
 
 }  // namespace sonarbench::sim

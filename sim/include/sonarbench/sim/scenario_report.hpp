@@ -13,6 +13,10 @@ namespace sonarbench::sim {
 /// Version of report.json's layout; raised whenever a field changes meaning or goes away.
 inline constexpr int kScenarioReportSchema = 2;
 
+/// A map's scores as report.json holds them (its "metrics"): precision, recall, F1, coverage,
+/// free accuracy, per mesh, surface distances and the counts behind each.
+[[nodiscard]] nlohmann::json MetricsJson(const MapMetrics& m);
+
 /// report.json of a run: scene, parameters, metrics with their counts, each criterion's actual,
 /// expected and margin, the verdict, mapping totals and stage timings.
 [[nodiscard]] nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& result);
