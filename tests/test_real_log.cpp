@@ -606,27 +606,29 @@ struct RealTank {
   static constexpr double kBehindSquare = 43.03;
   static constexpr double kBehindCorners = 83.78;
   // The mean intensity over each of FidelityReport::kRangeBandsM: 0.4-1.5, 1.5-2, 2-2.5, 2.5-3,
-  // 3-4, 4-4.5 and 4.5-5 m (the guard below leaves the last out: the model's back lobe brings it
-  // only to 39-41).
+  // 3-4, 4-4.5 and 4.5-5 m (the guard below leaves the last out: the model's back lobe and the
+  // walls' glint bring it only to 50).
   static constexpr std::array<double, sim::FidelityReport::kRangeBandsM.size()> kBandMeans = {
       7.21, 28.20, 51.24, 56.43, 50.79, 42.24, 59.50};
 };
 
 // The fidelity guard: the tank scene, simulated as the main job does (its seed, 27 sweeps), stays
-// near the real log's recorded statistics. Seeds 1-5 gave: the self-reflection's mean 95.5-97.6,
-// its spreads 6.19-6.22 from ping to ping and 9.41-10.18 across head angles; the fine texture's
-// range correlation 0.594-0.608, contrast 0.332-0.342 and correlation across 1 / 2 / 3 head steps
-// 0.635-0.655 / 0.512-0.542 / 0.396-0.434; the sweep-to-sweep spread 2.17-2.18; the walls' median
-// strongest echo 148-150; the bands within 5.8 of the real ones, 2.3-2.8 on average; the near
-// range's mean 15.9-16.9 and spread across head angles 20.7-22.3 (earlier figures:
+// near the real log's recorded statistics. Seeds 1-5 gave: the self-reflection's mean 95.4-97.5,
+// its spreads 6.11-6.15 from ping to ping and 9.30-10.03 across head angles; the fine texture's
+// range correlation 0.631-0.647, contrast 0.329-0.339 and correlation across 1 / 2 / 3 head steps
+// 0.625-0.650 / 0.529-0.553 / 0.419-0.452; the sweep-to-sweep spread 2.11-2.13; the walls' median
+// strongest echo 151-152; the bands within 9.7 of the real ones (2.5-3 m, lit by the walls' glint),
+// 3.3-4.2 on average; the near range's mean 14.8-16.0 and spread across head angles 20.4-22.1
+// (earlier figures, before the sidelobes, the receiver's knee and the walls' glint:
 // docs/history.md). Each bound sits outside that spread and inside what a lost piece of the model
-// gives (docs/fidelity.md): the self-reflection under the speckle (mean 120, ping spread 1.2), one
-// look of speckle (0.70 and contrast 0.51), no own share (0.90 / 0.75 / 0.59 across head steps) or
-// the scattering alike over 3° instead of 7.2° (0.58 / 0.35 / 0.16; 0.82 / 0.51 / 0.25 without the
-// own share either), no receiver jitter (spread 1.6), no skirts (median 167), the gain 2 dB off
-// (every band ≈ 13 units), no vehicle parts (the near range's mean 6.4 without them and their tail
-// all round; 8.3 across head angles with the model's mean tail instead), the parts without those
-// at the real log's spots (15.1 across head angles).
+// gives (docs/fidelity.md; the bands' average 7.1 and 11.0 with the gain 2 dB under and over): the
+// self-reflection under the speckle (mean 120, ping spread 1.2), one look of speckle (0.70 and
+// contrast 0.51), no own share (0.90 / 0.75 / 0.59 across head steps) or the scattering alike over
+// 3° instead of 7.2° (0.58 / 0.35 / 0.16; 0.82 / 0.51 / 0.25 without the own share either), no
+// receiver jitter (spread 1.6), no skirts (median 167), the gain 2 dB off (every band ≈ 13 units),
+// no vehicle parts (the near range's mean 6.4 without them and their tail all round; 8.3 across
+// head angles with the model's mean tail instead), the parts without those at the real log's spots
+// (15.1 across head angles).
 TEST(Fidelity, SimulatedTankStaysNearTheRealLogsRecordedStatistics) {
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   const auto meshes = sim::BuildSceneMeshes(scene);
@@ -660,7 +662,7 @@ TEST(Fidelity, SimulatedTankStaysNearTheRealLogsRecordedStatistics) {
         << sim::FidelityReport::kRangeBandsM[b][0] << " m";
     total += std::abs(*r.sim_band_means[b] - RealTank::kBandMeans[b]);
   }
-  EXPECT_LT(total / kGuarded, 4.0);
+  EXPECT_LT(total / kGuarded, 5.0);
 }
 
 // The recorded statistics are the real log's, to their last digit.

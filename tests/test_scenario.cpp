@@ -26,20 +26,23 @@ using mapping::kDegToRad;
 // trip, its pulse's skirts and the back lobe (which hears the wall behind the sonar) are switched
 // off here, so that "nothing echoes from beyond a wall" holds exactly and a wall's echo starts at
 // the wall, and so is its scattering's correlation across azimuth (its texture in long arcs leaves
-// whole sectors of floor unmapped); BeamSynthesis tests both on their own. The scene's floor is
-// fitted as faint as the real log's and its threshold (110) set against the reverberation, so it
-// maps little floor. These tests are about where echoes land, so the walls here are bright
-// (reflectivity 0.5, where the fitted 0.012 matches the real log's moderate wall echoes), the floor
-// brighter (0.2, cos^0.5: 12 times the fitted floor's 0.03 cos¹ where the fan meets it, at 72.5°
-// incidence) and, with no ghosts to reject, the threshold 90: the floor's echo is a run of its own
-// before the wall's in nearly every beam. (A floor as bright as the walls merges with their echo
-// into one run at the floor's range: with the threshold 60, 34-75 of a wall's 88-90 columns
-// mapped.)
+// whole sectors of floor unmapped), and so are the sidelobes and the walls' glint (which map a
+// strong echo onto every bearing within ±20° of it); BeamSynthesis tests them on their own. The
+// scene's floor is fitted as faint as the real log's and its threshold (110) set against the
+// reverberation, so it maps little floor. These tests are about where echoes land, so the walls
+// here are bright (reflectivity 0.5, where the fitted 0.012 matches the real log's moderate wall
+// echoes), the floor brighter (0.2, cos^0.5: 12 times the fitted floor's 0.03 cos¹ where the fan
+// meets it, at 72.5° incidence) and, with no ghosts to reject, the threshold 90: the floor's echo
+// is a run of its own before the wall's in nearly every beam. (A floor as bright as the walls
+// merges with their echo into one run at the floor's range: with the threshold 60, 34-75 of a
+// wall's 88-90 columns mapped.)
 class TankScenario : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     scene_ = new Scene(LoadScene(test::SourcePath("scenes/cras-tank.yaml")));
     MaterialNamed("tank_wall").reflectivity = 0.5;
+    MaterialNamed("tank_wall").glint = 0.0;
+    scene_->sensor.acoustics.sidelobe_extent_deg = 0.0;
     Material& floor = MaterialNamed("tank_floor");
     floor.reflectivity = 0.2;
     floor.backscatter_exponent = 0.5;
@@ -192,13 +195,13 @@ TEST_F(TankScenario, OutputsAreWrittenWithTheReportLast) {
                    result_->metrics.occupied_precision);
   EXPECT_TRUE(report["timing"].contains("map_s"));
   EXPECT_EQ(report["parameters"]["mapping"]["rays_vertical"], 64);
-  // The sensor's settings in force, the ones off by default too.
+  // The sensor's settings in force, the ones switched off too.
   const auto& acoustics = report["parameters"]["sensor"]["acoustics"];
   EXPECT_EQ(acoustics["gain_db"], scene_->sensor.acoustics.gain_db);
   EXPECT_EQ(acoustics["sidelobe_extent_deg"], 0.0);
-  EXPECT_EQ(acoustics["sidelobe_rays_vertical"], scene_->sensor.acoustics.sidelobe_rays_vertical);
-  EXPECT_EQ(acoustics["ad_knee"], 255.0);
-  EXPECT_EQ(acoustics["ad_ceiling"], 255.0);
+  EXPECT_EQ(acoustics["sidelobe_rays_vertical"], 10);
+  EXPECT_EQ(acoustics["ad_knee"], 100.0);
+  EXPECT_EQ(acoustics["ad_ceiling"], 191.0);
   // Every mesh's preflight, the vehicle's parts marked as such.
   std::size_t parts = 0;
   for (const auto& mesh : report["meshes"]) parts += mesh["vehicle_part"].get<bool>() ? 1 : 0;

@@ -282,13 +282,11 @@ void BM_SynthesisNoMultipath(benchmark::State& state, const std::string& file) {
       PrimaryRaysPerSweep(bench.no_multipath) * state.iterations(), benchmark::Counter::kIsRate);
 }
 
-// The tank: 14 triangles, 8 rough reflections per ray, the default scenario.
+// The tank: 14 triangles, 8 rough reflections per ray, the horizontal pattern's sidelobes (40 more
+// primary rays per beam, to ±22°), the default scenario.
 const std::string kTank = "cras-tank.yaml";
 // The seabed survey: a 30 m × 12 m height field at 25 cm (11.5 k triangles), no multipath.
 const std::string kSeabed = "seabed.yaml";
-// The tank's trial with the horizontal pattern's sidelobes (320 more primary rays per beam, to
-// ±22°), a receiver ceiling and glinting walls.
-const std::string kTankSidelobes = "trials/cras-tank-sidelobes.yaml";
 
 BENCHMARK_CAPTURE(BM_RawEmbree, tank, kTank)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RawEmbreeBundle, tank, kTank)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -302,14 +300,6 @@ BENCHMARK_CAPTURE(BM_RawEmbreeReplay, tank_per_ray, kTank, true)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Synthesis, tank, kTank)
-    ->Arg(1)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK_CAPTURE(BM_RawEmbreeReplay, tank_sidelobes_queries, kTankSidelobes, false)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK_CAPTURE(BM_Synthesis, tank_sidelobes, kTankSidelobes)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
