@@ -166,6 +166,8 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
     sidelobe_level_ = std::pow(10.0, a.sidelobe_db / 10.0);
     sidelobe_width2_ = std::pow(a.sidelobe_width_deg * mapping::kDegToRad, 2);
     sidelobe_extent_rad_ = a.sidelobe_extent_deg * mapping::kDegToRad;
+    // 1e-9 over: past it atan2 can round no azimuth back inside the extent.
+    sidelobe_extent_sin2_ = std::pow(std::sin(sidelobe_extent_rad_), 2) * (1.0 + 1e-9);
   }
   // The slots of `strata` strata: slot a of stratum i at the angle angle_at((i + (a + ½)/slots)
   // / strata), with the factor factor(angle).
@@ -770,9 +772,12 @@ double BeamSynthesizer::OneWayPatternBound(const Eigen::Vector3d& u) const {
     if (across <= 0.0) return back_level_;
     return back_level_ * ExpBound(0.5 * back_k_ * (u.y() * u.y() / across + u.z() * u.z()));
   }
-  // The sidelobes' pedestal S adds to the two-way main lobe's power, at most 1 + S.
-  if (sidelobe_level_ > 0.0) return std::sqrt(1.0 + sidelobe_level_);
-  if (across <= 0.0) return 1.0;
+  if (across <= 0.0) return sidelobe_level_ > 0.0 ? std::sqrt(1.0 + sidelobe_level_) : 1.0;
+  // Within their extent the sidelobes' pedestal S adds to the two-way main lobe's power, at most
+  // 1 + S; past it there is the main lobe alone.
+  if (sidelobe_level_ > 0.0 && u.y() * u.y() <= sidelobe_extent_sin2_ * across) {
+    return std::sqrt(1.0 + sidelobe_level_) * ExpBound(0.5 * pattern_k_v_ * u.z() * u.z());
+  }
   return ExpBound(0.5 * (pattern_k_h_ * u.y() * u.y() / across + pattern_k_v_ * u.z() * u.z()));
 }
 

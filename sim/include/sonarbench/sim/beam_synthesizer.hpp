@@ -125,7 +125,7 @@ class BeamSynthesizer {
   /// An upper bound on OneWayPatternTowards(u), unblurred, that needs no trigonometry, for
   /// culling: the pattern's Gaussian exponent with sin²θ = u_y² / (u_x² + u_y²) for θ² and u_z²
   /// for ε² (each no larger), e^-x bounded by 2^-⌊x log₂e⌋ (within a factor of 2); ahead with
-  /// sidelobes, √(1 + S) for their level S.
+  /// sidelobes and within their extent, √(1 + S) for their level S times the elevation's bound.
   [[nodiscard]] double OneWayPatternBound(const Eigen::Vector3d& u) const;
 
   /// Maps a level [dB] to the 8-bit intensity the sonar would report: the AD window's step,
@@ -350,6 +350,8 @@ class BeamSynthesizer {
   double sidelobe_level_ = 0.0;
   double sidelobe_width2_ = 0.0;
   double sidelobe_extent_rad_ = 0.0;
+  /// sin² of the extent, a little over it: OneWayPatternBound's test for an azimuth past it.
+  double sidelobe_extent_sin2_ = 0.0;
   std::vector<JitterSlot> sidelobe_horizontal_slots_;
   std::vector<JitterSlot> sidelobe_vertical_slots_;
   /// The back lobe (Acoustics::back_lobe_width_deg), if any: B, 1/σ² [rad⁻²], and its strata's
