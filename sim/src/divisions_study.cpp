@@ -66,9 +66,8 @@ StudyInputs PrepareInputs(const Scene& scene, std::uint64_t seed, int coverage_b
   in.truth = VoxelizeMeshes(meshes, key_space);
   std::vector<BeamPose> poses;
   for (std::size_t b = 0; b < synthesized.size(); ++b) poses.push_back(ScheduleBeam(scene, b).pose);
-  const Acoustics& a = scene.sensor.acoustics;
-  in.observable = ObservableSurfaceCells(tracer, poses, scene.sensor.geometry,
-                                         2 * a.rays_horizontal, 2 * a.rays_vertical, key_space);
+  in.observable =
+      PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics, key_space);
   const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
   const std::size_t n = std::min<std::size_t>(static_cast<std::size_t>(coverage_beams),
                                               std::min(per_sweep, synthesized.size()));

@@ -191,4 +191,11 @@ mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer, std::span<const 
   return all;
 }
 
+mapping::KeySet PerfectSensorCells(const RayTracer& tracer, std::span<const BeamPose> beams,
+                                   const mapping::SensorGeometry& sensor,
+                                   const Acoustics& acoustics, const octomap::OcTree& key_space) {
+  return ObservableSurfaceCells(tracer, beams, sensor, 2 * acoustics.rays_horizontal,
+                                2 * acoustics.rays_vertical, key_space);
+}
+
 }  // namespace sonarbench::sim

@@ -101,11 +101,9 @@ MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene) {
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
   const octomap::OcTree& map = result.mapper->tree();
-  const Acoustics& a = scene.sensor.acoustics;
-  return ScoreMap(map, VoxelizeMeshes(meshes, map),
-                  ObservableSurfaceCells(tracer, result.poses, result.sensor, 2 * a.rays_horizontal,
-                                         2 * a.rays_vertical, map),
-                  meshes);
+  return ScoreMap(
+      map, VoxelizeMeshes(meshes, map),
+      PerfectSensorCells(tracer, result.poses, result.sensor, scene.sensor.acoustics, map), meshes);
 }
 
 void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) {

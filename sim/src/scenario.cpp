@@ -66,10 +66,8 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
   std::vector<BeamPose> poses;
   for (std::size_t b = 0; b < synthesized.size(); ++b) poses.push_back(ScheduleBeam(scene, b).pose);
   if (!poses.empty()) result.sonar_start_m = poses.front().T_world_sonar.translation();
-  // A perfect sensor: rays twice as dense as the acoustic sampling in each direction.
-  const Acoustics& a = scene.sensor.acoustics;
-  result.observable = ObservableSurfaceCells(tracer, poses, scene.sensor.geometry,
-                                             2 * a.rays_horizontal, 2 * a.rays_vertical, map);
+  result.observable =
+      PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics, map);
   result.timings.ground_truth_s = clock.Lap();
 
   result.metrics = ScoreMap(map, result.truth, result.observable, meshes);

@@ -8,6 +8,7 @@
 #include "sonarbench/mapping/beam_volume.hpp"
 #include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/ray_tracer.hpp"
+#include "sonarbench/sim/sensor_model.hpp"
 
 namespace sonarbench::sim {
 
@@ -38,5 +39,13 @@ struct BeamPose {
                                                      const mapping::SensorGeometry& sensor,
                                                      int rays_horizontal, int rays_vertical,
                                                      const octomap::OcTree& key_space);
+
+/// ObservableSurfaceCells as every score takes it: a perfect sensor, with rays twice as dense in
+/// each direction as the synthesis samples a beam (`acoustics`).
+[[nodiscard]] mapping::KeySet PerfectSensorCells(const RayTracer& tracer,
+                                                 std::span<const BeamPose> beams,
+                                                 const mapping::SensorGeometry& sensor,
+                                                 const Acoustics& acoustics,
+                                                 const octomap::OcTree& key_space);
 
 }  // namespace sonarbench::sim
