@@ -727,7 +727,7 @@ TEST(Fidelity, RecordedRealLogStatisticsAreTheLogs) {
   // The map's scores, as `sonarbench map --score` gets them.
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   const sim::LogMapResult mapped =
-      sim::MapLog(RealLogPath(), scene.sensor.geometry, scene.mapping, sim::StaticSonarPose(scene));
+      sim::MapLog(RealLogPath(), scene.sensor.geometry, scene.mapping, &scene);
   const sim::MapMetrics m = sim::ScoreLogMap(mapped, scene);
   EXPECT_EQ(m.true_positive_cells, RealTank::kMapTruePositives);
   EXPECT_EQ(m.occupied_cells, RealTank::kMapOccupied);

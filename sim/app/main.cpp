@@ -158,14 +158,8 @@ int Map(const MapArgs& args) {
   config.threads = args.threads;
   // A .mat log scored against the scene is mapped from the scene's sonar pose.
   std::optional<sonarbench::sim::Scene> scene;
-  std::optional<Eigen::Isometry3d> mat_log_pose;
-  if (args.score) {
-    scene = sonarbench::sim::LoadScene(args.scene);
-    const bool dataset = std::filesystem::is_directory(args.input) &&
-                         sonarbench::sim::MatLogInDirectory(args.input).empty();
-    if (!dataset) mat_log_pose = sonarbench::sim::StaticSonarPose(*scene);
-  }
-  auto result = sonarbench::sim::MapLog(args.input, sensor, config, mat_log_pose);
+  if (args.score) scene = sonarbench::sim::LoadScene(args.scene);
+  auto result = sonarbench::sim::MapLog(args.input, sensor, config, scene ? &*scene : nullptr);
   if (scene) result.metrics = sonarbench::sim::ScoreLogMap(result, *scene);
   sonarbench::sim::WriteLogMapOutputs(args.out, result);
   const auto& t = result.totals;

@@ -40,8 +40,7 @@ std::string MatLogInDirectory(const std::string& input) {
 }
 
 LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
-                    const mapping::MapperConfig& config,
-                    const std::optional<Eigen::Isometry3d>& mat_log_pose) {
+                    const mapping::MapperConfig& config, const Scene* place_in) {
   LogMapResult result;
   result.input = input;
   auto start = std::chrono::steady_clock::now();
@@ -54,13 +53,16 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
     beams = std::move(dataset.beams);
     result.source = "dataset";
   } else {
+    // The scene is checked before the log is read: a moving one is refused at once.
+    const std::optional<Eigen::Isometry3d> pose =
+        place_in ? std::optional(StaticSonarPose(*place_in)) : std::nullopt;
     mapping::MatLog log = mapping::ReadMatLog(log_file.empty() ? input : log_file);
     beams = std::move(log.beams);
     result.truncated_beams = log.truncated_beams;
     result.source = "mat";
     if (!log_file.empty()) result.input = log_file;
-    if (mat_log_pose) {
-      for (mapping::Beam& beam : beams) beam.T_world_sonar = *mat_log_pose;
+    if (pose) {
+      for (mapping::Beam& beam : beams) beam.T_world_sonar = *pose;
     }
   }
   for (const mapping::Beam& beam : beams) {

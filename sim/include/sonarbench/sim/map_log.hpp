@@ -42,13 +42,12 @@ struct LogMapResult {
 /// Reads a real `.mat` log (a file, or a folder holding just one, see MatLogInDirectory) or a
 /// dataset directory (mapping::ReadDataset; its own sensor geometry replaces `sensor`) and maps it
 /// sweep by sweep (BeamsPerSweep() consecutive beams each; the last sweep may be partial). A
-/// `.mat` log's vehicle is static at its own origin: with `mat_log_pose` every beam of one is
-/// mapped from that sonar pose instead (a scene's, to score it against the scene); a dataset's
-/// beams keep their own. Throws InputError for input that is not a readable log.
-[[nodiscard]] LogMapResult MapLog(
-    const std::string& input, const mapping::SensorGeometry& sensor,
-    const mapping::MapperConfig& config,
-    const std::optional<Eigen::Isometry3d>& mat_log_pose = std::nullopt);
+/// `.mat` log's vehicle is static at its own origin: with `place_in` every beam of one is mapped
+/// from that scene's static sonar pose instead (StaticSonarPose, to score it against the scene);
+/// a dataset's beams keep their own. Throws InputError for input that is not a readable log.
+[[nodiscard]] LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
+                                  const mapping::MapperConfig& config,
+                                  const Scene* place_in = nullptr);
 
 /// The static sonar pose of `scene` (its first beam's), where a `.mat` log of the place is mapped
 /// to score it against the scene. Throws InputError when the scene's sonar moves: a static log
