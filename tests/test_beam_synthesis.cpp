@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -1425,18 +1426,22 @@ TEST(BeamSynthesis, SpeckleIsFrozenPerPlaceWithACorrelationLength) {
             fresh.Synthesize(8.5, 0.0, here, 2).beam.intensities);
 }
 
-// The receiver's level jitter (level_jitter_db σ = 2 dB here, 12.75 AD steps, so that the
+// The receiver's level jitter alone (level_jitter_db σ = 2 dB, 12.75 AD steps, so that the
 // levels' rounding is small beside it): with the echoes frozen by the place (speckle off, the
-// rays' jitter the place's) and no noise, pings differ by the jitter alone. Each bright bin's
-// level less the exact level of its noise-free echo, 10 log10 P, in dB:
-//  - is normal with mean 0 and variance σ² v + s²/12, v the tabled quantiles' variance and s
-//    the AD step (the rounding): mean within 5 standard errors, variance within 5 of its own
-//    (σ² √(2/n)), a false alarm under 1e-5 each;
-//  - KS against the normal at a 0.1% false-alarm rate (1.949/√n), plus the rounding's most
-//    (half a step moves the distribution by at most φ(0) s / 2σ) and the table's 1/4096;
-//  - neighbouring bins' deviations are uncorrelated (within 5/√n);
-// and the same seed gives the same beam.
-TEST(BeamSynthesis, LevelJitterIsTheReceiversPerBinAndPerPing) {
+// rays' jitter the place's) and no noise, pings differ by the jitter alone. Per ping, each
+// bright bin's level less the exact level of its noise-free echo, 10 log10 P [dB], and the
+// products of the deviations of bright bins 1 and 2 apart.
+struct LevelJitterDeviations {
+  std::vector<double> deviations;
+  std::array<double, 3> lag_products{};  // by lag in bins; [0] unused
+  std::array<double, 3> lag_pairs{};
+  /// σ² v + s²/12: v the tabled quantiles' variance, s the AD step (the rounding's share).
+  double expected_variance = 0.0;
+  /// σ² v: the jitter's own share.
+  double jitter_variance = 0.0;
+};
+
+LevelJitterDeviations MeasureLevelJitter(double bin_correlation) {
   const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
   const RayTracer tracer(meshes);
   Material wall;
@@ -1444,6 +1449,7 @@ TEST(BeamSynthesis, LevelJitterIsTheReceiversPerBinAndPerPing) {
   SensorModel sensor = QuietSensor();
   sensor.acoustics.speckle_correlation_m = 0.05;
   sensor.acoustics.level_jitter_db = 2.0;
+  sensor.acoustics.level_jitter_bin_correlation = bin_correlation;
   const Acoustics& a = sensor.acoustics;
   const double sigma = a.level_jitter_db;
   const double step = a.ad_span_db / 255.0;
@@ -1460,48 +1466,82 @@ TEST(BeamSynthesis, LevelJitterIsTheReceiversPerBinAndPerPing) {
     bright.push_back(k);
     exact_db.push_back(db);
   }
-  ASSERT_GE(bright.size(), 4u);
-  std::vector<double> deviations;
-  double lag_one = 0.0;
-  double lag_pairs = 0.0;
+  EXPECT_GE(bright.size(), 4u);
+  LevelJitterDeviations out;
   constexpr std::uint64_t kPings = 4000;
   for (std::uint64_t seed = 1; seed <= kPings; ++seed) {
     const auto beam = synthesizer.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), seed);
-    ASSERT_EQ(beam.echo_power, reference.echo_power);  // the echoes are the place's
-    std::optional<double> previous;
+    EXPECT_EQ(beam.echo_power, reference.echo_power);  // the echoes are the place's
+    const std::size_t first = out.deviations.size();
     for (std::size_t i = 0; i < bright.size(); ++i) {
       const double level = a.ad_low_db + beam.beam.intensities[bright[i]] * step;
-      const double d = level - exact_db[i];
-      deviations.push_back(d);
-      if (previous && bright[i] == bright[i - 1] + 1) {
-        lag_one += d * *previous;
-        lag_pairs += 1.0;
+      out.deviations.push_back(level - exact_db[i]);
+      for (std::size_t lag = 1; lag <= 2 && lag <= i; ++lag) {
+        if (bright[i] != bright[i - lag] + lag) continue;
+        out.lag_products[lag] += out.deviations.back() * out.deviations[first + i - lag];
+        out.lag_pairs[lag] += 1.0;
       }
-      previous = d;
     }
   }
-  const auto n = static_cast<double>(deviations.size());
-  const double mean = std::accumulate(deviations.begin(), deviations.end(), 0.0) / n;
-  double variance = 0.0;
-  for (double d : deviations) variance += (d - mean) * (d - mean);
-  variance /= n - 1.0;
   double table_variance = 0.0;
   for (int i = 0; i < BeamSynthesizer::kLevelJitters; ++i) {
     const double z = BeamSynthesizer::NormalQuantile((i + 0.5) / BeamSynthesizer::kLevelJitters);
     table_variance += z * z / BeamSynthesizer::kLevelJitters;
   }
-  const double expected = sigma * sigma * table_variance + step * step / 12.0;
-  EXPECT_NEAR(mean, 0.0, 5.0 * std::sqrt(expected / n));
-  EXPECT_NEAR(variance, expected, 5.0 * expected * std::sqrt(2.0 / n));
-  const double rounding = 0.5 * step / sigma / std::sqrt(2.0 * std::numbers::pi);
-  std::vector<double> z;
-  for (double d : deviations) z.push_back(d / sigma);
-  EXPECT_LT(KsDistance(z, [](double x) { return 0.5 * std::erfc(-x / std::numbers::sqrt2); }),
-            1.949 / std::sqrt(n) + rounding + 1.0 / BeamSynthesizer::kLevelJitters);
-  ASSERT_GT(lag_pairs, 1000.0);
-  EXPECT_NEAR(lag_one / lag_pairs / expected, 0.0, 5.0 / std::sqrt(lag_pairs));
+  out.jitter_variance = sigma * sigma * table_variance;
+  out.expected_variance = out.jitter_variance + step * step / 12.0;
   EXPECT_EQ(synthesizer.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 3).beam.intensities,
             synthesizer.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 3).beam.intensities);
+  return out;
+}
+
+// Independent bin by bin (level_jitter_bin_correlation 0), the deviations:
+//  - are normal with mean 0 and the expected variance: mean within 5 standard errors, variance
+//    within 5 of its own (σ² √(2/n)), a false alarm under 1e-5 each;
+//  - KS against the normal at a 0.1% false-alarm rate (1.949/√n), plus the rounding's most
+//    (half a step moves the distribution by at most φ(0) s / 2σ) and the table's 1/4096;
+//  - neighbouring bins' deviations are uncorrelated (within 5/√n);
+// and the same seed gives the same beam.
+TEST(BeamSynthesis, LevelJitterIsTheReceiversPerBinAndPerPing) {
+  const LevelJitterDeviations m = MeasureLevelJitter(0.0);
+  const double expected = m.expected_variance;
+  const auto n = static_cast<double>(m.deviations.size());
+  const double mean = std::accumulate(m.deviations.begin(), m.deviations.end(), 0.0) / n;
+  double variance = 0.0;
+  for (double d : m.deviations) variance += (d - mean) * (d - mean);
+  variance /= n - 1.0;
+  EXPECT_NEAR(mean, 0.0, 5.0 * std::sqrt(expected / n));
+  EXPECT_NEAR(variance, expected, 5.0 * expected * std::sqrt(2.0 / n));
+  const double sigma = std::sqrt(m.jitter_variance);
+  const double step = QuietSensor().acoustics.ad_span_db / 255.0;
+  const double rounding = 0.5 * step / sigma / std::sqrt(2.0 * std::numbers::pi);
+  std::vector<double> z;
+  for (double d : m.deviations) z.push_back(d / sigma);
+  EXPECT_LT(KsDistance(z, [](double x) { return 0.5 * std::erfc(-x / std::numbers::sqrt2); }),
+            1.949 / std::sqrt(n) + rounding + 1.0 / BeamSynthesizer::kLevelJitters);
+  ASSERT_GT(m.lag_pairs[1], 1000.0);
+  EXPECT_NEAR(m.lag_products[1] / m.lag_pairs[1] / expected, 0.0, 5.0 / std::sqrt(m.lag_pairs[1]));
+}
+
+// With level_jitter_bin_correlation ρ (0.4 here) each bin's draw is a z_k + b z_k+1 with
+// a² + b² = 1 and a b = ρ: its variance is unchanged (within 5 of its standard errors), the
+// deviations of neighbouring bins covary by ρ σ² v (v the table's variance), so correlate by
+// ρ σ² v / (σ² v + s²/12), and bins two apart do not correlate; each within 5/√pairs (the
+// sample correlation's standard error is at most 1/√pairs), a false alarm under 1e-6 each. A
+// draw shared whole (a = b) would correlate by 0.5, one not shared by 0: both fail.
+TEST(BeamSynthesis, LevelJitterCorrelatesNeighbouringBinsAsConfigured) {
+  constexpr double kRho = 0.4;
+  const LevelJitterDeviations m = MeasureLevelJitter(kRho);
+  const double expected = m.expected_variance;
+  const auto n = static_cast<double>(m.deviations.size());
+  double variance = 0.0;
+  for (double d : m.deviations) variance += d * d;
+  variance /= n;
+  EXPECT_NEAR(variance, expected, 5.0 * expected * std::sqrt(2.0 / n));
+  ASSERT_GT(m.lag_pairs[2], 1000.0);
+  EXPECT_NEAR(m.lag_products[1] / m.lag_pairs[1] / expected, kRho * m.jitter_variance / expected,
+              5.0 / std::sqrt(m.lag_pairs[1]));
+  EXPECT_NEAR(m.lag_products[2] / m.lag_pairs[2] / expected, 0.0, 5.0 / std::sqrt(m.lag_pairs[2]));
 }
 
 // The speckle and noise draws are exponential with mean 1 (the power of a Rayleigh amplitude).

@@ -332,8 +332,8 @@ TEST(SceneFile, SpecularSpreadIsReadInDegrees) {
 }
 
 // The tank's reverberation, second trip, pulse skirts and level jitter are the scene's (the
-// sensor model has none), and a level outside its range (-100..20 dB, the jitter 0..20 dB) is
-// refused, naming the key and line.
+// sensor model has none), and a level outside its range (-100..20 dB, the jitter 0..20 dB, its
+// correlation between neighbouring bins 0..0.5) is refused, naming the key and line.
 TEST(SceneFile, ReverberationIsTheScenes) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
@@ -351,8 +351,10 @@ TEST(SceneFile, ReverberationIsTheScenes) {
   EXPECT_EQ(tank.sensor.acoustics.pulse_skirt_db, 3.0);
   EXPECT_EQ(micron.acoustics.level_jitter_db, 0.0);
   EXPECT_EQ(tank.sensor.acoustics.level_jitter_db, 0.19);
-  for (const char* key :
-       {"reverberation_db", "second_trip_db", "pulse_skirt_db", "level_jitter_db"}) {
+  EXPECT_EQ(micron.acoustics.level_jitter_bin_correlation, 0.0);
+  EXPECT_EQ(tank.sensor.acoustics.level_jitter_bin_correlation, 0.31);
+  for (const char* key : {"reverberation_db", "second_trip_db", "pulse_skirt_db", "level_jitter_db",
+                          "level_jitter_bin_correlation"}) {
     test::TempDir dir;
     const std::string path = (dir.path() / "bad.yaml").string();
     std::ofstream(path) << "name: x\nsensor_model: "

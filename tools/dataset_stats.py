@@ -13,9 +13,10 @@ more, and the sweep-to-sweep spread (per head angle, to 0.1°, and bin, the stan
 over the beams at that angle, averaged over the band's cells seen twice or more: a static
 sonar's echoes repeat, noise does not); that spread's median over the cells from bin 32 whose
 mean lies in 30-69, 70-99 and 100-255 (bright cells show a receiver's own noise, which the
-background noise cannot reach there), and how neighbouring bins' deviations from their cells'
-means correlate, pooled over the pairs of cells of mean 60 or more; and the ringing tail: each beam's largest 5-bin moving average over bins 30-63
-(0.38-0.79 m, past the self-reflection the mapper drops), as percentiles over beams and the
+background noise cannot reach there), and how the deviations from their cells' means of bins
+1, 2 and 3 apart correlate, pooled over the pairs of cells of mean 60 or more; and the ringing
+tail: each beam's largest 5-bin moving average over bins 30-63 (0.38-0.79 m, past the
+self-reflection the mapper drops), as percentiles over beams and the
 share of beams whose tail reaches 60; and the fine texture, as `sonarbench fidelity` measures
 it (FidelityReport, its own implementation here): over the far half of the bins past the
 manifest's self_reflection_range_m, each bin less its beam's mean over the bins within 15 of it,
@@ -133,26 +134,31 @@ def cell_deviations(with_angles, first=FIRST_SPREAD_BIN):
         yield group[0][0], means, [[b[k] - m for k, m in zip(bins, means)] for _, b in group]
 
 
+DEVIATION_LAGS = (1, 2, 3)  # bins apart
+
+
 def spread_by_mean(with_angles):
     """The median sweep-to-sweep spread of the cells in each SPREAD_BY_MEAN band of their mean
-    ({band: median or None}), and the correlation of neighbouring bins' deviations from their
-    cells' means over the pairs of cells both of mean CORRELATED_MEAN or more (None if none)."""
+    ({band: median or None}), and per DEVIATION_LAGS lag the correlation of the deviations
+    from their cells' means of bins that far apart, over the pairs of cells both of mean
+    CORRELATED_MEAN or more ([correlation or None])."""
     spreads = {band: [] for band in SPREAD_BY_MEAN}
-    products = squares_a = squares_b = 0.0
+    sums = {lag: [0.0, 0.0, 0.0] for lag in DEVIATION_LAGS}  # products, squares of each
     for _, means, deviations in cell_deviations(with_angles):
         for k, mean in enumerate(means):
             sd = math.sqrt(sum(d[k] ** 2 for d in deviations) / (len(deviations) - 1))
             for band in SPREAD_BY_MEAN:
                 if band[0] <= mean < band[1]:
                     spreads[band].append(sd)
-            if k + 1 < len(means) and min(mean, means[k + 1]) >= CORRELATED_MEAN:
-                products += sum(d[k] * d[k + 1] for d in deviations)
-                squares_a += sum(d[k] ** 2 for d in deviations)
-                squares_b += sum(d[k + 1] ** 2 for d in deviations)
+            for lag, s in sums.items():
+                if k + lag < len(means) and min(mean, means[k + lag]) >= CORRELATED_MEAN:
+                    s[0] += sum(d[k] * d[k + lag] for d in deviations)
+                    s[1] += sum(d[k] ** 2 for d in deviations)
+                    s[2] += sum(d[k + lag] ** 2 for d in deviations)
     medians = {band: sorted(v)[len(v) // 2] if v else None for band, v in spreads.items()}
-    correlation = (products / math.sqrt(squares_a * squares_b)
-                   if squares_a > 0 and squares_b > 0 else None)
-    return medians, correlation
+    correlations = [s[0] / math.sqrt(s[1] * s[2]) if s[1] > 0 and s[2] > 0 else None
+                    for s in sums.values()]
+    return medians, correlations
 
 
 def side_crossings(with_angles, threshold, from_m):
@@ -404,14 +410,15 @@ def report(directory, crossing=None, from_m=None, bins=None, lit=None, arc=None,
         if cells:
             line += (f", sweep-to-sweep spread {sum(c[0] for c in cells) / sum(c[1] for c in cells):.1f}")
         print(line)
-    medians, correlation = spread_by_mean(with_angles)
+    medians, correlations = spread_by_mean(with_angles)
     if any(m is not None for m in medians.values()):
         print(f"  sweep-to-sweep spread by the cell's mean, median over cells from bin "
               f"{FIRST_SPREAD_BIN}: " +
               ", ".join(f"{low}-{high - 1} " + (f"{m:.2f}" if m is not None else "none")
                         for (low, high), m in medians.items()) +
-              f"; neighbouring bins' deviations (cells of mean {CORRELATED_MEAN} or more) "
-              "correlate by " + (f"{correlation:.2f}" if correlation is not None else "none"))
+              "; the deviations of bins " + " / ".join(map(str, DEVIATION_LAGS)) +
+              f" apart (cells of mean {CORRELATED_MEAN} or more) correlate by " +
+              " / ".join(f"{c:.2f}" if c is not None else "none" for c in correlations))
     tails = []
     for _, b in beams:
         if len(b) < TAIL_BINS[1] + 2:

@@ -68,15 +68,16 @@ def main():
         assert "3.0-4.0 m: mean 116.5, at 0 0.0%, at 150 or more 7.69%, sweep-to-sweep spread 5.5" \
             in result.stdout, result.stdout
         # By the cell's mean: every cell from bin 32 has mean 105 and spread sqrt(30), and each
-        # beam's deviations share one sign along it: correlation 1. In the first dataset no
-        # cell varies: spread 0, and no deviations to correlate.
+        # beam's deviations share one sign along it: correlation 1 at every lag. In the first
+        # dataset no cell varies: spread 0, and no deviations to correlate.
         assert "median over cells from bin 32: 30-69 none, 70-99 none, 100-255 5.48; " \
-            "neighbouring bins' deviations (cells of mean 60 or more) correlate by 1.00" \
-            in result.stdout, result.stdout
-        assert "30-69 none, 70-99 none, 100-255 0.00; neighbouring bins' deviations " \
-            "(cells of mean 60 or more) correlate by none" in out, out
+            "the deviations of bins 1 / 2 / 3 apart (cells of mean 60 or more) correlate by " \
+            "1.00 / 1.00 / 1.00" in result.stdout, result.stdout
+        assert "30-69 none, 70-99 none, 100-255 0.00; the deviations of bins 1 / 2 / 3 apart " \
+            "(cells of mean 60 or more) correlate by none / none / none" in out, out
         # A chequerboard at one angle (100 and 110 alternating along the beam and from beam to
-        # beam): deviations of opposite sign in neighbouring bins, correlation -1; at another
+        # beam): deviations of opposite sign in neighbouring bins, correlation -1, of the same
+        # sign two bins apart, 1, and opposite again three apart, -1; at another
         # angle 40 and 50 alternating from beam to beam: cells of mean 45 in the 30-69 band.
         os.makedirs(os.path.join(tmp, "chequer", "beams"))
         beams, angles = [], []
@@ -89,8 +90,8 @@ def main():
         result = run(os.path.join(tmp, "chequer"))
         assert result.returncode == 0, result.stderr
         assert "median over cells from bin 32: 30-69 5.48, 70-99 none, 100-255 5.48; " \
-            "neighbouring bins' deviations (cells of mean 60 or more) correlate by -1.00" \
-            in result.stdout, result.stdout
+            "the deviations of bins 1 / 2 / 3 apart (cells of mean 60 or more) correlate by " \
+            "-1.00 / 1.00 / -1.00" in result.stdout, result.stdout
 
         # Where a detector meets each side: beams at 0° (a floor-like 80 at bins 100-119, a wall
         # of 200 from bin 160), 10° (the wall from bin 170) and 90° (nothing); one at 45° belongs

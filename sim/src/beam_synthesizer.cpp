@@ -225,10 +225,18 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
   }
 
   if (a.level_jitter_db > 0.0) {
+    // a² + b² = 1 and a b = ρ: a² and b² are the roots of x² - x + ρ².
+    const double rho = a.level_jitter_bin_correlation;
+    const double root = std::sqrt(1.0 - 4.0 * rho * rho);
+    const double own = rho > 0.0 ? std::sqrt(0.5 * (1.0 + root)) : 1.0;
+    const double shared = std::sqrt(0.5 * (1.0 - root));
     level_jitter_factors_.reserve(kLevelJitters);
     for (int i = 0; i < kLevelJitters; ++i) {
       const double z = NormalQuantile((i + 0.5) / kLevelJitters);
-      level_jitter_factors_.push_back(std::pow(10.0, a.level_jitter_db * z / 10.0));
+      level_jitter_factors_.push_back(std::pow(10.0, a.level_jitter_db * own * z / 10.0));
+      if (rho > 0.0) {
+        level_jitter_next_factors_.push_back(std::pow(10.0, a.level_jitter_db * shared * z / 10.0));
+      }
     }
   }
 
@@ -1352,19 +1360,31 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
     if (k < self_reflection.size()) signal += self_reflection[k];
     powers[k] = signal + noise_power * rng_.Exponential();
   }
-  // The receiver's level jitter, the ping's whatever the echoes are: five 12-bit picks per draw.
+  // The receiver's level jitter, the ping's whatever the echoes are: five 12-bit picks per draw,
+  // bin k's own and, if neighbouring bins correlate, bin k + 1's too (a z_k + b z_k+1).
   if (const std::vector<double>& jitter = s_.level_jitter_factors_; !jitter.empty()) {
     static_assert(kLevelJitters == 1 << 12, "12 bits per pick");
     std::uint64_t bits = 0;
     int picks_left = 0;
-    for (double& power : powers) {
+    const auto pick = [&] {
       if (picks_left == 0) {
         bits = rng_.Next();
         picks_left = 5;
       }
-      power *= jitter[bits & (kLevelJitters - 1)];
+      const std::uint64_t i = bits & (kLevelJitters - 1);
       bits >>= 12;
       --picks_left;
+      return i;
+    };
+    if (const std::vector<double>& next = s_.level_jitter_next_factors_; next.empty()) {
+      for (double& power : powers) power *= jitter[pick()];
+    } else {
+      std::uint64_t own = pick();
+      for (double& power : powers) {
+        const std::uint64_t shared = pick();
+        power *= jitter[own] * next[shared];
+        own = shared;
+      }
     }
   }
   const AdSteps quantise{s_.ad_thresholds_.data(), s_.ad_bucket_steps_.data(), s_.ad_first_bucket_,

@@ -86,6 +86,7 @@ nlohmann::json SensorJson(const SensorModel& s) {
             {"pulse_skirt_db", a.pulse_skirt_db},
             {"noise_level_db", a.noise_level_db},
             {"level_jitter_db", a.level_jitter_db},
+            {"level_jitter_bin_correlation", a.level_jitter_bin_correlation},
             {"max_bounces", a.max_bounces},
             {"speckle", a.speckle},
             {"speckle_looks", a.speckle_looks},

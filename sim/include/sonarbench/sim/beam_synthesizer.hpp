@@ -227,7 +227,9 @@ class BeamSynthesizer {
 
   /// The receiver's level jitter (Acoustics::level_jitter_db) is tabled: the standard normal's
   /// quantiles z_i at (i + ½)/kLevelJitters (up to 3.66), each a power factor 10^(σ z_i / 10),
-  /// one picked by 12 random bits per bin (five bins per 64-bit draw of the ping's generator).
+  /// one picked by 12 random bits per bin (five bins per 64-bit draw of the ping's generator);
+  /// with neighbouring bins correlating (Acoustics::level_jitter_bin_correlation), bin k's
+  /// factor is the product of its own pick's and, from a second table, pick k + 1's.
   static constexpr int kLevelJitters = 4096;
 
   /// The self-reflection's power per bin (Acoustics::self_reflection_db, one entry per bin of
@@ -304,8 +306,11 @@ class BeamSynthesizer {
   double second_trip_ = 0.0;
   std::vector<double> tvg_at_bin_;
   std::vector<double> untvg_at_bin_;
-  /// kLevelJitters power factors of the receiver's level jitter; empty when it has none.
+  /// kLevelJitters power factors of the receiver's level jitter, 10^(σ a z_i / 10); empty when
+  /// it has none. With neighbouring bins correlating (Acoustics::level_jitter_bin_correlation),
+  /// the next bin's draw's share, 10^(σ b z_i / 10), in level_jitter_next_factors_ (else empty).
   std::vector<double> level_jitter_factors_;
+  std::vector<double> level_jitter_next_factors_;
   /// The self-reflection's mean power per head step and bin (row j: head step j of a turn, one
   /// row when it has no angle spread), the angle spread and the mean's divisor applied.
   std::vector<double> self_reflection_by_head_;

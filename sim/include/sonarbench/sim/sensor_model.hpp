@@ -74,6 +74,11 @@ struct Acoustics {
   /// static sonar's bright bins still vary a little from sweep to sweep, as the real log's do.
   /// 0, the default: none (not drawn). See BeamSynthesizer::kLevelJitters.
   double level_jitter_db = 0.0;
+  /// The correlation of neighbouring bins' level jitter within a ping [0, 0.5]: bin k's draw
+  /// is a z_k + b z_k+1, the z independent standard normals, a² + b² = 1 and a b this, so each
+  /// bin's jitter keeps its σ, neighbouring bins share one draw and bins two or more apart none
+  /// (a receiver whose bandwidth spans two samples). 0, the default: independent bin by bin.
+  double level_jitter_bin_correlation = 0.0;
   /// Specular reflections a ray follows after its first hit (0: no multipath). Every hit after
   /// one echoes back along its path and, when the sonar is in view and in the beam's lobe, also
   /// straight to the sonar (see BeamSynthesizer).
