@@ -8,6 +8,7 @@
 #include <numbers>
 #include <numeric>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -1909,6 +1910,50 @@ TEST(BeamSynthesis, ReceiverCeilingCompressesAboveItsKneeAndNeverPassesIt) {
   EXPECT_EQ(clip.Quantise(level(300.0)), 191);
   EXPECT_EQ(clip.QuantisePower(std::pow(10.0, level(190.4) / 10.0)), 190);
   EXPECT_EQ(clip.QuantisePower(std::pow(10.0, level(300.0) / 10.0)), 191);
+}
+
+// The converter's readings (Acoustics::ad_levels 160, the real log's): the window's level
+// rounded to steps of 255/160 intensity units, reading k reported as floor(k · 255 / 160). Over
+// a fine sweep of levels the values reported are exactly those of k = 0..160 (161 of the 256),
+// never decreasing; reading k begins at (k - ½) · 255/160 units (a level just under it reports
+// k - 1's value, just over it k's); QuantisePower agrees with Quantise off the readings' edges;
+// under the tank's ceiling (knee 100, ceiling 191) the highest value is 191, reading 120, as in
+// the real log.
+TEST(BeamSynthesis, ConverterReadingsAreReportedOnThe8BitScale) {
+  SensorModel sensor = QuietSensor();
+  Acoustics& a = sensor.acoustics;
+  a.ad_levels = 160;
+  const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
+  const RayTracer tracer(meshes);
+  const BeamSynthesizer converter(sensor, tracer, {Material{}});
+  const auto level = [&](double steps) { return a.ad_low_db + steps / 255.0 * a.ad_span_db; };
+  const double step = 255.0 / 160.0;
+  std::set<int> expected;
+  for (int k = 0; k <= 160; ++k) expected.insert(k * 255 / 160);
+  std::set<int> seen;
+  int previous = 0;
+  int compared = 0;
+  for (double x = -5.0; x < 270.0; x += 0.0137) {
+    const int v = converter.Quantise(level(x));
+    ASSERT_GE(v, previous) << x;
+    previous = v;
+    seen.insert(v);
+    const double reading = x / step;
+    if (std::abs(reading - std::round(reading - 0.5) - 0.5) < 1e-9) continue;  // on an edge
+    ASSERT_EQ(converter.QuantisePower(std::pow(10.0, level(x) / 10.0)), v) << x;
+    ++compared;
+  }
+  EXPECT_EQ(seen, expected);
+  EXPECT_GT(compared, 15000);
+  for (const int k : {1, 2, 5, 80, 159, 160}) {
+    EXPECT_EQ(converter.Quantise(level((k - 0.5) * step - 1e-6)), (k - 1) * 255 / 160) << k;
+    EXPECT_EQ(converter.Quantise(level((k - 0.5) * step + 1e-6)), k * 255 / 160) << k;
+  }
+  a.ad_knee = 100.0;
+  a.ad_ceiling = 191.0;
+  const BeamSynthesizer tank(sensor, tracer, {Material{}});
+  EXPECT_EQ(tank.Quantise(level(2000.0)), 191);
+  EXPECT_EQ(tank.QuantisePower(std::pow(10.0, level(2000.0) / 10.0)), 191);
 }
 
 // A wall 20 dB over the window's top, pinged: without a ceiling its echo clips at 255; under a

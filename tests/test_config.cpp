@@ -352,7 +352,7 @@ TEST(SceneFile, ReverberationIsTheScenes) {
   EXPECT_EQ(micron.acoustics.level_jitter_db, 0.0);
   EXPECT_EQ(tank.sensor.acoustics.level_jitter_db, 0.19);
   EXPECT_EQ(micron.acoustics.level_jitter_bin_correlation, 0.0);
-  EXPECT_EQ(tank.sensor.acoustics.level_jitter_bin_correlation, 0.31);
+  EXPECT_EQ(tank.sensor.acoustics.level_jitter_bin_correlation, 0.36);
   for (const char* key : {"reverberation_db", "second_trip_db", "pulse_skirt_db", "level_jitter_db",
                           "level_jitter_bin_correlation"}) {
     test::TempDir dir;
@@ -497,6 +497,21 @@ TEST(SceneFile, BackLobeIsOffUnlessAskedForAndChecked) {
       {"  back_lobe_width_deg: 91\n", {"'sonar_acoustics.back_lobe_width_deg'", "'91'"}},
       {"  back_lobe_rays: 0\n  back_lobe_width_deg: 30\n",
        {"'sonar_acoustics.back_lobe_rays'", "'0'"}}};
+  for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
+}
+
+// The Micron's converter reads the AD window in 160 steps (the real log's values; the default, 255,
+// is every value); a count under 2, over 255 or not a whole number is refused with the key and
+// line.
+TEST(SceneFile, ConverterStepsAreTheMicronsAndChecked) {
+  const sim::SensorModel micron =
+      sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
+  EXPECT_EQ(micron.acoustics.ad_levels, 160);
+  EXPECT_EQ(sim::Acoustics{}.ad_levels, 255);
+  const std::pair<std::string, std::vector<std::string>> cases[] = {
+      {"  ad_levels: 1\n", {"'sonar_acoustics.ad_levels'", "'1'"}},
+      {"  ad_levels: 256\n", {"'sonar_acoustics.ad_levels'", "'256'"}},
+      {"  ad_levels: 160.5\n", {"'sonar_acoustics.ad_levels'", "'160.5'"}}};
   for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
 }
 

@@ -115,21 +115,28 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
     }
   }
   TabulateSelfReflection(run_seed);
-  // Quantise rounds half up: step q begins where the output reaches q - 0.5 AD steps, at the
-  // level the ceiling's inverse gives; the steps past the ceiling are never reached.
+  // Quantise rounds half up: the converter's reading q begins where the output reaches q - 0.5
+  // of its steps (255 / ad_levels intensity units each), at the level the ceiling's inverse
+  // gives; the readings past the ceiling, or past ad_levels, are never reached.
   const Acoustics& a = sensor_.acoustics;
+  const double reading_steps = 255.0 / a.ad_levels;  // 1 exactly for 255 levels
+  ad_thresholds_.fill(std::numeric_limits<double>::infinity());
   ad_thresholds_[0] = 0.0;
   ad_top_step_ = 0;
-  for (int q = 1; q < 256; ++q) {
-    const double steps = UnderCeiling(a, q - 0.5);
+  for (int q = 1; q <= a.ad_levels; ++q) {
+    const double steps = UnderCeiling(a, (q - 0.5) * reading_steps);
     const double level_db = a.ad_low_db + steps / 255.0 * a.ad_span_db;
     ad_thresholds_[static_cast<std::size_t>(q)] =
         std::isinf(steps) ? steps : std::pow(10.0, level_db / 10.0);
     if (!std::isinf(steps)) ad_top_step_ = static_cast<std::uint8_t>(q);
   }
+  for (int q = 0; q < 256; ++q) {
+    ad_reported_[static_cast<std::size_t>(q)] =
+        static_cast<std::uint8_t>(std::min(q, a.ad_levels) * 255 / a.ad_levels);
+  }
   // Buckets of positive doubles by their exponent and top mantissa bits: with 2^m per octave,
-  // a bucket spans 3.01/2^m dB; m is chosen so that spans half an AD step, or less.
-  const double step_db = a.ad_span_db / 255.0;
+  // a bucket spans 3.01/2^m dB; m is chosen so that spans half a reading's step, or less.
+  const double step_db = a.ad_span_db / a.ad_levels;
   int mantissa_bits = 0;
   while (mantissa_bits < 20 &&
          10.0 * std::log10(2.0) / std::ldexp(1.0, mantissa_bits) > 0.5 * step_db) {
@@ -436,31 +443,33 @@ namespace {
 struct AdSteps {
   const double* thresholds;
   const std::uint8_t* bucket_steps;
+  const std::uint8_t* reported;
   std::uint64_t first_bucket;
   int bucket_shift;
-  std::uint8_t top;  // the highest step the ceiling lets a level reach
+  std::uint8_t top;  // the highest reading the ceiling lets a level reach
 
-  // The largest q with thresholds[q] <= power (the thresholds increase; q = 0 below them): the
-  // table gives it at the start of the power's bucket, and the power may pass the next
-  // threshold within the bucket (a compare added, not branched on: it is a coin toss). Buckets
-  // of half an AD step hold at most one threshold; the loop keeps it exact for wider ones.
+  // The value reported for the largest reading q with thresholds[q] <= power (the thresholds
+  // increase; q = 0 below them): the table gives q at the start of the power's bucket, and the
+  // power may pass the next threshold within the bucket (a compare added, not branched on: it is
+  // a coin toss). Buckets of half a reading's step hold at most one threshold; the loop keeps it
+  // exact for wider ones.
   std::uint8_t operator()(double power) const {
-    if (!(power >= thresholds[1])) return 0;
-    if (power >= thresholds[top]) return top;
+    if (!(power >= thresholds[1])) return reported[0];
+    if (power >= thresholds[top]) return reported[top];
     const std::uint64_t bucket =
         (std::bit_cast<std::uint64_t>(power) >> bucket_shift) - first_bucket;
     unsigned q = bucket_steps[bucket];
     q += power >= thresholds[q + 1] ? 1 : 0;
     while (power >= thresholds[q + 1]) ++q;
-    return static_cast<std::uint8_t>(q);
+    return reported[q];
   }
 };
 
 }  // namespace
 
 std::uint8_t BeamSynthesizer::QuantisePower(double power) const {
-  return AdSteps{ad_thresholds_.data(), ad_bucket_steps_.data(), ad_first_bucket_, ad_bucket_shift_,
-                 ad_top_step_}(power);
+  return AdSteps{ad_thresholds_.data(), ad_bucket_steps_.data(), ad_reported_.data(),
+                 ad_first_bucket_,      ad_bucket_shift_,        ad_top_step_}(power);
 }
 
 namespace {
@@ -739,9 +748,9 @@ double Glint(const Material& m, double cos_alpha) {
 
 std::uint8_t BeamSynthesizer::Quantise(double level_db) const {
   const Acoustics& a = sensor_.acoustics;
-  const double scaled =
-      std::round(ReceiverCeiling(a, (level_db - a.ad_low_db) / a.ad_span_db * 255.0));
-  return static_cast<std::uint8_t>(std::clamp(scaled, 0.0, 255.0));
+  const double output = ReceiverCeiling(a, (level_db - a.ad_low_db) / a.ad_span_db * 255.0);
+  const double reading = std::round(output / (255.0 / a.ad_levels));  // / 1 for 255 levels
+  return ad_reported_[static_cast<std::size_t>(std::clamp(reading, 0.0, 255.0))];
 }
 
 double BeamSynthesizer::BackLobePattern(const Eigen::Vector3d& u, double blur) const {
@@ -1387,8 +1396,9 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
       }
     }
   }
-  const AdSteps quantise{s_.ad_thresholds_.data(), s_.ad_bucket_steps_.data(), s_.ad_first_bucket_,
-                         s_.ad_bucket_shift_, s_.ad_top_step_};
+  const AdSteps quantise{s_.ad_thresholds_.data(), s_.ad_bucket_steps_.data(),
+                         s_.ad_reported_.data(),   s_.ad_first_bucket_,
+                         s_.ad_bucket_shift_,      s_.ad_top_step_};
   std::uint8_t* const levels = out_.beam.intensities.data();
   for (std::size_t k = 0; k < bins_; ++k) levels[k] = quantise(powers[k]);
   if (echo_power == EchoPower::kKeep) out_.echo_power = echo;

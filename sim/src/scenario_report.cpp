@@ -101,6 +101,7 @@ nlohmann::json SensorJson(const SensorModel& s) {
             {"ad_span_db", a.ad_span_db},
             {"ad_knee", a.ad_knee},
             {"ad_ceiling", a.ad_ceiling},
+            {"ad_levels", a.ad_levels},
             {"self_reflection_db", a.self_reflection_db},
             {"self_reflection_ping_spread_db", a.self_reflection_ping_spread_db},
             {"self_reflection_ringing_range_m", a.self_reflection_ringing_range_m},

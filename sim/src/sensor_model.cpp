@@ -58,6 +58,7 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("ad_span_db", a.ad_span_db, InRange(1.0, 200.0));
   node.Optional("ad_knee", a.ad_knee, InRange(0.0, 255.0));
   node.Optional("ad_ceiling", a.ad_ceiling, InRange(1.0, 255.0));
+  node.Optional("ad_levels", a.ad_levels, IntInRange(2, 255));
   node.Optional("self_reflection_db", a.self_reflection_db);
   node.Optional("self_reflection_ping_spread_db", a.self_reflection_ping_spread_db,
                 InRange(0.0, 10.0));

@@ -129,12 +129,13 @@ class BeamSynthesizer {
   [[nodiscard]] double OneWayPatternBound(const Eigen::Vector3d& u) const;
 
   /// Maps a level [dB] to the 8-bit intensity the sonar would report: the AD window's step,
-  /// under the receiver's ceiling (Acoustics::ad_knee, ad_ceiling), rounded.
+  /// under the receiver's ceiling (Acoustics::ad_knee, ad_ceiling), rounded to the converter's
+  /// reading (Acoustics::ad_levels) and reported on the 0-255 scale.
   [[nodiscard]] std::uint8_t Quantise(double level_db) const;
 
-  /// The same for a linear power: the number of AD steps whose lower edge the power reaches,
-  /// from a table indexed by the power's exponent and top mantissa bits, then a compare with
-  /// the next step's threshold; no logarithm taken.
+  /// The same for a linear power: the value reported for the number of the converter's readings
+  /// whose lower edge the power reaches, from a table indexed by the power's exponent and top
+  /// mantissa bits, then a compare with the next reading's threshold; no logarithm taken.
   [[nodiscard]] std::uint8_t QuantisePower(double power) const;
 
   /// The range loss 10^(-((S - G)·log10 r + α·r)/10) at range `range_m` [m], exactly.
@@ -330,12 +331,15 @@ class BeamSynthesizer {
   std::vector<double> sector_weights_;
   /// Convolves sector_weights_ (the pattern's) with the place's angular correlation.
   void CorrelateSectors();
-  /// Power at which each AD step begins: step q for power ≥ ad_thresholds_[q] (index 0 unused).
+  /// Power at which each reading of the AD converter begins: reading q for power ≥
+  /// ad_thresholds_[q] (index 0 unused; infinite past Acoustics::ad_levels).
   std::array<double, 256> ad_thresholds_{};
-  /// The highest step a level can reach under the receiver's ceiling (Acoustics::ad_ceiling).
+  /// The 8-bit value reported for reading q: floor(q · 255 / ad_levels) (q itself for 255).
+  std::array<std::uint8_t, 256> ad_reported_{};
+  /// The highest reading a level can reach under the receiver's ceiling (Acoustics::ad_ceiling).
   std::uint8_t ad_top_step_ = 255;
   /// Per bucket of powers (the top bits of the double, from the bucket of ad_thresholds_[1]
-  /// on), the AD step at the bucket's start.
+  /// on), the reading at the bucket's start.
   std::vector<std::uint8_t> ad_bucket_steps_;
   std::uint64_t ad_first_bucket_ = 0;
   int ad_bucket_shift_ = 52;

@@ -144,6 +144,11 @@ struct Acoustics {
   /// but the 8 bits' own. See BeamSynthesizer::Quantise.
   double ad_knee = 255.0;
   double ad_ceiling = 255.0;
+  /// The steps [2-255] the sonar's AD converter divides the AD window into: its reading is the
+  /// window's level (after the ceiling) rounded to a step of 255 / ad_levels intensity units,
+  /// reading k reported as floor(k · 255 / ad_levels), so only ad_levels + 1 of the 256 values
+  /// occur. 255, the default: every value. See BeamSynthesizer::Quantise.
+  int ad_levels = 255;
   /// Mean self-reflection (vehicle body and transducer ringing) power per bin from bin 0, at the
   /// receiver output [dB]; bins past the end of the list get none. It is the sonar's own: not
   /// the place's, so no speckle multiplies it, but it varies by these (BeamSynthesizer::
