@@ -263,6 +263,9 @@ TEST(Fidelity, SelfComparisonAgreesAndShiftsAreMeasuredInBins) {
   const auto same = sim::CompareWithLog(beams, beams, sensor, 1.6);
   EXPECT_NEAR(same.profile_correlation_all, 1.0, 1e-12);
   EXPECT_NEAR(same.histogram_intersection, 1.0, 1e-12);
+  EXPECT_EQ(same.sim_values, 3u);  // 100, 200 and 10
+  EXPECT_EQ(same.real_values, 3u);
+  EXPECT_EQ(same.sim_values_not_real, 0u);
   EXPECT_EQ(same.median_wall_difference_bins, 0.0);
   EXPECT_EQ(same.wall_angles_compared, static_cast<std::size_t>(sensor.BeamsPerSweep()));
   std::vector<mapping::Beam> shifted = beams;
@@ -270,6 +273,13 @@ TEST(Fidelity, SelfComparisonAgreesAndShiftsAreMeasuredInBins) {
     std::rotate(beam.intensities.rbegin(), beam.intensities.rbegin() + 3, beam.intensities.rend());
   EXPECT_NEAR(sim::CompareWithLog(shifted, beams, sensor, 1.6).median_wall_difference_bins, 3.0,
               1e-9);
+  // The background at 11 instead of 10: one value the real run never holds.
+  std::vector<mapping::Beam> brighter = beams;
+  for (auto& beam : brighter)
+    std::replace(beam.intensities.begin(), beam.intensities.end(), 10, 11);
+  const auto odd = sim::CompareWithLog(brighter, beams, sensor, 1.6);
+  EXPECT_EQ(odd.sim_values, 3u);
+  EXPECT_EQ(odd.sim_values_not_real, 1u);
 }
 
 // The profile by range: intensity 10 up to bin 358 and 50 from bin 359, which starts at 4.4986 m

@@ -266,7 +266,9 @@ int Fidelity(const FidelityArgs& args) {
             << report.real_second_trip_beams
             << " beams) [intensity x bins]; profile mean |difference| "
             << report.second_trip_mean_abs_difference << "\n"
-            << "intensity histograms: intersection " << report.histogram_intersection << "\n"
+            << "intensity histograms: intersection " << report.histogram_intersection
+            << "; values held: sim " << report.sim_values << ", real " << report.real_values
+            << ", sim's never in the real log " << report.sim_values_not_real << "\n"
             << "range correlation at 1/2/3 bins (far half): sim " << report.sim_range_correlation[1]
             << "/" << report.sim_range_correlation[2] << "/" << report.sim_range_correlation[3]
             << ", real " << report.real_range_correlation[1] << "/"

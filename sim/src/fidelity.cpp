@@ -638,6 +638,11 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   r.real_histogram = Histogram(real, first);
   for (std::size_t v = 0; v < 256; ++v) {
     r.histogram_intersection += std::min(r.sim_histogram[v], r.real_histogram[v]);
+    const bool in_sim = r.sim_histogram[v] > 0.0;
+    const bool in_real = r.real_histogram[v] > 0.0;
+    r.sim_values += in_sim ? 1 : 0;
+    r.real_values += in_real ? 1 : 0;
+    r.sim_values_not_real += in_sim && !in_real ? 1 : 0;
   }
   return r;
 }
@@ -762,6 +767,9 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"second_trip_beams_real", r.real_second_trip_beams},
                  {"second_trip_mean_abs_difference", r.second_trip_mean_abs_difference},
                  {"histogram_intersection", r.histogram_intersection},
+                 {"values_held_sim", r.sim_values},
+                 {"values_held_real", r.real_values},
+                 {"values_held_sim_not_real", r.sim_values_not_real},
                  {"range_correlation_by_lag_sim", r.sim_range_correlation},
                  {"range_correlation_by_lag_real", r.real_range_correlation},
                  {"beam_correlation_by_step_sim", r.sim_beam_correlation},

@@ -172,6 +172,12 @@ struct FidelityReport {
   std::array<double, 256> sim_histogram{};
   std::array<double, 256> real_histogram{};
   double histogram_intersection = 0.0;
+  /// How many of the 256 values each holds, and how many the simulation holds that the real
+  /// log never does: a sonar that reports fewer steps than 256 (Acoustics::ad_levels) shows
+  /// as values only the simulation holds.
+  std::size_t sim_values = 0;
+  std::size_t real_values = 0;
+  std::size_t sim_values_not_real = 0;
 };
 
 /// Compares simulated beams with real ones (both in time order; bins beyond the shorter of two
