@@ -500,6 +500,14 @@ TEST(SceneFile, BackLobeIsOffUnlessAskedForAndChecked) {
   for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
 }
 
+// The level jitter's correlation between neighbouring bins needs a jitter: alone, it is refused,
+// naming the key, its line and what it needs.
+TEST(SceneFile, LevelJitterCorrelationNeedsAJitter) {
+  ExpectSonarAcousticsRefused("  level_jitter_bin_correlation: 0.3\n",
+                              {"'sonar_acoustics.level_jitter_bin_correlation'",
+                               "level_jitter_db > 0 (a jitter to correlate), got 0"});
+}
+
 // The Micron's converter reads the AD window in 160 steps (the real log's values; the default, 255,
 // is every value); a count under 2, over 255 or not a whole number is refused with the key and
 // line.

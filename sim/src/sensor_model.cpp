@@ -115,6 +115,9 @@ void CheckAcoustics(YamlReader& node, const Acoustics& merged,
     node.Fail("self_reflection_angle_correlation_deg",
               "self_reflection_angle_spread_db > 0 (a spread to correlate), got 0");
   }
+  if (merged.level_jitter_bin_correlation > 0.0 && merged.level_jitter_db <= 0.0) {
+    node.Fail("level_jitter_bin_correlation", "level_jitter_db > 0 (a jitter to correlate), got 0");
+  }
 }
 
 SensorModel ReadSensorModel(YamlReader& root) {
