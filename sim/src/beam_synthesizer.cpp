@@ -122,13 +122,13 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
   const double reading_steps = 255.0 / a.ad_levels;  // 1 exactly for 255 levels
   ad_thresholds_.fill(std::numeric_limits<double>::infinity());
   ad_thresholds_[0] = 0.0;
-  ad_top_step_ = 0;
+  ad_top_reading_ = 0;
   for (int q = 1; q <= a.ad_levels; ++q) {
     const double steps = UnderCeiling(a, (q - 0.5) * reading_steps);
     const double level_db = a.ad_low_db + steps / 255.0 * a.ad_span_db;
     ad_thresholds_[static_cast<std::size_t>(q)] =
         std::isinf(steps) ? steps : std::pow(10.0, level_db / 10.0);
-    if (!std::isinf(steps)) ad_top_step_ = static_cast<std::uint8_t>(q);
+    if (!std::isinf(steps)) ad_top_reading_ = static_cast<std::uint8_t>(q);
   }
   for (int q = 0; q < 256; ++q) {
     ad_reported_[static_cast<std::size_t>(q)] =
@@ -145,12 +145,12 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
   ad_bucket_shift_ = 52 - mantissa_bits;
   ad_first_bucket_ = std::bit_cast<std::uint64_t>(ad_thresholds_[1]) >> ad_bucket_shift_;
   const std::uint64_t last_bucket =
-      std::bit_cast<std::uint64_t>(ad_thresholds_[ad_top_step_]) >> ad_bucket_shift_;
+      std::bit_cast<std::uint64_t>(ad_thresholds_[ad_top_reading_]) >> ad_bucket_shift_;
   ad_bucket_steps_.resize(last_bucket - ad_first_bucket_ + 1);
   unsigned q = 0;
   for (std::uint64_t b = ad_first_bucket_; b <= last_bucket; ++b) {
     const double start = std::bit_cast<double>(b << ad_bucket_shift_);
-    while (q < ad_top_step_ && start >= ad_thresholds_[q + 1]) ++q;
+    while (q < ad_top_reading_ && start >= ad_thresholds_[q + 1]) ++q;
     ad_bucket_steps_[b - ad_first_bucket_] = static_cast<std::uint8_t>(q);
   }
 
@@ -468,8 +468,12 @@ struct AdSteps {
 }  // namespace
 
 std::uint8_t BeamSynthesizer::QuantisePower(double power) const {
-  return AdSteps{ad_thresholds_.data(), ad_bucket_steps_.data(), ad_reported_.data(),
-                 ad_first_bucket_,      ad_bucket_shift_,        ad_top_step_}(power);
+  return AdSteps{.thresholds = ad_thresholds_.data(),
+                 .bucket_steps = ad_bucket_steps_.data(),
+                 .reported = ad_reported_.data(),
+                 .first_bucket = ad_first_bucket_,
+                 .bucket_shift = ad_bucket_shift_,
+                 .top = ad_top_reading_}(power);
 }
 
 namespace {
@@ -1396,9 +1400,12 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
       }
     }
   }
-  const AdSteps quantise{s_.ad_thresholds_.data(), s_.ad_bucket_steps_.data(),
-                         s_.ad_reported_.data(),   s_.ad_first_bucket_,
-                         s_.ad_bucket_shift_,      s_.ad_top_step_};
+  const AdSteps quantise{.thresholds = s_.ad_thresholds_.data(),
+                         .bucket_steps = s_.ad_bucket_steps_.data(),
+                         .reported = s_.ad_reported_.data(),
+                         .first_bucket = s_.ad_first_bucket_,
+                         .bucket_shift = s_.ad_bucket_shift_,
+                         .top = s_.ad_top_reading_};
   std::uint8_t* const levels = out_.beam.intensities.data();
   for (std::size_t k = 0; k < bins_; ++k) levels[k] = quantise(powers[k]);
   if (echo_power == EchoPower::kKeep) out_.echo_power = echo;

@@ -337,7 +337,7 @@ class BeamSynthesizer {
   /// The 8-bit value reported for reading q: floor(q · 255 / ad_levels) (q itself for 255).
   std::array<std::uint8_t, 256> ad_reported_{};
   /// The highest reading a level can reach under the receiver's ceiling (Acoustics::ad_ceiling).
-  std::uint8_t ad_top_step_ = 255;
+  std::uint8_t ad_top_reading_ = 255;
   /// Per bucket of powers (the top bits of the double, from the bucket of ad_thresholds_[1]
   /// on), the reading at the bucket's start.
   std::vector<std::uint8_t> ad_bucket_steps_;
