@@ -2360,6 +2360,13 @@ TEST(Simulation, ScheduleSteppsTheHeadAndKeepsTime) {
   EXPECT_NEAR(next.pose.head_angle_rad - first.pose.head_angle_rad, g.step_angle_rad, 1e-12);
   EXPECT_NEAR(lap.pose.head_angle_rad, first.pose.head_angle_rad, 1e-9);
   EXPECT_NEAR(next.time_s - first.time_s, 1.0 / g.beams_per_second, 1e-12);
+  // Every beam's head angle lies in [0, 2π): from the tank's start at 180°, beam 100 is a full
+  // turn, which the reduction once rounded to 2π itself.
+  for (std::size_t b = 0; b < ScenarioBeamCount(scene); ++b) {
+    const double head = ScheduleBeam(scene, b).pose.head_angle_rad;
+    ASSERT_GE(head, 0.0) << b;
+    ASSERT_LT(head, 2.0 * std::numbers::pi) << b;
+  }
 }
 
 }  // namespace

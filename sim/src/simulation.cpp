@@ -23,8 +23,10 @@ ScheduledBeam ScheduleBeam(const Scene& scene, std::size_t index) {
   ScheduledBeam out;
   out.time_s = static_cast<double>(index) / g.beams_per_second;
   const double angle = scene.start_head_angle_rad + static_cast<double>(index) * g.step_angle_rad;
-  out.pose.head_angle_rad = std::remainder(angle - std::numbers::pi, 2.0 * std::numbers::pi) +
-                            std::numbers::pi;  // in [0, 2π)
+  constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  out.pose.head_angle_rad = std::remainder(angle - std::numbers::pi, kTwoPi) + std::numbers::pi;
+  // remainder() is at most π in size, and π + π rounds to 2π itself: a full turn is 0.
+  if (out.pose.head_angle_rad >= kTwoPi) out.pose.head_angle_rad = 0.0;
   out.pose.T_world_sonar = scene.trajectory.T_world_vehicle(out.time_s) * g.T_vehicle_sonar;
   return out;
 }
