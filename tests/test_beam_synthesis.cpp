@@ -1851,6 +1851,29 @@ TEST(BeamSynthesis, NothingInRangeGivesOnlyTheNoiseFloor) {
   for (auto v : beam.beam.intensities) EXPECT_EQ(v, 0);
 }
 
+// The receiver's blanking (blanking_range_m 0.025 with bins of 0.012531 m): bins 0 and 1 begin
+// within it and read 0, bin 2 (from 0.0251 m) does not; under noise that lights every bin (0 dB,
+// the AD window's top) the blanked beam is the plain one with those two bins zeroed, since the
+// draws are the same.
+TEST(BeamSynthesis, BlankingZeroesTheBinsThatBeginWithinIt) {
+  SensorModel sensor = QuietSensor();
+  sensor.acoustics.noise_level_db = 0.0;
+  const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
+  const RayTracer tracer(meshes);
+  const BeamSynthesizer plain(sensor, tracer, {Material{}});
+  sensor.acoustics.blanking_range_m = 0.025;
+  const BeamSynthesizer blanked(sensor, tracer, {Material{}});
+  const auto lit = plain.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 9).beam.intensities;
+  auto expected = lit;
+  expected[0] = 0;
+  expected[1] = 0;
+  ASSERT_GT(lit[0], 0);
+  ASSERT_GT(lit[1], 0);
+  ASSERT_GT(lit[2], 0);
+  EXPECT_EQ(blanked.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 9).beam.intensities,
+            expected);
+}
+
 TEST(BeamSynthesis, QuantisationFollowsTheAdWindow) {
   const SensorModel sensor = QuietSensor();
   const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);

@@ -523,6 +523,17 @@ TEST(SceneFile, ConverterStepsAreTheMicronsAndChecked) {
   for (const auto& [acoustics, expected] : cases) ExpectSonarAcousticsRefused(acoustics, expected);
 }
 
+// The Micron's receiver is blanked over its first 0.025 m (the real log's bins 0 and 1; the
+// default is none); a negative range is refused with the key and line.
+TEST(SceneFile, BlankingIsTheMicronsAndChecked) {
+  const sim::SensorModel micron =
+      sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
+  EXPECT_EQ(micron.acoustics.blanking_range_m, 0.025);
+  EXPECT_EQ(sim::Acoustics{}.blanking_range_m, 0.0);
+  ExpectSonarAcousticsRefused("  blanking_range_m: -0.01\n",
+                              {"'sonar_acoustics.blanking_range_m'", "'-0.01'"});
+}
+
 // The scenes built on the fitted tank (the two that must fail, and the crate) extend it: they
 // must keep its acoustics, materials and detection, or they no longer test what their comments
 // say. The two must-fail scenes also keep the tank's criteria, only expecting them to fail, and

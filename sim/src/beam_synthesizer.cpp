@@ -1408,6 +1408,11 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
                          .top = s_.ad_top_reading_};
   std::uint8_t* const levels = out_.beam.intensities.data();
   for (std::size_t k = 0; k < bins_; ++k) levels[k] = quantise(powers[k]);
+  // The receiver off while the head transmits: after the draws, so the other bins' are the same.
+  for (std::size_t k = 0; k < bins_; ++k) {
+    if (static_cast<double>(k) * g_.bin_size_m >= a_.blanking_range_m) break;
+    levels[k] = 0;
+  }
   if (echo_power == EchoPower::kKeep) out_.echo_power = echo;
 }
 

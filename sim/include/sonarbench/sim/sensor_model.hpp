@@ -67,6 +67,9 @@ struct Acoustics {
   double pulse_skirt_db = -20.0;
   /// Mean background noise power at the receiver output [dB].
   double noise_level_db = -40.0;
+  /// The receiver is off while the head transmits: the bins that begin within this range [m] of
+  /// the transducer read 0, noise and all. 0, the default: none.
+  double blanking_range_m = 0.0;
   /// The receiver's own noise on its output level [dB, standard deviation]: every bin's level,
   /// echo and background alike, moves by a normal draw of this size from ping to ping,
   /// independently bin by bin (each bin's power times 10^(σ z / 10); a log detector's output
