@@ -197,6 +197,15 @@ std::string HeadAngleLine(const std::string& what,
   return line.str();
 }
 
+// Values as "a/b/c", to one decimal.
+template <std::size_t N>
+std::string Slashed(const std::array<double, N>& values) {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(1);
+  for (std::size_t i = 0; i < N; ++i) text << (i > 0 ? "/" : "") << values[i];
+  return text.str();
+}
+
 int Fidelity(const FidelityArgs& args) {
   namespace sim = sonarbench::sim;
   sonarbench::CheckOutputDirectory(args.out);
@@ -254,7 +263,10 @@ int Fidelity(const FidelityArgs& args) {
             << sim::FidelityReport::kSquareDeg << " deg of a side's normal / "
             << sim::FidelityReport::kCornerFromDeg << "-45 deg off it: sim "
             << report.sim_behind_walls[0] << " / " << report.sim_behind_walls[1] << ", real "
-            << report.real_behind_walls[0] << " / " << report.real_behind_walls[1] << "\n"
+            << report.real_behind_walls[0] << " / " << report.real_behind_walls[1]
+            << "; within it, by side (0/90/180/270 deg): sim "
+            << Slashed(report.sim_behind_walls_by_side) << ", real "
+            << Slashed(report.real_behind_walls_by_side) << "\n"
             << "wall echo's front (20 bins before the strongest, over the beams whose strongest "
                "echo is the simulated wall: sim "
             << report.sim_direct_wall_beams << ", real " << report.real_direct_wall_beams

@@ -98,30 +98,55 @@ std::vector<double> WallProfile(std::span<const mapping::Beam> beams,
   return sum;
 }
 
-// FidelityReport::sim_behind_walls for `beams`: the wall profile over the beams whose head angle
-// lies in each band off the nearest side's normal, averaged over the offsets behind the wall.
-std::array<double, 2> BehindWalls(std::span<const mapping::Beam> beams,
-                                  const StrongestBins& strongest, std::size_t first_usable) {
+// The wall profile over the beams whose head angle `keep` accepts [deg], averaged over the
+// offsets kBehindFirst..kBehindLast past the strongest echo.
+template <typename Keep>
+double BehindWall(std::span<const mapping::Beam> beams, const StrongestBins& strongest,
+                  std::size_t first_usable, Keep keep) {
   using R = FidelityReport;
   static_assert(R::kBehindFirst >= 0 && R::kBehindLast <= R::kWallProfileAfter,
                 "the offsets behind the wall lie in the wall profile");
+  StrongestBins kept(strongest.size());
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    if (keep(beams[b].head_angle_rad * 180.0 / std::numbers::pi)) kept[b] = strongest[b];
+  }
+  const std::vector<double> profile = WallProfile(beams, kept, first_usable);
+  const auto from = static_cast<std::size_t>(R::kWallProfileBefore + R::kBehindFirst);
+  const auto to = static_cast<std::size_t>(R::kWallProfileBefore + R::kBehindLast);
+  return std::accumulate(profile.begin() + static_cast<long>(from),
+                         profile.begin() + static_cast<long>(to) + 1, 0.0) /
+         static_cast<double>(to - from + 1);
+}
+
+// FidelityReport::sim_behind_walls for `beams`: over the beams whose head angle lies in each
+// band off the nearest side's normal.
+std::array<double, 2> BehindWalls(std::span<const mapping::Beam> beams,
+                                  const StrongestBins& strongest, std::size_t first_usable) {
+  using R = FidelityReport;
   const std::array<std::array<double, 2>, 2> bands = {
       {{0.0, R::kSquareDeg}, {R::kCornerFromDeg, 45.0}}};
   std::array<double, 2> out{};
   for (std::size_t band = 0; band < 2; ++band) {
-    StrongestBins in_band(strongest.size());
-    for (std::size_t b = 0; b < beams.size(); ++b) {
+    out[band] = BehindWall(beams, strongest, first_usable, [&](double degrees) {
       // std::remainder leaves the head angle within ±45° of the nearest multiple of 90°.
+      const double off = std::abs(std::remainder(degrees, 90.0));
+      return off >= bands[band][0] && off <= bands[band][1];
+    });
+  }
+  return out;
+}
+
+// FidelityReport::sim_behind_walls_by_side for `beams`: over the beams within kSquareDeg of each
+// side's normal.
+std::array<double, 4> BehindWallsBySide(std::span<const mapping::Beam> beams,
+                                        const StrongestBins& strongest, std::size_t first_usable) {
+  std::array<double, 4> out{};
+  for (std::size_t side = 0; side < 4; ++side) {
+    out[side] = BehindWall(beams, strongest, first_usable, [&](double degrees) {
       const double off =
-          std::abs(std::remainder(beams[b].head_angle_rad * 180.0 / std::numbers::pi, 90.0));
-      if (off >= bands[band][0] && off <= bands[band][1]) in_band[b] = strongest[b];
-    }
-    const std::vector<double> profile = WallProfile(beams, in_band, first_usable);
-    const auto from = static_cast<std::size_t>(R::kWallProfileBefore + R::kBehindFirst);
-    const auto to = static_cast<std::size_t>(R::kWallProfileBefore + R::kBehindLast);
-    out[band] = std::accumulate(profile.begin() + static_cast<long>(from),
-                                profile.begin() + static_cast<long>(to) + 1, 0.0) /
-                static_cast<double>(to - from + 1);
+          std::abs(std::remainder(degrees - 90.0 * static_cast<double>(side), 360.0));
+      return off <= FidelityReport::kSquareDeg;
+    });
   }
   return out;
 }
@@ -556,6 +581,8 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
                         std::span(r.real_wall_profile).subspan(tail_start));
   r.sim_behind_walls = BehindWalls(sim, sim_strongest, first);
   r.real_behind_walls = BehindWalls(real, real_strongest, first);
+  r.sim_behind_walls_by_side = BehindWallsBySide(sim, sim_strongest, first);
+  r.real_behind_walls_by_side = BehindWallsBySide(real, real_strongest, first);
   r.sim_direct_wall_profile =
       WallProfile(sim,
                   NearWall(sim, sim_strongest, r.sim_wall_m, sensor,
@@ -756,6 +783,8 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"wall_peak_intensity_p10_p50_p90_sim", r.sim_wall_peak},
                  {"wall_tail_mean_abs_difference", r.wall_tail_mean_abs_difference},
                  {"behind_walls_square_corners_sim", r.sim_behind_walls},
+                 {"behind_walls_square_by_side_sim", r.sim_behind_walls_by_side},
+                 {"behind_walls_square_by_side_real", r.real_behind_walls_by_side},
                  {"behind_walls_square_corners_real", r.real_behind_walls},
                  {"wall_peak_intensity_p10_p50_p90_real", r.real_wall_peak},
                  {"wall_front_mean_abs_difference", r.wall_front_mean_abs_difference},

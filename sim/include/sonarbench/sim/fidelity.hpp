@@ -62,6 +62,11 @@ struct FidelityReport {
   /// every echo feeds alike is not (docs/fidelity.md, behind the walls).
   std::array<double, 2> sim_behind_walls{};  // {met squarely, towards the corners}
   std::array<double, 2> real_behind_walls{};
+  /// The first of those (met squarely) side by side: over the beams within kSquareDeg of head
+  /// angle 0°, 90°, 180° and 270°. A side unlike the others (a vehicle's part shadowing one, an
+  /// object behind one) shows here, averaged away above.
+  std::array<double, 4> sim_behind_walls_by_side{};
+  std::array<double, 4> real_behind_walls_by_side{};
   static constexpr double kSquareDeg = 20.0;
   static constexpr double kCornerFromDeg = 30.0;
   static constexpr int kBehindFirst = 10;
