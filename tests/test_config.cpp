@@ -534,6 +534,20 @@ TEST(SceneFile, BlankingIsTheMicronsAndChecked) {
                               {"'sonar_acoustics.blanking_range_m'", "'-0.01'"});
 }
 
+// The noise under the time-varied gain is the tank's (fitted to its log; the model has none,
+// -100 dB, the default), and a level outside -300..100 dB is refused with the key and line.
+TEST(SceneFile, NoiseBeforeTheGainIsTheTanksAndChecked) {
+  const sim::SensorModel micron =
+      sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
+  EXPECT_EQ(micron.acoustics.noise_before_tvg_db, -100.0);
+  EXPECT_EQ(sim::Acoustics{}.noise_before_tvg_db, -100.0);
+  const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  EXPECT_EQ(tank.sensor.acoustics.noise_before_tvg_db, -59.5);
+  EXPECT_EQ(tank.sensor.acoustics.noise_level_db, -47.0);
+  ExpectSonarAcousticsRefused("  noise_before_tvg_db: 200\n",
+                              {"'sonar_acoustics.noise_before_tvg_db'", "'200'"});
+}
+
 // The scenes built on the fitted tank (the two that must fail, and the crate) extend it: they
 // must keep its acoustics, materials and detection, or they no longer test what their comments
 // say. The two must-fail scenes also keep the tank's criteria, only expecting them to fail, and

@@ -670,12 +670,12 @@ struct RealTank {
 };
 
 // The fidelity guard: the tank scene, simulated as the main job does (its seed, 27 sweeps), stays
-// near the real log's recorded statistics. Seeds 1-5 gave: the self-reflection's mean 95.8-97.9,
-// its spreads 6.12-6.16 from ping to ping and 9.29-10.02 across head angles; the fine texture's
-// range correlation 0.633-0.649, contrast 0.332-0.341 and correlation across 1 / 2 / 3 head steps
-// 0.625-0.650 / 0.529-0.552 / 0.419-0.451; the sweep-to-sweep spread 2.11-2.14; the walls' median
-// strongest echo 151; the bands within 9.2 of the real ones (2.5-3 m, lit by the walls' glint),
-// 3.2-4.2 on average; the near range's mean 14.5-15.7 and spread across head angles 20.3-22.0
+// near the real log's recorded statistics. Seeds 1-5 gave: the self-reflection's mean 95.8-97.8,
+// its spreads 6.13-6.16 from ping to ping and 9.31-10.04 across head angles; the fine texture's
+// range correlation 0.624-0.640, contrast 0.324-0.333 and correlation across 1 / 2 / 3 head steps
+// 0.616-0.642 / 0.521-0.545 / 0.413-0.445; the sweep-to-sweep spread 2.27-2.30; the walls' median
+// strongest echo 151; the bands within 9.4 of the real ones (2.5-3 m, lit by the walls' glint),
+// 3.0-4.0 on average; the near range's mean 14.0-15.2 and spread across head angles 20.4-22.2
 // (earlier figures: docs/history.md). Every value it reports lies on the real log's grid. Each
 // bound sits outside that spread and inside what a lost piece of the model gives (docs/fidelity.md;
 // the bands' average 7.1 and 11.0 with the gain 2 dB under and over): the self-reflection under the
@@ -734,8 +734,8 @@ TEST(Fidelity, SimulatedTankStaysNearTheRealLogsRecordedStatistics) {
 
 // The mapper scores on the simulated tank (the main job: its seed, 27 sweeps) as it does on the
 // real log against the same scene: precision, recall and coverage each within 0.05 of the log's
-// recorded scores (0.135, 0.344, 0.788). Seeds 1-5 gave 0.116-0.128, 0.352-0.383 and 0.776-0.809,
-// at most 0.039 off; before the tank's sidelobes, receiver knee and glinting walls the tank gave
+// recorded scores (0.135, 0.344, 0.788). Seeds 1-5 gave 0.116-0.128, 0.351-0.382 and 0.774-0.809,
+// at most 0.038 off; before the tank's sidelobes, receiver knee and glinting walls the tank gave
 // 0.271, 0.468 and 0.917 (seed 1), which this fails by more than 0.1 on each.
 TEST(Fidelity, SimulatedTankMapsAsTheRealLogDoes) {
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));

@@ -114,6 +114,18 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
       untvg_at_bin_.push_back(1.0 / tvg_at_bin_.back());
     }
   }
+  {
+    const Acoustics& a = sensor_.acoustics;
+    const mapping::SensorGeometry& g = sensor_.geometry;
+    const double noise = std::pow(10.0, a.noise_level_db / 10.0);
+    const double before_tvg =
+        a.noise_before_tvg_db > -100.0 ? std::pow(10.0, a.noise_before_tvg_db / 10.0) : 0.0;
+    for (int i = 0; i < g.num_bins; ++i) {
+      const double r = (i + 0.5) * g.bin_size_m;
+      noise_at_bin_.push_back(
+          before_tvg > 0.0 ? noise + before_tvg * std::pow(r, a.tvg_db_per_decade / 10.0) : noise);
+    }
+  }
   TabulateSelfReflection(run_seed);
   // Quantise rounds half up: the converter's reading q begins where the output reaches q - 0.5
   // of its steps (255 / ad_levels intensity units each), at the level the ceiling's inverse
@@ -1324,7 +1336,6 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
   ++out_.traced_rays;
 
   out_.beam.intensities.resize(bins_);
-  const double noise_power = std::pow(10.0, a_.noise_level_db / 10.0);
   const double gain = std::pow(10.0, a_.gain_db / 10.0);
   for (double& power : echo) power /= weight_sum_;
   s_.AddPulseSkirts(echo);
@@ -1371,7 +1382,7 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
     double signal = gain * echo[k];
     if (a_.speckle) signal *= speckle[k];
     if (k < self_reflection.size()) signal += self_reflection[k];
-    powers[k] = signal + noise_power * rng_.Exponential();
+    powers[k] = signal + s_.noise_at_bin_[k] * rng_.Exponential();
   }
   // The receiver's level jitter, the ping's whatever the echoes are: five 12-bit picks per draw,
   // bin k's own and, if neighbouring bins correlate, bin k + 1's too (a z_k + b z_k+1).

@@ -85,6 +85,7 @@ nlohmann::json SensorJson(const SensorModel& s) {
             {"pulse_skirt_length_m", a.pulse_skirt_length_m},
             {"pulse_skirt_db", a.pulse_skirt_db},
             {"noise_level_db", a.noise_level_db},
+            {"noise_before_tvg_db", a.noise_before_tvg_db},
             {"blanking_range_m", a.blanking_range_m},
             {"level_jitter_db", a.level_jitter_db},
             {"level_jitter_bin_correlation", a.level_jitter_bin_correlation},

@@ -41,6 +41,7 @@ void ReadAcoustics(YamlReader& node, Acoustics& a) {
   node.Optional("pulse_skirt_length_m", a.pulse_skirt_length_m, InRange(0.0, 10.0));
   node.Optional("pulse_skirt_db", a.pulse_skirt_db, InRange(-100.0, 20.0));
   node.Optional("noise_level_db", a.noise_level_db, InRange(-300.0, 100.0));
+  node.Optional("noise_before_tvg_db", a.noise_before_tvg_db, InRange(-300.0, 100.0));
   node.Optional("blanking_range_m", a.blanking_range_m, InRange(0.0, 10.0));
   node.Optional("level_jitter_db", a.level_jitter_db, InRange(0.0, 20.0));
   node.Optional("level_jitter_bin_correlation", a.level_jitter_bin_correlation, InRange(0.0, 0.5));

@@ -307,6 +307,9 @@ class BeamSynthesizer {
   double second_trip_ = 0.0;
   std::vector<double> tvg_at_bin_;
   std::vector<double> untvg_at_bin_;
+  /// The background noise's mean power per bin: noise_level_db's, plus noise_before_tvg_db's
+  /// times the time-varied gain at the bin's centre when there is such noise.
+  std::vector<double> noise_at_bin_;
   /// kLevelJitters power factors of the receiver's level jitter, 10^(σ a z_i / 10); empty when
   /// it has none. With neighbouring bins correlating (Acoustics::level_jitter_bin_correlation),
   /// the next bin's draw's share, 10^(σ b z_i / 10), in level_jitter_next_factors_ (else empty).

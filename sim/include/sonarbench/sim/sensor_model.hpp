@@ -65,8 +65,13 @@ struct Acoustics {
   /// BeamSynthesizer::AddPulseSkirts.
   double pulse_skirt_length_m = 0.0;
   double pulse_skirt_db = -20.0;
-  /// Mean background noise power at the receiver output [dB].
+  /// Mean background noise power at the receiver output [dB], the same at every range.
   double noise_level_db = -40.0;
+  /// Background noise that enters the receiver before its time-varied gain [dB]: its mean power
+  /// at the output where that gain is 0 dB (1 m), rising with range as the gain does
+  /// (tvg_db_per_decade), on top of noise_level_db; the two are one draw of exponential power
+  /// with the sum as its mean. -100 or less, the default: none.
+  double noise_before_tvg_db = -100.0;
   /// The receiver is off while the head transmits: the bins that begin within this range [m] of
   /// the transducer read 0, noise and all. 0, the default: none.
   double blanking_range_m = 0.0;
