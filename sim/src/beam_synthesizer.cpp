@@ -107,12 +107,6 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
   }
   if (sensor_.acoustics.second_trip_db > -100.0) {
     second_trip_ = std::pow(10.0, sensor_.acoustics.second_trip_db / 10.0);
-    const mapping::SensorGeometry& g = sensor_.geometry;
-    for (int i = 0; i < g.num_bins; ++i) {
-      const double r = (i + 0.5) * g.bin_size_m;
-      tvg_at_bin_.push_back(std::pow(r, sensor_.acoustics.tvg_db_per_decade / 10.0));
-      untvg_at_bin_.push_back(1.0 / tvg_at_bin_.back());
-    }
   }
   {
     const Acoustics& a = sensor_.acoustics;
@@ -122,8 +116,9 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
         a.noise_before_tvg_db > -100.0 ? std::pow(10.0, a.noise_before_tvg_db / 10.0) : 0.0;
     for (int i = 0; i < g.num_bins; ++i) {
       const double r = (i + 0.5) * g.bin_size_m;
-      noise_at_bin_.push_back(
-          before_tvg > 0.0 ? noise + before_tvg * std::pow(r, a.tvg_db_per_decade / 10.0) : noise);
+      tvg_at_bin_.push_back(std::pow(r, a.tvg_db_per_decade / 10.0));
+      untvg_at_bin_.push_back(1.0 / tvg_at_bin_.back());
+      noise_at_bin_.push_back(noise + before_tvg * tvg_at_bin_.back());
     }
   }
   TabulateSelfReflection(run_seed);

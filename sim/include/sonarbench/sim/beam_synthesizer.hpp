@@ -303,7 +303,8 @@ class BeamSynthesizer {
   /// kept apart from its diffuse echoes (FormLevels).
   bool scene_glints_ = false;
   /// The second trip's level T (0: none) and, per bin i, the time-varied gain r^(G/10) at its
-  /// centre r = (i + ½) bins and its inverse (AddSecondTrip).
+  /// centre r = (i + ½) bins and its inverse (AddSecondTrip; the gain also scales the noise that
+  /// enters before it, noise_at_bin_).
   double second_trip_ = 0.0;
   std::vector<double> tvg_at_bin_;
   std::vector<double> untvg_at_bin_;
