@@ -244,12 +244,18 @@ int Fidelity(const FidelityArgs& args) {
     }
     return text.str();
   };
-  for (std::size_t b = 0; b < sim::FidelityReport::kRangeBandsM.size(); ++b) {
-    std::cout << (b == 0 ? " " : ", ") << sim::FidelityReport::kRangeBandsM[b][0] << "-"
-              << sim::FidelityReport::kRangeBandsM[b][1] << " " << show(report.sim_band_means[b])
-              << " / " << show(report.real_band_means[b]);
-  }
-  std::cout << "\n"
+  // Each band as "from-to sim / real".
+  const auto by_band = [&](const sim::FidelityReport::RangeBands& sim_values,
+                           const sim::FidelityReport::RangeBands& real_values) {
+    std::ostringstream text;
+    for (std::size_t b = 0; b < sim::FidelityReport::kRangeBandsM.size(); ++b) {
+      text << (b == 0 ? " " : ", ") << sim::FidelityReport::kRangeBandsM[b][0] << "-"
+           << sim::FidelityReport::kRangeBandsM[b][1] << " " << show(sim_values[b]) << " / "
+           << show(real_values[b]);
+    }
+    return text.str();
+  };
+  std::cout << by_band(report.sim_band_means, report.real_band_means) << "\n"
             << "wall range: median difference " << report.median_wall_difference_bins
             << " bins over " << report.wall_angles_compared << " head angles\n"
             << "wall echo intensity, 10th/50th/90th percentile over beams: sim "
@@ -302,7 +308,8 @@ int Fidelity(const FidelityArgs& args) {
             << "/" << report.real_local_beam_correlation[3] << "; contrast sim "
             << report.sim_local_contrast << ", real " << report.real_local_contrast << "\n"
             << "sweep-to-sweep spread per head angle and bin: sim " << report.sim_sweep_spread
-            << ", real " << report.real_sweep_spread << "\n"
+            << ", real " << report.real_sweep_spread << "; by range [m], sim / real:"
+            << by_band(report.sim_sweep_spread_by_band, report.real_sweep_spread_by_band) << "\n"
             << HeadAngleLine("self-reflection", report.sim_ringing, report.real_ringing)
             << HeadAngleLine("near range past it", report.sim_near_range, report.real_near_range)
             << "wrote " << args.out << "/fidelity.json\n";

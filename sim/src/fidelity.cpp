@@ -359,6 +359,23 @@ double SweepSpread(std::span<const mapping::Beam> beams, const mapping::SensorGe
       .MeanSpread();
 }
 
+// FidelityReport::sim_sweep_spread_by_band: SweepSpread over the usable bins of each band.
+FidelityReport::RangeBands SweepSpreadByBand(std::span<const mapping::Beam> beams,
+                                             const mapping::SensorGeometry& sensor) {
+  FidelityReport::RangeBands out{};
+  const auto usable = static_cast<std::size_t>(sensor.FirstUsableBin());
+  for (std::size_t band = 0; band < out.size(); ++band) {
+    const auto [from, to] = FidelityReport::kRangeBandsM[band];
+    // The bins whose centres (k + ½) bins lie in [from, to).
+    const auto first = std::max(
+        usable, static_cast<std::size_t>(std::max(0.0, std::ceil(from / sensor.bin_size_m - 0.5))));
+    const auto end = std::min(static_cast<std::size_t>(sensor.num_bins),
+                              static_cast<std::size_t>(std::ceil(to / sensor.bin_size_m - 0.5)));
+    if (first < end) out[band] = SumCells(beams, sensor, first, end).MeanSpread();
+  }
+  return out;
+}
+
 // FidelityReport::HeadAngleCells over bins [first, last] (last < bins).
 FidelityReport::HeadAngleCells HeadAngleStats(std::span<const mapping::Beam> beams,
                                               const mapping::SensorGeometry& sensor,
@@ -466,9 +483,8 @@ cv::Mat SideBySide(const cv::Mat& left, const cv::Mat& right) {
 }
 
 // The mean of `profile` over the bins whose centres lie in each of FidelityReport::kRangeBandsM.
-std::array<std::optional<double>, FidelityReport::kRangeBandsM.size()> BandMeans(
-    std::span<const double> profile, double bin_size_m) {
-  std::array<std::optional<double>, FidelityReport::kRangeBandsM.size()> means{};
+FidelityReport::RangeBands BandMeans(std::span<const double> profile, double bin_size_m) {
+  FidelityReport::RangeBands means{};
   for (std::size_t band = 0; band < means.size(); ++band) {
     const auto [from, to] = FidelityReport::kRangeBandsM[band];
     double sum = 0.0;
@@ -622,6 +638,8 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   }
   r.sim_sweep_spread = SweepSpread(sim, sensor);
   r.real_sweep_spread = SweepSpread(real, sensor);
+  r.sim_sweep_spread_by_band = SweepSpreadByBand(sim, sensor);
+  r.real_sweep_spread_by_band = SweepSpreadByBand(real, sensor);
   const std::size_t far_half = (first + bins) / 2;
   const auto sim_rows = CentredRows(sim, far_half, bins);
   const auto real_rows = CentredRows(real, far_half, bins);
@@ -678,7 +696,8 @@ namespace {
 
 // The mean profiles by range band, for fidelity.json: one object per band, null where a run's
 // bins do not reach it.
-nlohmann::json RangeBandsJson(const FidelityReport& r) {
+nlohmann::json RangeBandsJson(const FidelityReport::RangeBands& sim,
+                              const FidelityReport::RangeBands& real) {
   nlohmann::json bands = nlohmann::json::array();
   const auto value = [](const std::optional<double>& v) {
     return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
@@ -686,8 +705,8 @@ nlohmann::json RangeBandsJson(const FidelityReport& r) {
   for (std::size_t b = 0; b < FidelityReport::kRangeBandsM.size(); ++b) {
     bands.push_back({{"from_m", FidelityReport::kRangeBandsM[b][0]},
                      {"to_m", FidelityReport::kRangeBandsM[b][1]},
-                     {"sim", value(r.sim_band_means[b])},
-                     {"real", value(r.real_band_means[b])}});
+                     {"sim", value(sim[b])},
+                     {"real", value(real[b])}});
   }
   return bands;
 }
@@ -777,7 +796,7 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                  {"profile_correlation_all_bins", r.profile_correlation_all},
                  {"profile_correlation_usable_bins", r.profile_correlation_usable},
                  {"profile_mean_abs_difference_usable_bins", r.profile_mean_abs_difference},
-                 {"mean_by_range_band", RangeBandsJson(r)},
+                 {"mean_by_range_band", RangeBandsJson(r.sim_band_means, r.real_band_means)},
                  {"median_wall_range_difference_bins", r.median_wall_difference_bins},
                  {"wall_angles_compared", r.wall_angles_compared},
                  {"wall_peak_intensity_p10_p50_p90_sim", r.sim_wall_peak},
@@ -819,6 +838,8 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                    {"real", HeadAngleJson(r.real_near_range)}}},
                  {"sweep_spread_sim", r.sim_sweep_spread},
                  {"sweep_spread_real", r.real_sweep_spread},
+                 {"sweep_spread_by_range_band",
+                  RangeBandsJson(r.sim_sweep_spread_by_band, r.real_sweep_spread_by_band)},
                  {"outputs",
                   {"profile.csv", "profile.png", "wall_range.csv", "wall_profile.csv",
                    "direct_wall_profile.csv", "second_trip_profile.csv", "histogram.csv",

@@ -28,8 +28,10 @@ struct FidelityReport {
   /// without such a bin.
   static constexpr std::array<std::array<double, 2>, 7> kRangeBandsM = {
       {{0.4, 1.5}, {1.5, 2.0}, {2.0, 2.5}, {2.5, 3.0}, {3.0, 4.0}, {4.0, 4.5}, {4.5, 5.0}}};
-  std::array<std::optional<double>, kRangeBandsM.size()> sim_band_means{};
-  std::array<std::optional<double>, kRangeBandsM.size()> real_band_means{};
+  /// A value per band of kRangeBandsM.
+  using RangeBands = std::array<std::optional<double>, kRangeBandsM.size()>;
+  RangeBands sim_band_means{};
+  RangeBands real_band_means{};
   /// Per head-angle step (index = angle / step): the median, over sweeps, of the range [m] of
   /// the strongest echo beyond `wall_min_range_m` (the wall, in a tank).
   std::vector<std::optional<double>> sim_wall_m;
@@ -113,6 +115,11 @@ struct FidelityReport {
   /// or more sweeps). A static sonar's echoes and speckle repeat; only noise varies.
   double sim_sweep_spread = 0.0;
   double real_sweep_spread = 0.0;
+  /// The same over the usable bins whose centres lie in each band of kRangeBandsM (none for a
+  /// band without such a bin). Noise that enters a receiver before its time-varied gain rises
+  /// with range, and so does the spread it gives; noise after the gain is as loud near as far.
+  RangeBands sim_sweep_spread_by_band{};
+  RangeBands real_sweep_spread_by_band{};
   /// The texture along range: entry m (m = 0 .. kTextureLags) is the correlation of intensities
   /// m bins apart within a beam, over the far half of the usable bins (each beam's mean taken
   /// out; covariances and variances summed over beams). Speckle that changes over the pulse
