@@ -694,8 +694,8 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
 
 namespace {
 
-// The mean profiles by range band, for fidelity.json: one object per band, null where a run's
-// bins do not reach it.
+// A value per range band of each run (the mean profiles', the sweep spreads'), for fidelity.json:
+// one object per band, null where a run's bins do not reach it.
 nlohmann::json RangeBandsJson(const FidelityReport::RangeBands& sim,
                               const FidelityReport::RangeBands& real) {
   nlohmann::json bands = nlohmann::json::array();
