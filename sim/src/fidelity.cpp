@@ -359,18 +359,28 @@ double SweepSpread(std::span<const mapping::Beam> beams, const mapping::SensorGe
       .MeanSpread();
 }
 
+// The bins [first, end) among the first `bins` whose centres (k + ½) bins lie in band `band` of
+// FidelityReport::kRangeBandsM (empty when none does).
+std::pair<std::size_t, std::size_t> BandBins(std::size_t band, double bin_size_m,
+                                             std::size_t bins) {
+  const auto [from, to] = FidelityReport::kRangeBandsM[band];
+  const auto centre = [&](std::size_t k) { return (static_cast<double>(k) + 0.5) * bin_size_m; };
+  std::size_t first = 0;
+  while (first < bins && centre(first) < from) ++first;
+  std::size_t end = first;
+  while (end < bins && centre(end) < to) ++end;
+  return {first, end};
+}
+
 // FidelityReport::sim_sweep_spread_by_band: SweepSpread over the usable bins of each band.
 FidelityReport::RangeBands SweepSpreadByBand(std::span<const mapping::Beam> beams,
                                              const mapping::SensorGeometry& sensor) {
   FidelityReport::RangeBands out{};
   const auto usable = static_cast<std::size_t>(sensor.FirstUsableBin());
   for (std::size_t band = 0; band < out.size(); ++band) {
-    const auto [from, to] = FidelityReport::kRangeBandsM[band];
-    // The bins whose centres (k + ½) bins lie in [from, to).
-    const auto first = std::max(
-        usable, static_cast<std::size_t>(std::max(0.0, std::ceil(from / sensor.bin_size_m - 0.5))));
-    const auto end = std::min(static_cast<std::size_t>(sensor.num_bins),
-                              static_cast<std::size_t>(std::ceil(to / sensor.bin_size_m - 0.5)));
+    const auto [in_band, end] =
+        BandBins(band, sensor.bin_size_m, static_cast<std::size_t>(sensor.num_bins));
+    const std::size_t first = std::max(usable, in_band);
     if (first < end) out[band] = SumCells(beams, sensor, first, end).MeanSpread();
   }
   return out;
@@ -486,16 +496,11 @@ cv::Mat SideBySide(const cv::Mat& left, const cv::Mat& right) {
 FidelityReport::RangeBands BandMeans(std::span<const double> profile, double bin_size_m) {
   FidelityReport::RangeBands means{};
   for (std::size_t band = 0; band < means.size(); ++band) {
-    const auto [from, to] = FidelityReport::kRangeBandsM[band];
+    const auto [first, end] = BandBins(band, bin_size_m, profile.size());
+    if (first == end) continue;
     double sum = 0.0;
-    std::size_t count = 0;
-    for (std::size_t k = 0; k < profile.size(); ++k) {
-      const double centre = (static_cast<double>(k) + 0.5) * bin_size_m;
-      if (centre < from || centre >= to) continue;
-      sum += profile[k];
-      ++count;
-    }
-    if (count > 0) means[band] = sum / static_cast<double>(count);
+    for (std::size_t k = first; k < end; ++k) sum += profile[k];
+    means[band] = sum / static_cast<double>(end - first);
   }
   return means;
 }
