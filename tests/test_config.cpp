@@ -137,6 +137,13 @@ TEST(YamlReader, SyntaxErrorNamesFileAndLine) {
                                    {"scene.yaml:", "invalid YAML"}));
 }
 
+// A directory opens as a stream and would read as an empty document: it is refused as what it is.
+TEST(YamlReader, ADirectoryIsNotAFile) {
+  test::TempDir dir;
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)YamlReader::FromFile(dir.path().string()); },
+                                   {dir.path().string(), "is a directory"}));
+}
+
 TEST(SceneFile, ShippedScenesLoad) {
   for (const char* name : {"scenes/cras-tank.yaml", "scenes/seabed.yaml"}) {
     SCOPED_TRACE(name);
@@ -158,6 +165,13 @@ TEST(SceneFile, BadSceneNamesItsFileAndKey) {
   std::ofstream(path) << text;
   EXPECT_TRUE(
       ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, {path, "'sweeps'", "got '-3'"}));
+}
+
+// Writes `text` to the file `name` in `dir`; returns its path.
+std::string WriteText(const test::TempDir& dir, const std::string& name, const std::string& text) {
+  const std::string path = (dir.path() / name).string();
+  std::ofstream(path) << text;
+  return path;
 }
 
 // The message a small scene (one material, one mesh, the trajectory; `acoustics`, if any, as its
@@ -221,6 +235,45 @@ TEST(SceneFile, AMaterialNamedTwiceInOneFileIsRefused) {
                         kPlane, kStatic),
       "bad.yaml:6:12: key 'materials[1].name': a material name not used before in this file, got "
       "'rock'"));
+}
+
+// "" names no material, mesh or file: refused where it stands, not taken as "none given" (a
+// mesh whose material was "" once went on without one and ran out of memory).
+TEST(SceneFile, EmptyNamesAreRefused) {
+  const char* kEmpty = "expected a non-empty string, got ''";
+  EXPECT_TRUE(IsTheOneError(
+      SmallSceneRefusal(kRock, "{name: m, type: plane, size_m: [1, 1, 0], material: ''}", kStatic),
+      std::string("bad.yaml:7:57: key 'meshes[0].material': ") + kEmpty));
+  EXPECT_TRUE(IsTheOneError(
+      SmallSceneRefusal(kRock, "{name: '', type: plane, size_m: [1, 1, 0], material: rock}",
+                        kStatic),
+      std::string("key 'meshes[0].name': ") + kEmpty));
+  EXPECT_TRUE(IsTheOneError(
+      SmallSceneRefusal(kRock, "{name: m, type: file, file: '', material: rock}", kStatic),
+      std::string("key 'meshes[0].file': ") + kEmpty));
+  // The material's name is refused; the mesh that names a material it cannot find then is not
+  // reported as well.
+  EXPECT_TRUE(IsTheOneError(SmallSceneRefusal("{name: '', reflectivity: 0.5}", kPlane, kStatic),
+                            std::string("key 'materials[0].name': ") + kEmpty));
+  test::TempDir dir;
+  const std::string model = test::SourcePath("sensor-models/shad-micron.yaml");
+  const std::string scene_tail =
+      "\nsweeps: 1\nmaterials: [{name: m, reflectivity: 0.5}]\n"
+      "meshes: [{name: bed, type: plane, size_m: [1, 1, 0], material: m}]\n"
+      "trajectory: {type: static, position_m: [0, 0, 1]}\n";
+  for (const auto& [text, key] : std::vector<std::pair<std::string, std::string>>{
+           {"name: ''\nsensor_model: " + model + scene_tail, "'name'"},
+           {"name: x\nsensor_model: ''" + scene_tail, "'sensor_model'"},
+           {"name: x\nextends: ''\n", "'extends'"}}) {
+    SCOPED_TRACE(text);
+    const std::string path = WriteText(dir, "empty.yaml", text);
+    EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
+                                     {"empty.yaml:", "key " + key, kEmpty}));
+  }
+  // A refused base is the one error: the keys it would have given are not reported missing.
+  const std::string refused_base = WriteText(dir, "refused_base.yaml", "name: x\nextends: [a]\n");
+  EXPECT_EQ(test::InputErrorOf([&] { (void)sim::LoadScene(refused_base); }),
+            refused_base + ":2:10: key 'extends': expected a string, got a list");
 }
 
 TEST(SceneFile, UnknownMaterialIsNamed) {
@@ -581,13 +634,6 @@ TEST(SceneFile, TankScenesShareTheFittedTank) {
   const sim::Scene drift = sim::LoadScene(test::SourcePath("scenes/cras-tank-nav-drift.yaml"));
   EXPECT_EQ(drift.navigation.position_noise_m, 0.02);
   EXPECT_EQ(drift.mapping.rays_vertical, tank.mapping.rays_vertical);
-}
-
-// Writes `text` to the file `name` in `dir`; returns its path.
-std::string WriteText(const test::TempDir& dir, const std::string& name, const std::string& text) {
-  const std::string path = (dir.path() / name).string();
-  std::ofstream(path) << text;
-  return path;
 }
 
 // A scene that extends another: the base first, then only what the derived file names changes

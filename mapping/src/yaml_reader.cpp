@@ -137,6 +137,11 @@ YamlReader::YamlReader(YAML::Node node, std::shared_ptr<State> state, std::strin
 }
 
 YamlReader YamlReader::FromFile(const std::string& path) {
+  // A directory opens as a stream too, and reads as an empty document.
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) {
+    throw InputError(path + ": is a directory (expected a readable YAML file)");
+  }
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open file (expected a readable YAML file)");
   std::stringstream text;
@@ -348,6 +353,13 @@ YamlReader::Check<std::string> OneOf(std::vector<std::string> choices) {
       all += (all.empty() ? "" : ", ") + c;
     }
     return "one of: " + all;
+  };
+}
+
+YamlReader::Check<std::string> NonEmpty() {
+  return [](const std::string& v) -> std::optional<std::string> {
+    if (!v.empty()) return std::nullopt;
+    return "a non-empty string";
   };
 }
 

@@ -26,7 +26,7 @@ Eigen::Isometry3d ReadPose(YamlReader& node) {
 MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
   MeshSpec m;
   std::string type;
-  node.Required("name", m.name);
+  node.Required("name", m.name, NonEmpty());
   node.Required("type", type, OneOf({"tank", "box", "plane", "height_field", "file"}));
   m.type = type == "tank"           ? MeshSpec::Type::kTank
            : type == "plane"        ? MeshSpec::Type::kPlane
@@ -41,7 +41,7 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
       node.Ignore(key);
     }
   } else if (m.type == MeshSpec::Type::kFile) {
-    node.Required("file", m.file);
+    node.Required("file", m.file, NonEmpty());
     node.Optional("scale", m.scale,
                   YamlReader::Check<std::array<double, 3>>(
                       [](const std::array<double, 3>& s) -> std::optional<std::string> {
@@ -66,7 +66,7 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
   node.Optional("fill", m.fill);
   node.Optional("truth", m.truth);
   std::string material;
-  node.Required("material", material);
+  node.Required("material", material, NonEmpty());
   bool found = false;
   for (std::size_t i = 0; i < materials.size(); ++i) {
     if (materials[i].name == material) {
@@ -76,7 +76,7 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
   }
   if (!found) {
     m.material = materials.size();  // none: no check on the material's properties follows
-    if (!material.empty()) {
+    if (!material.empty()) {        // an empty one was refused already (missing or "")
       node.Fail("material", "the name of a material under 'materials', got '" + material + "'");
     }
   }
@@ -158,7 +158,7 @@ void ReadMaterials(YamlReader& root, bool extending, std::vector<Material>& mate
   std::vector<std::string> names;
   for (YamlReader& item : root.Sequence("materials")) {
     Material m;
-    item.Required("name", m.name);
+    item.Required("name", m.name, NonEmpty());
     item.Required("reflectivity", m.reflectivity, InRange(0.0, 1.0));
     item.Optional("backscatter_exponent", m.backscatter_exponent, InRange(0.0, 100.0));
     item.Optional("specular", m.specular, InRange(0.0, 1.0));
@@ -255,7 +255,9 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
   // A scene that extends another starts from it, loaded (and its errors reported) first.
   std::optional<Scene> base;
   std::string extends;
-  root.Optional("extends", extends);
+  root.Optional("extends", extends, NonEmpty());
+  // A base that is named but refused: what the scene lacks cannot be told without it.
+  if (root.Has("extends") && extends.empty()) root.ThrowIfErrors();
   if (!extends.empty()) {
     const std::string base_path = resolve(extends);
     chain.push_back(std::filesystem::path(path).lexically_normal().string());
@@ -272,9 +274,9 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
   Scene scene = base ? *base : Scene{};
   scene.file = path;
   if (base) scene.extends.insert(scene.extends.begin(), base->file);
-  root.Required("name", scene.name);
+  root.Required("name", scene.name, NonEmpty());
   if (!base) {
-    root.Required("sensor_model", scene.sensor_model_file);
+    root.Required("sensor_model", scene.sensor_model_file, NonEmpty());
   } else if (root.Has("sensor_model")) {
     root.Fail("sensor_model", "no sensor_model: a scene that extends another takes its model");
   }

@@ -98,5 +98,7 @@ class YamlReader {
 [[nodiscard]] YamlReader::Check<int> PositiveInt();
 [[nodiscard]] YamlReader::Check<int> IntInRange(int lo, int hi);
 [[nodiscard]] YamlReader::Check<std::string> OneOf(std::vector<std::string> choices);
+/// A name or a path: "" names nothing, so it is refused rather than taken as "none given".
+[[nodiscard]] YamlReader::Check<std::string> NonEmpty();
 
 }  // namespace sonarbench
