@@ -5,9 +5,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <numbers>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mat_log.hpp"
@@ -78,18 +81,42 @@ TEST(MatLog, CorruptOrMissingFilesAreClearErrors) {
   }
 }
 
+// Writes the real log's bytes, changed by `change`, to `path`.
+void WriteChangedRealLog(const std::string& path,
+                         const std::function<void(std::vector<char>&)>& change) {
+  std::ifstream in(RealLogPath(), std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  change(bytes);
+  std::ofstream(path, std::ios::binary)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
 TEST(MatLog, TruncatedCopyOfTheRealLogIsAClearError) {
   REQUIRE_REAL_LOG();
   test::TempDir dir;
   const std::string cut = (dir.path() / "cut.mat").string();
-  {
-    std::ifstream in(RealLogPath(), std::ios::binary);
-    std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    bytes.resize(bytes.size() / 2);
-    std::ofstream(cut, std::ios::binary)
-        .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  }
+  WriteChangedRealLog(cut, [](std::vector<char>& bytes) { bytes.resize(bytes.size() / 2); });
   EXPECT_THROW((void)mapping::ReadMatLog(cut), InputError);
+}
+
+// One byte changed inside the compressed struct's header (offset 299 of the real log, found by
+// flipping bytes) makes libmatio size its table of fields at 571 GB and leave it unallocated; its
+// field lookup then read through a null pointer. A clear error now, naming the file.
+TEST(MatLog, CorruptStructTableIsAClearError) {
+  REQUIRE_REAL_LOG();
+  test::TempDir dir;
+  const std::string bad = (dir.path() / "bad.mat").string();
+  WriteChangedRealLog(bad, [](std::vector<char>& bytes) {
+    ASSERT_EQ(static_cast<unsigned char>(bytes.at(299)), 140);
+    bytes[299] = static_cast<char>(165);
+  });
+  try {
+    (void)mapping::ReadMatLog(bad);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(bad + ": 'parsedData' is corrupt"), std::string::npos)
+        << e.what();
+  }
 }
 
 // A straight wall: the wall points of one side lie on a line. Fitted by total least squares to

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
@@ -63,6 +64,16 @@ MatLog ReadMatLog(const std::string& path) {
   if (data->class_type != MAT_C_STRUCT) throw fail("'parsedData' is not a struct array");
   const std::size_t count = ElementCount(data.get());
   if (count == 0) throw fail("'parsedData' holds no beams");
+  // A corrupt file can leave the struct's table of fields unread or the wrong size, and
+  // libmatio's field lookup reads that table unchecked: check it before asking for a field.
+  const unsigned fields = Mat_VarGetNumberOfFields(data.get());
+  char* const* names = Mat_VarGetStructFieldnames(data.get());
+  if (data->data == nullptr || fields == 0 || names == nullptr ||
+      data->nbytes != count * fields * sizeof(matvar_t*) ||
+      std::any_of(names, names + fields, [](const char* name) { return name == nullptr; })) {
+    throw fail("'parsedData' is corrupt: its table of " + std::to_string(count) +
+               " beams' fields does not read back whole");
+  }
 
   MatLog log;
   log.beams.reserve(count);
