@@ -1,7 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <fstream>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/mesh_file.hpp"
@@ -136,6 +142,107 @@ TEST(MeshFile, MissingOrUnreadableFilesNameTheFile) {
   std::ofstream(garbage) << "this is not a mesh\n";
   const std::string error = test::InputErrorOf([&] { (void)LoadMeshFile(garbage.string()); });
   EXPECT_NE(error.find(garbage.string() + ": "), std::string::npos) << error;
+}
+
+// The shipped PLY file's text, and a file in `dir` holding `text`.
+std::string QuayWallPly() { return ReadFileBytes(test::SourcePath("scenes/meshes/quay_wall.ply")); }
+std::string WriteFile(const test::TempDir& dir, const std::string& name, const std::string& text) {
+  const std::string path = (dir.path() / name).string();
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+// Assimp 5.2 loops for ever on a PLY header without end_header, aborts on a body shorter than the
+// header's counts or on a face of no vertices, and segfaults on a vertex index past the vertices
+// (each found by cutting or changing the shipped file): each is now an input error naming it.
+TEST(MeshFile, PlyFilesAssimpCannotReadAreClearErrors) {
+  test::TempDir dir;
+  const std::string ply = QuayWallPly();
+  const std::size_t body = ply.find("end_header\n") + 11;
+  ASSERT_NE(ply.find("\n3 0 1 6\n"), std::string::npos);
+  std::string far_index = ply;
+  far_index.replace(far_index.find("\n3 0 1 6\n"), 9, "\n3 0 1 99\n");
+  std::string no_vertices = ply;
+  no_vertices.replace(no_vertices.find("\n3 0 1 6\n"), 9, "\n0\n");
+  for (const auto& [text, expected] : std::vector<std::pair<std::string, std::string>>{
+           {ply.substr(0, body - 5), "the header has no 'end_header' line"},
+           {ply.substr(0, ply.size() - 6),
+            "the body ends in element 'face' 15 of the 16 its header declares"},
+           {ply.substr(0, body + 20),
+            "the body ends in element 'vertex' 1 of the 10 its header declares"},
+           {far_index,
+            "element 'face' 0: vertex index 99, expected a whole index from 0 of the 10 vertices"},
+           {no_vertices, "element 'face' 0: a face of no vertices"}}) {
+    const std::string path = WriteFile(dir, "bad.ply", text);
+    EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(path); }),
+              path + ": not a readable PLY file: " + expected);
+  }
+}
+
+// The check reads binary PLY of either byte order as the ASCII: the same file in each loads the
+// same triangles, and is refused when one byte short.
+TEST(MeshFile, BinaryPlyOfEitherOrderLoadsAsTheAscii) {
+  test::TempDir dir;
+  const std::string ascii = QuayWallPly();
+  const MeshFileData expected = LoadMeshFile(WriteFile(dir, "ascii.ply", ascii));
+  const std::size_t body = ascii.find("end_header\n") + 11;
+  std::istringstream numbers(ascii.substr(body));
+  std::vector<float> xyz(30);
+  for (float& v : xyz) numbers >> v;
+  std::vector<std::int32_t> faces;
+  for (int f = 0, n = 0; f < 16 && numbers >> n; ++f) {
+    faces.resize(faces.size() + 3);
+    numbers >> faces[faces.size() - 3] >> faces[faces.size() - 2] >> faces.back();
+  }
+  ASSERT_EQ(faces.size(), 48u);
+  for (const bool little : {true, false}) {
+    SCOPED_TRACE(little ? "little-endian" : "big-endian");
+    std::string text = ascii.substr(0, body);
+    text.replace(text.find("format ascii"), 12,
+                 little ? "format binary_little_endian" : "format binary_big_endian");
+    const auto put = [&](const void* value, std::size_t bytes) {
+      const auto* b = static_cast<const char*>(value);
+      for (std::size_t i = 0; i < bytes; ++i) text += b[little ? i : bytes - 1 - i];
+    };
+    for (const float v : xyz) put(&v, sizeof v);
+    for (std::size_t f = 0; f < faces.size(); f += 3) {
+      text += '\x03';
+      for (std::size_t k = f; k < f + 3; ++k) put(&faces[k], sizeof faces[k]);
+    }
+    const MeshFileData read = LoadMeshFile(WriteFile(dir, "binary.ply", text));
+    EXPECT_EQ(read.triangles, expected.triangles);
+    ASSERT_EQ(read.vertices.size(), expected.vertices.size());
+    for (std::size_t v = 0; v < read.vertices.size(); ++v) {
+      EXPECT_EQ(read.vertices[v], expected.vertices[v]);
+    }
+    const std::string cut = WriteFile(dir, "cut.ply", text.substr(0, text.size() - 1));
+    EXPECT_NE(test::InputErrorOf([&] {
+                (void)LoadMeshFile(cut);
+              }).find("the body ends in element 'face' 15 of the 16"),
+              std::string::npos);
+  }
+}
+
+// Assimp 5.2 loops for ever on a COLLADA index list holding anything but whole numbers (found by
+// changing digits of the shipped crate), reads "-1" as some index and takes 4e9 for a valid one:
+// each is now an input error naming the file's line and the item.
+TEST(MeshFile, ColladaIndexListsAssimpCannotReadAreClearErrors) {
+  test::TempDir dir;
+  const std::string dae = ReadFileBytes(test::SourcePath("scenes/meshes/crate.dae"));
+  const std::size_t list = dae.find("<p>0 2 3 ");
+  ASSERT_NE(list, std::string::npos);
+  for (const std::string item : {"x", "1.5", "-1", "4000000000"}) {
+    std::string text = dae;
+    text.replace(list, 6, "<p>0 " + item);
+    const std::string path = WriteFile(dir, "bad.dae", text);
+    EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(path); }),
+              path + ":22: not a readable COLLADA file: <p> holds '" + item +
+                  "' where an index (a whole number from 0 to 2^31 - 1) belongs");
+  }
+  std::string plus = dae;
+  plus.replace(list, 6, "<p>0 +2");
+  EXPECT_EQ(LoadMeshFile(WriteFile(dir, "plus.dae", plus)).triangles,
+            LoadMeshFile(test::SourcePath("scenes/meshes/crate.dae")).triangles);
 }
 
 }  // namespace

@@ -3,15 +3,308 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <algorithm>
 #include <assimp/Importer.hpp>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <vector>
 
+#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::sim {
+namespace {
+
+// Text from a file, quoted for a message: bytes that are not printable ASCII as \xNN, and at most
+// 60 of them.
+std::string Quoted(const std::string& text) {
+  std::string quoted = "'";
+  for (std::size_t i = 0; i < text.size() && i < 60; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      quoted += static_cast<char>(c);
+    } else {
+      static constexpr char kHex[] = "0123456789abcdef";
+      quoted += {'\\', 'x', kHex[c >> 4], kHex[c & 15]};
+    }
+  }
+  return quoted + (text.size() > 60 ? "'..." : "'");
+}
+
+// A PLY value as the file would write it: 99, -5, 2.5.
+std::string Number(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+// A PLY scalar type.
+struct PlyType {
+  int bytes = 0;  // 0: not a PLY type
+  bool is_signed = false;
+  bool is_float = false;
+};
+
+PlyType PlyTypeNamed(const std::string& name) {
+  static const std::map<std::string, PlyType> kTypes = {
+      {"char", {1, true, false}},    {"int8", {1, true, false}},    {"uchar", {1, false, false}},
+      {"uint8", {1, false, false}},  {"short", {2, true, false}},   {"int16", {2, true, false}},
+      {"ushort", {2, false, false}}, {"uint16", {2, false, false}}, {"int", {4, true, false}},
+      {"int32", {4, true, false}},   {"uint", {4, false, false}},   {"uint32", {4, false, false}},
+      {"float", {4, true, true}},    {"float32", {4, true, true}},  {"double", {8, true, true}},
+      {"float64", {8, true, true}}};
+  const auto found = kTypes.find(name);
+  return found == kTypes.end() ? PlyType{} : found->second;
+}
+
+// One property of a PLY element: a scalar, or a list (a count, then that many items).
+struct PlyProperty {
+  std::string name;
+  bool list = false;
+  PlyType count;  // the list's
+  PlyType item;   // the scalar, or each item of the list
+};
+
+struct PlyElement {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+struct PlyHeader {
+  std::string format;  // ascii, binary_little_endian or binary_big_endian
+  std::vector<PlyElement> elements;
+  std::size_t body = 0;  // where the body starts
+};
+
+PlyHeader ReadPlyHeader(const std::string& bytes,
+                        const std::function<InputError(std::string)>& fail) {
+  PlyHeader header;
+  std::size_t at = 0;
+  for (int line_number = 1;; ++line_number) {
+    const std::size_t end = bytes.find('\n', at);
+    if (end == std::string::npos) throw fail("the header has no 'end_header' line");
+    std::string line = bytes.substr(at, end - at);
+    at = end + 1;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    const auto bad_line = [&](const std::string& expected) {
+      return fail("header line " + std::to_string(line_number) + ": expected " + expected +
+                  ", got " + Quoted(line));
+    };
+    if (line_number == 1) {
+      if (line != "ply") throw bad_line("'ply'");
+    } else if (keyword == "end_header") {
+      break;
+    } else if (keyword == "comment" || keyword == "obj_info" || keyword.empty()) {
+      continue;
+    } else if (keyword == "format") {
+      words >> header.format;
+      if (header.format != "ascii" && header.format != "binary_little_endian" &&
+          header.format != "binary_big_endian") {
+        throw bad_line("format ascii, binary_little_endian or binary_big_endian");
+      }
+    } else if (keyword == "element") {
+      PlyElement element;
+      if (!(words >> element.name >> element.count)) throw bad_line("element NAME COUNT");
+      header.elements.push_back(element);
+    } else if (keyword == "property") {
+      if (header.elements.empty()) throw bad_line("an element before its properties");
+      PlyProperty property;
+      std::string type;
+      words >> type;
+      if (type == "list") {
+        std::string count_type, item_type;
+        words >> count_type >> item_type >> property.name;
+        property.list = true;
+        property.count = PlyTypeNamed(count_type);
+        property.item = PlyTypeNamed(item_type);
+        if (property.count.bytes == 0 || property.count.is_float || property.item.bytes == 0) {
+          throw bad_line("property list COUNT_TYPE ITEM_TYPE NAME, COUNT_TYPE an integer type");
+        }
+      } else {
+        words >> property.name;
+        property.item = PlyTypeNamed(type);
+        if (property.item.bytes == 0) throw bad_line("property TYPE NAME, TYPE a PLY type");
+      }
+      header.elements.back().properties.push_back(property);
+    } else {
+      throw bad_line("a PLY header keyword");
+    }
+  }
+  if (header.format.empty()) throw fail("the header has no 'format' line");
+  header.body = at;
+  return header;
+}
+
+// The values of a PLY body one by one: whitespace-separated numbers, or binary of either order.
+class PlyValues {
+ public:
+  PlyValues(const std::string& bytes, const PlyHeader& header,
+            std::function<InputError(std::string)> fail)
+      : bytes_(bytes),
+        at_(header.body),
+        ascii_(header.format == "ascii"),
+        little_endian_(header.format == "binary_little_endian"),
+        fail_(std::move(fail)) {}
+
+  // The next value, read as `type`; nullopt at the body's end.
+  std::optional<double> Next(const PlyType& type) {
+    if (ascii_) {
+      while (at_ < bytes_.size() && std::isspace(static_cast<unsigned char>(bytes_[at_]))) ++at_;
+      if (at_ == bytes_.size()) return std::nullopt;
+      std::size_t end = at_;
+      while (end < bytes_.size() && !std::isspace(static_cast<unsigned char>(bytes_[end]))) ++end;
+      double value = 0.0;
+      const auto [stop, error] = std::from_chars(bytes_.data() + at_, bytes_.data() + end, value);
+      if (error != std::errc() || stop != bytes_.data() + end) {
+        throw fail_("the body holds " + Quoted(bytes_.substr(at_, end - at_)) +
+                    " where a number belongs");
+      }
+      at_ = end;
+      return value;
+    }
+    if (bytes_.size() - at_ < static_cast<std::size_t>(type.bytes)) return std::nullopt;
+    std::uint64_t bits = 0;
+    for (int b = 0; b < type.bytes; ++b) {
+      const int shift = little_endian_ ? 8 * b : 8 * (type.bytes - 1 - b);
+      bits |= static_cast<std::uint64_t>(static_cast<unsigned char>(bytes_[at_ + b])) << shift;
+    }
+    at_ += type.bytes;
+    if (type.is_float && type.bytes == 4) {
+      float value = 0.0f;
+      const auto narrow = static_cast<std::uint32_t>(bits);
+      std::memcpy(&value, &narrow, sizeof value);
+      return value;
+    }
+    if (type.is_float) {
+      double value = 0.0;
+      std::memcpy(&value, &bits, sizeof value);
+      return value;
+    }
+    if (type.is_signed && (bits >> (8 * type.bytes - 1)) != 0) {
+      return static_cast<double>(bits) - std::ldexp(1.0, 8 * type.bytes);
+    }
+    return static_cast<double>(bits);
+  }
+
+ private:
+  const std::string& bytes_;
+  std::size_t at_;
+  bool ascii_;
+  bool little_endian_;
+  std::function<InputError(std::string)> fail_;
+};
+
+// Assimp 5.2's PLY reader loops for ever on a header without `end_header`, aborts (an assertion
+// in its triangulation) on a body shorter than its header declares or on a face of no vertices,
+// and reads out of bounds through a face's vertex index past the vertices. So a PLY file is
+// checked first: its header whole, every element the header counts present in the body, and
+// every face a list of at least one whole index to one of the vertices.
+void CheckPly(const std::string& path, const std::string& bytes) {
+  const auto fail = [&](std::string what) {
+    return InputError(path + ": not a readable PLY file: " + what);
+  };
+  const PlyHeader header = ReadPlyHeader(bytes, fail);
+  std::uint64_t vertices = 0;
+  for (const PlyElement& element : header.elements) {
+    if (element.name == "vertex") vertices = element.count;
+  }
+  PlyValues values(bytes, header, fail);
+  for (const PlyElement& element : header.elements) {
+    for (std::uint64_t i = 0; i < element.count && !element.properties.empty(); ++i) {
+      const auto where = [&] { return "element '" + element.name + "' " + std::to_string(i); };
+      const auto next = [&](const PlyType& type) {
+        const std::optional<double> value = values.Next(type);
+        if (!value) {
+          throw fail("the body ends in " + where() + " of the " + std::to_string(element.count) +
+                     " its header declares");
+        }
+        return *value;
+      };
+      for (const PlyProperty& p : element.properties) {
+        if (!p.list) {
+          (void)next(p.item);
+          continue;
+        }
+        const double count = next(p.count);
+        if (count < 0.0 || count != std::floor(count)) {
+          throw fail(where() + ": a list's count of " + Number(count));
+        }
+        const bool indices =
+            element.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
+        if (indices && count == 0.0) throw fail(where() + ": a face of no vertices");
+        for (double k = 0; k < count; ++k) {
+          const double index = next(p.item);
+          if (indices && (index < 0.0 || index >= static_cast<double>(vertices) ||
+                          index != std::floor(index))) {
+            throw fail(where() + ": vertex index " + Number(index) +
+                       ", expected a whole index from 0 of the " + std::to_string(vertices) +
+                       " vertices");
+          }
+        }
+      }
+    }
+  }
+}
+
+// Assimp 5.2's COLLADA reader loops for ever on an index list (<p>, <vcount>, <v> or <h>)
+// holding anything but whole numbers, and takes an index of 2^31 or more for a valid one (4e9 in
+// a 12-triangle file read as whole): each list's items are checked first.
+void CheckColladaIndexLists(const std::string& path, const std::string& bytes) {
+  constexpr std::uint32_t kLargestIndex = 0x7fffffff;
+  for (const std::string tag : {"p", "vcount", "v", "h"}) {
+    for (std::size_t at = bytes.find("<" + tag); at != std::string::npos;
+         at = bytes.find("<" + tag, at + 1)) {
+      const std::size_t name_end = at + 1 + tag.size();
+      if (name_end >= bytes.size()) break;
+      // Another element whose name starts so (<param>, <vertices>) or an empty one (<p/>).
+      if (bytes[name_end] != '>' && !std::isspace(static_cast<unsigned char>(bytes[name_end]))) {
+        continue;
+      }
+      const std::size_t content = bytes.find('>', name_end);
+      if (content == std::string::npos || bytes[content - 1] == '/') continue;
+      const std::size_t content_end = std::min(bytes.find('<', content), bytes.size());
+      std::istringstream items(bytes.substr(content + 1, content_end - content - 1));
+      for (std::string item; items >> item;) {
+        const char* first = item.data() + (item[0] == '+' ? 1 : 0);
+        const char* const end = item.data() + item.size();
+        std::uint32_t index = 0;
+        if (const auto [stop, error] = std::from_chars(first, end, index);
+            error != std::errc() || stop != end || index > kLargestIndex) {
+          const auto line = std::count(bytes.begin(), bytes.begin() + static_cast<long>(at), '\n');
+          throw InputError(path + ":" + std::to_string(line + 1) +
+                           ": not a readable COLLADA file: <" + tag + "> holds " + Quoted(item) +
+                           " where an index (a whole number from 0 to 2^31 - 1) belongs");
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
 
 MeshFileData LoadMeshFile(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": no such mesh file");
+  // What Assimp cannot read safely is checked first, in the formats it reads by their content.
+  std::string start(4096, '\0');
+  start.resize(static_cast<std::size_t>(
+      std::ifstream(path, std::ios::binary).read(start.data(), 4096).gcount()));
+  if (start.starts_with("ply\n") || start.starts_with("ply\r\n")) {
+    CheckPly(path, ReadFileBytes(path));
+  } else if (start.find("<COLLADA") != std::string::npos) {
+    CheckColladaIndexLists(path, ReadFileBytes(path));
+  }
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   // Points and lines have no surface to echo from.
