@@ -224,9 +224,10 @@ TEST(MeshFile, BinaryPlyOfEitherOrderLoadsAsTheAscii) {
 }
 
 // Assimp 5.2 loops for ever on a COLLADA index list holding anything but whole numbers (found by
-// changing digits of the shipped crate), reads "-1" as some index and takes 4e9 for a valid one:
-// each is now an input error naming the file's line and the item.
-TEST(MeshFile, ColladaIndexListsAssimpCannotReadAreClearErrors) {
+// changing digits of the shipped crate), reads "-1" as some index and takes 4e9 for a valid one;
+// it segfaults on an array without a count (found by flipping a byte of the attribute's name) and
+// reads only `count` items of a longer one. Each is now an input error naming the file's line.
+TEST(MeshFile, ColladaFilesAssimpCannotReadAreClearErrors) {
   test::TempDir dir;
   const std::string dae = ReadFileBytes(test::SourcePath("scenes/meshes/crate.dae"));
   const std::size_t list = dae.find("<p>0 2 3 ");
@@ -239,10 +240,25 @@ TEST(MeshFile, ColladaIndexListsAssimpCannotReadAreClearErrors) {
               path + ":22: not a readable COLLADA file: <p> holds '" + item +
                   "' where an index (a whole number from 0 to 2^31 - 1) belongs");
   }
+  const std::string count = "count=\"24\">-30 -20 0";
+  const std::size_t array = dae.find(count);
+  ASSERT_NE(array, std::string::npos);
+  for (const std::string said : {"xount=\"24\"", "count=\"10\"", "count=\"x\""}) {
+    std::string text = dae;
+    text.replace(array, 10, said);
+    const std::string path = WriteFile(dir, "bad.dae", text);
+    EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(path); }),
+              path + ":12: not a readable COLLADA file: <float_array> holds 24 items, expected " +
+                  "its count attribute to say so, as count=\"24\"");
+  }
+  // What XML and COLLADA allow loads as the shipped file does.
+  const auto triangles = LoadMeshFile(test::SourcePath("scenes/meshes/crate.dae")).triangles;
   std::string plus = dae;
   plus.replace(list, 6, "<p>0 +2");
-  EXPECT_EQ(LoadMeshFile(WriteFile(dir, "plus.dae", plus)).triangles,
-            LoadMeshFile(test::SourcePath("scenes/meshes/crate.dae")).triangles);
+  EXPECT_EQ(LoadMeshFile(WriteFile(dir, "plus.dae", plus)).triangles, triangles);
+  std::string quoted = dae;
+  quoted.replace(array, 10, "count = '+024'");
+  EXPECT_EQ(LoadMeshFile(WriteFile(dir, "quoted.dae", quoted)).triangles, triangles);
 }
 
 }  // namespace

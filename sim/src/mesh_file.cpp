@@ -23,21 +23,24 @@
 namespace sonarbench::sim {
 namespace {
 
-// Text from a file, quoted for a message: bytes that are not printable ASCII as \xNN, and at most
-// 60 of them.
-std::string Quoted(const std::string& text) {
-  std::string quoted = "'";
-  for (std::size_t i = 0; i < text.size() && i < 60; ++i) {
+// Text from a file or about it, for a message: bytes that are not printable ASCII as \xNN, and at
+// most `most` of them.
+std::string Printable(const std::string& text, std::size_t most) {
+  std::string printable;
+  for (std::size_t i = 0; i < text.size() && i < most; ++i) {
     const auto c = static_cast<unsigned char>(text[i]);
     if (c >= 0x20 && c < 0x7f) {
-      quoted += static_cast<char>(c);
+      printable += static_cast<char>(c);
     } else {
       static constexpr char kHex[] = "0123456789abcdef";
-      quoted += {'\\', 'x', kHex[c >> 4], kHex[c & 15]};
+      printable += {'\\', 'x', kHex[c >> 4], kHex[c & 15]};
     }
   }
-  return quoted + (text.size() > 60 ? "'..." : "'");
+  return text.size() > most ? printable + "..." : printable;
 }
+
+// Text from a file, quoted: '1\x885'.
+std::string Quoted(const std::string& text) { return "'" + Printable(text, 60) + "'"; }
 
 // A PLY value as the file would write it: 99, -5, 2.5.
 std::string Number(double value) {
@@ -258,37 +261,100 @@ void CheckPly(const std::string& path, const std::string& bytes) {
   }
 }
 
+// An element of an XML text, found by its tag: where it starts, its attributes' text and its
+// text up to the next tag.
+struct XmlElement {
+  std::size_t at = 0;
+  std::string attributes;
+  std::string content;
+};
+
+// Calls `each` on every element `tag` of `bytes` that is not empty (<p/>). A plain scan, not a
+// parser: what it cannot find, Assimp's own parser reports.
+void ForEachXmlElement(const std::string& bytes, const std::string& tag,
+                       const std::function<void(const XmlElement&)>& each) {
+  for (std::size_t at = bytes.find("<" + tag); at != std::string::npos;
+       at = bytes.find("<" + tag, at + 1)) {
+    const std::size_t name_end = at + 1 + tag.size();
+    if (name_end >= bytes.size()) break;
+    // Another element whose name starts so (<param>, <vertices>).
+    if (bytes[name_end] != '>' && !std::isspace(static_cast<unsigned char>(bytes[name_end]))) {
+      continue;
+    }
+    const std::size_t content = bytes.find('>', name_end);
+    if (content == std::string::npos || bytes[content - 1] == '/') continue;
+    const std::size_t content_end = std::min(bytes.find('<', content), bytes.size());
+    each({.at = at,
+          .attributes = bytes.substr(name_end, content - name_end),
+          .content = bytes.substr(content + 1, content_end - content - 1)});
+  }
+}
+
+// The value of the attribute `name` in an element's attributes' text; nullopt if it has none.
+std::optional<std::string> XmlAttribute(const std::string& attributes, const std::string& name) {
+  for (std::size_t at = attributes.find(name); at != std::string::npos;
+       at = attributes.find(name, at + 1)) {
+    if (at == 0 || !std::isspace(static_cast<unsigned char>(attributes[at - 1]))) continue;
+    std::size_t i = at + name.size();
+    while (i < attributes.size() && std::isspace(static_cast<unsigned char>(attributes[i]))) ++i;
+    if (i == attributes.size() || attributes[i] != '=') continue;
+    ++i;
+    while (i < attributes.size() && std::isspace(static_cast<unsigned char>(attributes[i]))) ++i;
+    if (i == attributes.size() || (attributes[i] != '"' && attributes[i] != '\'')) continue;
+    const std::size_t end = attributes.find(attributes[i], i + 1);
+    if (end == std::string::npos) return std::nullopt;
+    return attributes.substr(i + 1, end - i - 1);
+  }
+  return std::nullopt;
+}
+
+// A whole number as COLLADA's unsigned types write it (a '+' allowed); nullopt if it is not one.
+std::optional<std::uint64_t> WholeNumber(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  const char* const first = text.data() + (text[0] == '+' ? 1 : 0);
+  const char* const end = text.data() + text.size();
+  std::uint64_t value = 0;
+  const auto [stop, error] = std::from_chars(first, end, value);
+  if (error != std::errc() || stop != end) return std::nullopt;
+  return value;
+}
+
 // Assimp 5.2's COLLADA reader loops for ever on an index list (<p>, <vcount>, <v> or <h>)
-// holding anything but whole numbers, and takes an index of 2^31 or more for a valid one (4e9 in
-// a 12-triangle file read as whole): each list's items are checked first.
-void CheckColladaIndexLists(const std::string& path, const std::string& bytes) {
-  constexpr std::uint32_t kLargestIndex = 0x7fffffff;
+// holding anything but whole numbers, takes an index of 2^31 or more for a valid one (4e9 in a
+// 12-triangle file read as whole), segfaults on an array (<float_array>, ...) without a whole
+// `count`, and reads only `count` of its items when there are more. So index lists and arrays
+// are checked first.
+void CheckCollada(const std::string& path, const std::string& bytes) {
+  const auto fail = [&](std::size_t at, const std::string& what) {
+    const auto line = std::count(bytes.begin(), bytes.begin() + static_cast<long>(at), '\n');
+    return InputError(path + ":" + std::to_string(line + 1) +
+                      ": not a readable COLLADA file: " + what);
+  };
   for (const std::string tag : {"p", "vcount", "v", "h"}) {
-    for (std::size_t at = bytes.find("<" + tag); at != std::string::npos;
-         at = bytes.find("<" + tag, at + 1)) {
-      const std::size_t name_end = at + 1 + tag.size();
-      if (name_end >= bytes.size()) break;
-      // Another element whose name starts so (<param>, <vertices>) or an empty one (<p/>).
-      if (bytes[name_end] != '>' && !std::isspace(static_cast<unsigned char>(bytes[name_end]))) {
-        continue;
-      }
-      const std::size_t content = bytes.find('>', name_end);
-      if (content == std::string::npos || bytes[content - 1] == '/') continue;
-      const std::size_t content_end = std::min(bytes.find('<', content), bytes.size());
-      std::istringstream items(bytes.substr(content + 1, content_end - content - 1));
+    ForEachXmlElement(bytes, tag, [&](const XmlElement& element) {
+      std::istringstream items(element.content);
       for (std::string item; items >> item;) {
-        const char* first = item.data() + (item[0] == '+' ? 1 : 0);
-        const char* const end = item.data() + item.size();
-        std::uint32_t index = 0;
-        if (const auto [stop, error] = std::from_chars(first, end, index);
-            error != std::errc() || stop != end || index > kLargestIndex) {
-          const auto line = std::count(bytes.begin(), bytes.begin() + static_cast<long>(at), '\n');
-          throw InputError(path + ":" + std::to_string(line + 1) +
-                           ": not a readable COLLADA file: <" + tag + "> holds " + Quoted(item) +
-                           " where an index (a whole number from 0 to 2^31 - 1) belongs");
+        if (const auto index = WholeNumber(item); !index || *index > 0x7fffffff) {
+          throw fail(element.at, "<" + tag + "> holds " + Quoted(item) +
+                                     " where an index (a whole number from 0 to 2^31 - 1) "
+                                     "belongs");
         }
       }
-    }
+    });
+  }
+  for (const std::string tag :
+       {"float_array", "int_array", "bool_array", "Name_array", "IDREF_array"}) {
+    ForEachXmlElement(bytes, tag, [&](const XmlElement& element) {
+      std::istringstream items(element.content);
+      std::uint64_t count = 0;
+      for (std::string item; items >> item;) ++count;
+      const std::optional<std::string> said = XmlAttribute(element.attributes, "count");
+      if (!said || WholeNumber(*said) != count) {
+        throw fail(element.at, "<" + tag + "> holds " + std::to_string(count) +
+                                   " items, expected its count attribute to say so, as count=\"" +
+                                   std::to_string(count) + "\"");
+      }
+    });
   }
 }
 
@@ -303,7 +369,7 @@ MeshFileData LoadMeshFile(const std::string& path) {
   if (start.starts_with("ply\n") || start.starts_with("ply\r\n")) {
     CheckPly(path, ReadFileBytes(path));
   } else if (start.find("<COLLADA") != std::string::npos) {
-    CheckColladaIndexLists(path, ReadFileBytes(path));
+    CheckCollada(path, ReadFileBytes(path));
   }
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
@@ -315,7 +381,7 @@ MeshFileData LoadMeshFile(const std::string& path) {
                                   aiProcess_SortByPType | aiProcess_JoinIdenticalVertices);
   if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0) {
     throw InputError(path + ": not a readable mesh file (OBJ, STL, PLY or DAE expected): " +
-                     importer.GetErrorString());
+                     Printable(importer.GetErrorString(), 300));
   }
   MeshFileData data;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
