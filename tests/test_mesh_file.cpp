@@ -153,30 +153,46 @@ std::string WriteFile(const test::TempDir& dir, const std::string& name, const s
 }
 
 // Assimp 5.2 loops for ever on a PLY header without end_header, aborts on a body shorter than the
-// header's counts or on a face of no vertices, and segfaults on a vertex index past the vertices
-// (each found by cutting or changing the shipped file): each is now an input error naming it.
+// header's counts, on a face of no vertices or on a form feed inside a number (it ends a line
+// there), and segfaults on a vertex index past the vertices (each found by cutting or changing
+// the shipped file). Each is now an input error naming the line or element. The shipped file's
+// header is 10 lines: vertex 0 is on line 11, face 0 on line 21 and face 15 on line 36.
 TEST(MeshFile, PlyFilesAssimpCannotReadAreClearErrors) {
   test::TempDir dir;
   const std::string ply = QuayWallPly();
   const std::size_t body = ply.find("end_header\n") + 11;
-  ASSERT_NE(ply.find("\n3 0 1 6\n"), std::string::npos);
-  std::string far_index = ply;
-  far_index.replace(far_index.find("\n3 0 1 6\n"), 9, "\n3 0 1 99\n");
-  std::string no_vertices = ply;
-  no_vertices.replace(no_vertices.find("\n3 0 1 6\n"), 9, "\n0\n");
+  // The shipped file with the first `from` after the header replaced by `to`.
+  const auto changed = [&](const std::string& from, const std::string& to) {
+    std::string text = ply;
+    const std::size_t at = text.find(from, body);
+    EXPECT_NE(at, std::string::npos) << from;
+    return text.replace(at, from.size(), to);
+  };
   for (const auto& [text, expected] : std::vector<std::pair<std::string, std::string>>{
            {ply.substr(0, body - 5), "the header has no 'end_header' line"},
-           {ply.substr(0, ply.size() - 6),
+           {ply.substr(0, ply.rfind("3 5 8 9\n")),
             "the body ends in element 'face' 15 of the 16 its header declares"},
-           {ply.substr(0, body + 20),
-            "the body ends in element 'vertex' 1 of the 10 its header declares"},
-           {far_index,
+           {ply.substr(0, ply.size() - 6),
+            "line 36 holds fewer values than element 'face' 15 has properties"},
+           {changed("\n3 0 1 6\n", "\n3 0 1\n6\n"),
+            "line 21 holds fewer values than element 'face' 0 has properties"},
+           {changed("\n3 0 1 6\n", "\n3 0 1 6 7\n"),
+            "line 21 holds more values than element 'face' 0 has properties"},
+           {changed("1.5000", "1\f.5000"), "line 12 holds the control character \\x0c"},
+           {changed("1.5000", "1,5000"), "line 12 holds '1,5000' where a number belongs"},
+           {changed("\n3 0 1 6\n", "\n3 0 1 99\n"),
             "element 'face' 0: vertex index 99, expected a whole index from 0 of the 10 vertices"},
-           {no_vertices, "element 'face' 0: a face of no vertices"}}) {
+           {changed("\n3 0 1 6\n", "\n0\n"), "element 'face' 0: a face of no vertices"}}) {
     const std::string path = WriteFile(dir, "bad.ply", text);
     EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(path); }),
               path + ": not a readable PLY file: " + expected);
   }
+  // Blank lines and CRLF line ends are read as the shipped file.
+  std::string crlf;
+  for (const char c : ply.substr(body)) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  const std::string loose = WriteFile(dir, "loose.ply", ply.substr(0, body) + "\n" + crlf + "\n");
+  EXPECT_EQ(LoadMeshFile(loose).triangles,
+            LoadMeshFile(test::SourcePath("scenes/meshes/quay_wall.ply")).triangles);
 }
 
 // The check reads binary PLY of either byte order as the ASCII: the same file in each loads the

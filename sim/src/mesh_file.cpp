@@ -86,6 +86,7 @@ struct PlyHeader {
   std::string format;  // ascii, binary_little_endian or binary_big_endian
   std::vector<PlyElement> elements;
   std::size_t body = 0;  // where the body starts
+  int lines = 0;         // the header's, end_header's included
 };
 
 PlyHeader ReadPlyHeader(const std::string& bytes,
@@ -108,6 +109,7 @@ PlyHeader ReadPlyHeader(const std::string& bytes,
     if (line_number == 1) {
       if (line != "ply") throw bad_line("'ply'");
     } else if (keyword == "end_header") {
+      header.lines = line_number;
       break;
     } else if (keyword == "comment" || keyword == "obj_info" || keyword.empty()) {
       continue;
@@ -150,29 +152,56 @@ PlyHeader ReadPlyHeader(const std::string& bytes,
   return header;
 }
 
-// The values of a PLY body one by one: whitespace-separated numbers, or binary of either order.
+// The values of a PLY body one by one: binary of either order, or ASCII numbers, one element per
+// line, separated by spaces or tabs.
 class PlyValues {
  public:
   PlyValues(const std::string& bytes, const PlyHeader& header,
             std::function<InputError(std::string)> fail)
       : bytes_(bytes),
         at_(header.body),
+        line_number_(header.lines),
         ascii_(header.format == "ascii"),
         little_endian_(header.format == "binary_little_endian"),
         fail_(std::move(fail)) {}
 
-  // The next value, read as `type`; nullopt at the body's end.
+  [[nodiscard]] bool ascii() const { return ascii_; }
+  // The file's line that the element being read is on (ASCII).
+  [[nodiscard]] int line_number() const { return line_number_; }
+
+  // Starts an element: in ASCII its line, the next one not blank; false if there is none.
+  bool BeginElement() {
+    if (!ascii_) return true;
+    for (;;) {
+      if (at_ >= bytes_.size()) return false;
+      line_end_ = std::min(bytes_.find('\n', at_), bytes_.size());
+      ++line_number_;
+      // Assimp ends a line at a form feed or a NUL as well: such a byte would split an element.
+      for (std::size_t i = at_; i < line_end_; ++i) {
+        const auto c = static_cast<unsigned char>(bytes_[i]);
+        if ((c < 0x20 && c != '\t' && !(c == '\r' && i + 1 == line_end_)) || c == 0x7f) {
+          throw fail_("line " + std::to_string(line_number_) + " holds the control character " +
+                      Printable(std::string(1, static_cast<char>(c)), 1));
+        }
+      }
+      SkipBlanks();
+      if (at_ < line_end_) return true;
+      at_ = line_end_ + 1;
+    }
+  }
+
+  // The next value, read as `type`; nullopt at the body's end, or in ASCII at the line's.
   std::optional<double> Next(const PlyType& type) {
     if (ascii_) {
-      while (at_ < bytes_.size() && std::isspace(static_cast<unsigned char>(bytes_[at_]))) ++at_;
-      if (at_ == bytes_.size()) return std::nullopt;
+      SkipBlanks();
+      if (at_ >= line_end_) return std::nullopt;
       std::size_t end = at_;
-      while (end < bytes_.size() && !std::isspace(static_cast<unsigned char>(bytes_[end]))) ++end;
+      while (end < line_end_ && !IsBlank(bytes_[end])) ++end;
       double value = 0.0;
       const auto [stop, error] = std::from_chars(bytes_.data() + at_, bytes_.data() + end, value);
       if (error != std::errc() || stop != bytes_.data() + end) {
-        throw fail_("the body holds " + Quoted(bytes_.substr(at_, end - at_)) +
-                    " where a number belongs");
+        throw fail_("line " + std::to_string(line_number_) + " holds " +
+                    Quoted(bytes_.substr(at_, end - at_)) + " where a number belongs");
       }
       at_ = end;
       return value;
@@ -201,9 +230,27 @@ class PlyValues {
     return static_cast<double>(bits);
   }
 
+  // Ends an element: in ASCII its line holds nothing more.
+  void EndElement(const std::string& element) {
+    if (!ascii_) return;
+    SkipBlanks();
+    if (at_ < line_end_) {
+      throw fail_("line " + std::to_string(line_number_) + " holds more values than " + element +
+                  " has properties");
+    }
+    at_ = line_end_ + 1;
+  }
+
  private:
+  static bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+  void SkipBlanks() {
+    while (at_ < line_end_ && IsBlank(bytes_[at_])) ++at_;
+  }
+
   const std::string& bytes_;
   std::size_t at_;
+  std::size_t line_end_ = 0;
+  int line_number_;
   bool ascii_;
   bool little_endian_;
   std::function<InputError(std::string)> fail_;
@@ -212,8 +259,9 @@ class PlyValues {
 // Assimp 5.2's PLY reader loops for ever on a header without `end_header`, aborts (an assertion
 // in its triangulation) on a body shorter than its header declares or on a face of no vertices,
 // and reads out of bounds through a face's vertex index past the vertices. So a PLY file is
-// checked first: its header whole, every element the header counts present in the body, and
-// every face a list of at least one whole index to one of the vertices.
+// checked first: its header whole, every element the header counts present in the body (in ASCII
+// on a line of its own, as Assimp reads it), and every face a list of at least one whole index to
+// one of the vertices.
 void CheckPly(const std::string& path, const std::string& bytes) {
   const auto fail = [&](std::string what) {
     return InputError(path + ": not a readable PLY file: " + what);
@@ -227,13 +275,17 @@ void CheckPly(const std::string& path, const std::string& bytes) {
   for (const PlyElement& element : header.elements) {
     for (std::uint64_t i = 0; i < element.count && !element.properties.empty(); ++i) {
       const auto where = [&] { return "element '" + element.name + "' " + std::to_string(i); };
+      const auto ends = [&] {
+        return fail("the body ends in " + where() + " of the " + std::to_string(element.count) +
+                    " its header declares");
+      };
+      if (!values.BeginElement()) throw ends();
       const auto next = [&](const PlyType& type) {
         const std::optional<double> value = values.Next(type);
-        if (!value) {
-          throw fail("the body ends in " + where() + " of the " + std::to_string(element.count) +
-                     " its header declares");
-        }
-        return *value;
+        if (value) return *value;
+        if (!values.ascii()) throw ends();
+        throw fail("line " + std::to_string(values.line_number()) + " holds fewer values than " +
+                   where() + " has properties");
       };
       for (const PlyProperty& p : element.properties) {
         if (!p.list) {
@@ -257,6 +309,7 @@ void CheckPly(const std::string& path, const std::string& bytes) {
           }
         }
       }
+      values.EndElement(where());
     }
   }
 }
