@@ -438,6 +438,14 @@ TEST(Cli, BadMeshFilesExitTwoNamingSceneMeshAndFile) {
       output.find("mesh 'fin' (" + (dir.path() / "nan.obj").string() + "): vertex 2 is not finite"),
       std::string::npos)
       << output;
+  // `simulate` and `sweep` refuse it before they make their directory (each once left a partial
+  // dataset or study behind).
+  for (const std::string command : {"simulate", "sweep"}) {
+    const auto out = dir.path() / command;
+    EXPECT_EQ(RunCli(command + " " + scene_with("nan.obj") + " --out " + out.string(), &output), 2);
+    EXPECT_NE(output.find("vertex 2 is not finite"), std::string::npos) << output;
+    EXPECT_FALSE(std::filesystem::exists(out)) << command;
+  }
 }
 
 TEST(Cli, SimulateWritesADatasetThatMapReads) {

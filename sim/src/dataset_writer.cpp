@@ -266,14 +266,17 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   DatasetSummary summary;
   summary.sweeps_total = static_cast<std::size_t>(scene.sweeps);
   summary.config_sha256 = SceneConfigHash(scene, seed);
+  // The output directory checked, then the meshes' preflight, before the directory is made: bad
+  // input leaves none.
+  CheckOutputDirectory(dir);
+  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
+  const RayTracer tracer(meshes);
+  const BeamSynthesizer synthesizer = SceneSynthesizer(scene, tracer, seed);
   if (PrepareDirectory(dir, summary.config_sha256, options.force)) {
     summary.complete = summary.already_complete = true;
     return summary;
   }
   const fs::path root(dir);
-  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
-  const RayTracer tracer(meshes);
-  const BeamSynthesizer synthesizer = SceneSynthesizer(scene, tracer, seed);
   const std::size_t beam_count = ScenarioBeamCount(scene);
   const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
   const auto first_sweep = static_cast<std::size_t>(options.shard.index);

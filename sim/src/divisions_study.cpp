@@ -56,9 +56,9 @@ struct StudyInputs {
   std::vector<CoverageBeam> coverage_beams;
 };
 
-StudyInputs PrepareInputs(const Scene& scene, std::uint64_t seed, int coverage_beams, int threads) {
+StudyInputs PrepareInputs(const Scene& scene, const std::vector<TriangleMesh>& meshes,
+                          std::uint64_t seed, int coverage_beams, int threads) {
   StudyInputs in;
-  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
   const auto synthesized = SimulateScene(scene, tracer, seed, threads);
   in.beams = BeamsOf(synthesized);
@@ -208,6 +208,8 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
                       std::to_string(options.items.size()));
   const fs::path root(dir);
   CheckOutputDirectory(dir);
+  // The meshes' preflight before the directory is made: bad input leaves none.
+  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   if (options.force) {
     for (const char* f :
          {"divisions.csv", "coverage_vs_divisions.png", "time_vs_divisions.png", "study.json"}) {
@@ -238,7 +240,9 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
       }
       ++summary.items_skipped;
     } else {
-      if (!inputs) inputs = PrepareInputs(scene, seed, options.coverage_beams, options.threads);
+      if (!inputs) {
+        inputs = PrepareInputs(scene, meshes, seed, options.coverage_beams, options.threads);
+      }
       json result = RunItem(scene, *inputs, items[i], options.threads);
       result["index"] = i;
       result["config_sha256"] = config;
