@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
+#include <matio.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -10,6 +12,7 @@
 #include <numbers>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "sonarbench/mapping/error.hpp"
@@ -99,24 +102,96 @@ TEST(MatLog, TruncatedCopyOfTheRealLogIsAClearError) {
   EXPECT_THROW((void)mapping::ReadMatLog(cut), InputError);
 }
 
-// One byte changed inside the compressed struct's header (offset 299 of the real log, found by
-// flipping bytes) makes libmatio size its table of fields at 571 GB and leave it unallocated; its
-// field lookup then read through a null pointer. A clear error now, naming the file.
-TEST(MatLog, CorruptStructTableIsAClearError) {
+// One byte changed inside the compressed log, found by flipping bytes: at offset 299 libmatio sized
+// parsedData's table of fields at 571 GB, left it unallocated and then read through a null pointer
+// (segfault); at 620834 it allocated 13 GB over 35 s before it refused the file. Both break the
+// compressed stream's checksum, which libmatio checks only at the end: refused at once now.
+TEST(MatLog, CorruptCopiesOfTheRealLogAreClearErrors) {
   REQUIRE_REAL_LOG();
   test::TempDir dir;
-  const std::string bad = (dir.path() / "bad.mat").string();
-  WriteChangedRealLog(bad, [](std::vector<char>& bytes) {
-    ASSERT_EQ(static_cast<unsigned char>(bytes.at(299)), 140);
-    bytes[299] = static_cast<char>(165);
-  });
-  try {
-    (void)mapping::ReadMatLog(bad);
-    ADD_FAILURE() << "no error";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find(bad + ": 'parsedData' is corrupt"), std::string::npos)
-        << e.what();
+  for (const auto& [offset, was, is] : {std::tuple{299, 140, 165}, std::tuple{620834, 151, 252}}) {
+    const std::string bad = (dir.path() / ("bad" + std::to_string(offset) + ".mat")).string();
+    WriteChangedRealLog(bad, [&](std::vector<char>& bytes) {
+      ASSERT_EQ(static_cast<unsigned char>(bytes.at(offset)), was);
+      bytes[offset] = static_cast<char>(is);
+    });
+    EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(bad); }),
+              bad + ": a corrupt MAT file (a compressed element does not inflate whole)");
   }
+}
+
+// The check before libmatio reads what libmatio writes: a char array (whose stated size counts
+// padding it leaves out of the compressed stream), an uncompressed array and the struct array of
+// beams, compressed and not.
+TEST(MatLog, WhatLibmatioWritesIsRead) {
+  test::TempDir dir;
+  for (const matio_compression compression : {MAT_COMPRESSION_ZLIB, MAT_COMPRESSION_NONE}) {
+    const std::string path = (dir.path() / "written.mat").string();
+    mat_t* mat = Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT5);
+    ASSERT_NE(mat, nullptr);
+    std::size_t note_dims[2] = {1, 7};
+    char note[] = "odd one";
+    matvar_t* var = Mat_VarCreate("note", MAT_C_CHAR, MAT_T_UINT8, 2, note_dims, note, 0);
+    Mat_VarWrite(mat, var, MAT_COMPRESSION_ZLIB);
+    Mat_VarFree(var);
+    std::size_t plain_dims[2] = {1, 3};
+    double plain[3] = {1, 2, 3};
+    var = Mat_VarCreate("plain", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, plain_dims, plain, 0);
+    Mat_VarWrite(mat, var, MAT_COMPRESSION_NONE);
+    Mat_VarFree(var);
+    const char* fields[4] = {"time", "angle", "step_dist", "intensities"};
+    std::size_t beams[2] = {1, 2};
+    matvar_t* data = Mat_VarCreateStruct("parsedData", 2, beams, fields, 4);
+    for (std::size_t i = 0; i < 2; ++i) {
+      std::size_t one[2] = {1, 1};
+      std::size_t bins[2] = {1, 5};
+      double time = 0.1 * static_cast<double>(i), angle = 1.8 * static_cast<double>(i);
+      double step = 0.0125;
+      double intensities[5] = {0, 10, 20, 30, 255};
+      const auto set = [&](const char* field, std::size_t* dims, double* values) {
+        Mat_VarSetStructFieldByName(
+            data, field, i, Mat_VarCreate(nullptr, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, values, 0));
+      };
+      set("time", one, &time);
+      set("angle", one, &angle);
+      set("step_dist", one, &step);
+      set("intensities", bins, intensities);
+    }
+    Mat_VarWrite(mat, data, compression);
+    Mat_VarFree(data);
+    Mat_Close(mat);
+    const mapping::MatLog log = mapping::ReadMatLog(path);
+    ASSERT_EQ(log.beams.size(), 2u);
+    EXPECT_EQ(log.beams[1].intensities, (std::vector<std::uint8_t>{0, 10, 20, 30, 255}));
+    EXPECT_DOUBLE_EQ(log.beams[1].head_angle_rad, 1.8 * std::numbers::pi / 180.0);
+  }
+}
+
+// A MAT v5 file whose array states more elements than it holds values is refused before libmatio
+// reads it (it would allocate what the dimensions say: 16 GB here).
+TEST(MatLog, AnArrayLargerThanItsBytesIsRefused) {
+  test::TempDir dir;
+  std::string mat(116, ' ');
+  mat.replace(0, 10, "MATLAB 5.0");
+  mat += std::string(8, '\0') + std::string("\x00\x01IM", 4);
+  const auto u32 = [&](std::uint32_t value) {
+    mat.append(reinterpret_cast<const char*>(&value), 4);  // little-endian, as "IM" says
+  };
+  u32(14), u32(72);                         // miMATRIX of 72 bytes
+  u32(6), u32(8), u32(6), u32(0);           // its flags: a double array
+  u32(5), u32(8), u32(1), u32(2000000000);  // 1 x 2e9
+  u32(1), u32(10), mat += std::string("parsedData\0\0\0\0\0\0", 16);
+  u32(9), u32(8), mat += std::string("\0\0\0\0\0\0\xf0\x3f", 8);  // one double, 1.0
+  const std::string path = (dir.path() / "huge.mat").string();
+  std::ofstream(path, std::ios::binary) << mat;
+  EXPECT_EQ(
+      test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+      path + ": a corrupt MAT file (an array of 2000000000 elements holds 8 bytes of values)");
+  // The same file stating the one element it holds is read as far as its layout: not a struct.
+  mat.replace(128 + 8 + 16 + 8 + 4, 4, std::string("\x01\0\0\0", 4));
+  std::ofstream(path, std::ios::binary) << mat;
+  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+            path + ": 'parsedData' is not a struct array");
 }
 
 // A straight wall: the wall points of one side lie on a line. Fitted by total least squares to

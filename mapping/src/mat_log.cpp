@@ -1,14 +1,19 @@
 #include "sonarbench/mapping/mat_log.hpp"
 
 #include <matio.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
 
+#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
@@ -53,10 +58,195 @@ std::optional<double> NumericAt(const matvar_t* var, std::size_t k) {
   }
 }
 
+// A MAT v5 file's elements, walked by their tags without reading any array's values: libmatio
+// 1.5 sizes its arrays by the dimensions a file states, so a corrupt one (a byte changed inside
+// the compressed log) had it allocate 13 GB and take 35 s before it refused the file. A file
+// whose stated sizes do not fit in the bytes it holds is refused here instead.
+class MatV5Check {
+ public:
+  explicit MatV5Check(std::function<InputError(const std::string&)> fail)
+      : fail_(std::move(fail)) {}
+
+  // Checks the file's bytes; files that are not MAT v5 (v4, v7.3's HDF5) are left to libmatio.
+  void File(const std::string& bytes) {
+    if (bytes.size() < 128 || bytes.compare(126, 2, "IM") != 0 ||
+        static_cast<unsigned char>(bytes[125]) != 0x01) {
+      return;
+    }
+    for (std::size_t at = 128; at < bytes.size();) {
+      const Tag tag = ReadTag(bytes, at, bytes.size());
+      if (tag.type == kCompressed) {
+        Element(Inflate(bytes.substr(tag.data, tag.bytes)), 0);
+        at = tag.data + tag.bytes;
+      } else {
+        Element(bytes.substr(at, tag.end - at), 0);
+        at = tag.end;
+      }
+    }
+  }
+
+ private:
+  static constexpr std::uint32_t kInt8 = 1, kInt32 = 5, kUInt32 = 6, kMatrix = 14, kCompressed = 15;
+  static constexpr int kMostDepth = 16;
+
+  struct Tag {
+    std::uint32_t type = 0;
+    std::size_t bytes = 0;  // the data's
+    std::size_t data = 0;   // where the data starts
+    std::size_t end = 0;    // where the next element starts (padded to 8 bytes)
+  };
+
+  static std::uint32_t U32(const std::string& bytes, std::size_t at) {
+    std::uint32_t value = 0;
+    std::memcpy(&value, bytes.data() + at, sizeof value);  // little-endian, as "IM" says
+    return value;
+  }
+
+  // The tag at `at`, whose element must end by `limit`.
+  Tag ReadTag(const std::string& bytes, std::size_t at, std::size_t limit) const {
+    if (limit < at + 8 || limit > bytes.size()) throw fail_("an element's tag is cut off");
+    Tag tag;
+    tag.type = U32(bytes, at);
+    if ((tag.type >> 16) != 0) {  // a small element: its bytes in the tag's upper half
+      tag.bytes = tag.type >> 16;
+      tag.type &= 0xffff;
+      tag.data = at + 4;
+      tag.end = at + 8;
+      if (tag.bytes > 4)
+        throw fail_("a small element states " + std::to_string(tag.bytes) +
+                    " bytes, more than the 4 it can hold");
+      return tag;
+    }
+    tag.bytes = U32(bytes, at + 4);
+    tag.data = at + 8;
+    // An array may state more bytes than follow: libmatio writes a compressed char array's size
+    // with padding it leaves out. What an array holds is checked element by element.
+    if (tag.type == kMatrix) {
+      tag.bytes = std::min(tag.bytes, limit - tag.data);
+    } else if (tag.bytes > limit - tag.data) {
+      throw fail_("an element states " + std::to_string(tag.bytes) + " bytes where " +
+                  std::to_string(limit - tag.data) + " are left");
+    }
+    // Padded to 8 bytes, but for a compressed one; libmatio leaves the last padding out of what
+    // it compresses.
+    const std::size_t padded = tag.type == kCompressed ? tag.bytes : (tag.bytes + 7) / 8 * 8;
+    tag.end = std::min(tag.data + padded, limit);
+    return tag;
+  }
+
+  std::string Inflate(const std::string& compressed) const {
+    z_stream stream{};
+    if (inflateInit(&stream) != Z_OK) throw fail_("zlib cannot start");
+    std::string out;
+    stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data()));
+    stream.avail_in = static_cast<uInt>(compressed.size());
+    int status = Z_OK;
+    while (status == Z_OK) {
+      out.resize(out.size() + (1 << 20));
+      stream.next_out = reinterpret_cast<Bytef*>(out.data() + stream.total_out);
+      stream.avail_out = 1 << 20;
+      status = inflate(&stream, Z_NO_FLUSH);
+    }
+    out.resize(stream.total_out);
+    inflateEnd(&stream);
+    if (status != Z_STREAM_END) throw fail_("a compressed element does not inflate whole");
+    return out;
+  }
+
+  // One element and, if it is an array (miMATRIX), what it holds.
+  void Element(const std::string& bytes, int depth) const {
+    if (bytes.empty()) return;
+    const Tag tag = ReadTag(bytes, 0, bytes.size());
+    if (tag.type == kMatrix) Matrix(bytes, tag, depth);
+  }
+
+  // An array: its flags, dimensions and name, then a numeric array's values, as many as its
+  // dimensions say, or a struct array's fields, one array per element and field.
+  void Matrix(const std::string& bytes, const Tag& matrix, int depth) const {
+    if (matrix.bytes == 0) return;  // an empty array
+    if (depth > kMostDepth) throw fail_("arrays nested deeper than " + std::to_string(kMostDepth));
+    const std::size_t end = matrix.data + matrix.bytes;
+    const Tag flags = ReadTag(bytes, matrix.data, end);
+    if (flags.type != kUInt32 || flags.bytes != 8) throw fail_("an array without its flags");
+    const std::uint32_t array_class = U32(bytes, flags.data) & 0xff;
+    const bool complex = (U32(bytes, flags.data) & 0x0800) != 0;
+    const Tag dims = ReadTag(bytes, flags.end, end);
+    if (dims.type != kInt32 || dims.bytes % 4 != 0 || dims.bytes < 8) {
+      throw fail_("an array without its dimensions");
+    }
+    double elements = 1.0;
+    for (std::size_t d = 0; d < dims.bytes; d += 4) {
+      elements *= static_cast<double>(static_cast<std::int32_t>(U32(bytes, dims.data + d)));
+    }
+    if (elements < 0.0) throw fail_("an array of negative dimensions");
+    const Tag name = ReadTag(bytes, dims.end, end);
+    if (name.type != kInt8) throw fail_("an array without its name");
+    std::size_t at = name.end;
+    if (array_class >= 6 && array_class <= 15) {  // numeric: double ... uint64
+      for (int part = 0; part < (complex ? 2 : 1); ++part) {
+        const Tag values = ReadTag(bytes, at, end);
+        const std::size_t size = TypeBytes(values.type);
+        if (size == 0 || static_cast<double>(values.bytes / size) != elements ||
+            values.bytes % size != 0) {
+          throw fail_("an array of " + std::to_string(static_cast<long long>(elements)) +
+                      " elements holds " + std::to_string(values.bytes) + " bytes of values");
+        }
+        at = values.end;
+      }
+    } else if (array_class == 2) {  // struct
+      const Tag length = ReadTag(bytes, at, end);
+      const Tag names = ReadTag(bytes, length.end, end);
+      const std::uint32_t name_length = length.bytes == 4 ? U32(bytes, length.data) : 0;
+      if (length.type != kInt32 || name_length == 0 || names.bytes % name_length != 0) {
+        throw fail_("a struct array without its field names");
+      }
+      const double fields = static_cast<double>(names.bytes / name_length);
+      at = names.end;
+      for (double k = 0; k < elements * fields; ++k) {
+        const Tag field = ReadTag(bytes, at, end);
+        if (field.type != kMatrix) throw fail_("a struct array's field is not an array");
+        Matrix(bytes, field, depth + 1);
+        at = field.end;
+      }
+    }
+  }
+
+  static std::size_t TypeBytes(std::uint32_t type) {
+    switch (type) {
+      case 1:
+      case 2:
+      case 16:
+        return 1;  // int8, uint8, utf8
+      case 3:
+      case 4:
+      case 17:
+        return 2;  // int16, uint16, utf16
+      case 5:
+      case 6:
+      case 7:
+      case 18:
+        return 4;  // int32, uint32, single, utf32
+      case 9:
+      case 12:
+      case 13:
+        return 8;  // double, int64, uint64
+      default:
+        return 0;
+    }
+  }
+
+  std::function<InputError(const std::string&)> fail_;
+};
+
 }  // namespace
 
 MatLog ReadMatLog(const std::string& path) {
   auto fail = [&](const std::string& what) { return InputError(path + ": " + what); };
+  if (std::filesystem::is_regular_file(path)) {
+    MatV5Check([&](const std::string& what) {
+      return fail("a corrupt MAT file (" + what + ")");
+    }).File(ReadFileBytes(path));
+  }
   std::unique_ptr<mat_t, MatCloser> mat(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
   if (!mat) throw fail("cannot open as a MATLAB .mat file (expected a v5 or v7.3 .mat log)");
   std::unique_ptr<matvar_t, VarFreer> data(Mat_VarRead(mat.get(), "parsedData"));
@@ -65,7 +255,8 @@ MatLog ReadMatLog(const std::string& path) {
   const std::size_t count = ElementCount(data.get());
   if (count == 0) throw fail("'parsedData' holds no beams");
   // A corrupt file can leave the struct's table of fields unread or the wrong size, and
-  // libmatio's field lookup reads that table unchecked: check it before asking for a field.
+  // libmatio's field lookup reads that table unchecked: check it before asking for a field (the
+  // MAT v5 check above finds such files first; a v7.3 file it does not read).
   const unsigned fields = Mat_VarGetNumberOfFields(data.get());
   char* const* names = Mat_VarGetStructFieldnames(data.get());
   if (data->data == nullptr || fields == 0 || names == nullptr ||
