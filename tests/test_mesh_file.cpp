@@ -178,7 +178,7 @@ TEST(MeshFile, PlyFilesAssimpCannotReadAreClearErrors) {
             "line 21 holds fewer values than element 'face' 0 has properties"},
            {changed("\n3 0 1 6\n", "\n3 0 1 6 7\n"),
             "line 21 holds more values than element 'face' 0 has properties"},
-           {changed("1.5000", "1\f.5000"), "line 12 holds the control character \\x0c"},
+           {changed("1.5000", "1\f.5000"), "line 12 holds the control character '\\x0c'"},
            {changed("1.5000", "1,5000"), "line 12 holds '1,5000' where a number belongs"},
            {changed("\n3 0 1 6\n", "\n3 0 1 99\n"),
             "element 'face' 0: vertex index 99, expected a whole index from 0 of the 10 vertices"},

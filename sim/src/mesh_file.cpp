@@ -15,6 +15,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
 #include "sonarbench/mapping/atomic_file.hpp"
@@ -22,25 +23,6 @@
 
 namespace sonarbench::sim {
 namespace {
-
-// Text from a file or about it, for a message: bytes that are not printable ASCII as \xNN, and at
-// most `most` of them.
-std::string Printable(const std::string& text, std::size_t most) {
-  std::string printable;
-  for (std::size_t i = 0; i < text.size() && i < most; ++i) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      printable += static_cast<char>(c);
-    } else {
-      static constexpr char kHex[] = "0123456789abcdef";
-      printable += {'\\', 'x', kHex[c >> 4], kHex[c & 15]};
-    }
-  }
-  return text.size() > most ? printable + "..." : printable;
-}
-
-// Text from a file, quoted: '1\x885'.
-std::string Quoted(const std::string& text) { return "'" + Printable(text, 60) + "'"; }
 
 // A PLY value as the file would write it: 99, -5, 2.5.
 std::string Number(double value) {
@@ -107,7 +89,7 @@ PlyHeader ReadPlyHeader(const std::string& bytes,
                   ", got " + Quoted(line));
     };
     if (line_number == 1) {
-      if (line != "ply") throw bad_line("'ply'");
+      if (keyword != "ply" || words >> keyword) throw bad_line("'ply'");
     } else if (keyword == "end_header") {
       header.lines = line_number;
       break;
@@ -181,7 +163,7 @@ class PlyValues {
         const auto c = static_cast<unsigned char>(bytes_[i]);
         if ((c < 0x20 && c != '\t' && !(c == '\r' && i + 1 == line_end_)) || c == 0x7f) {
           throw fail_("line " + std::to_string(line_number_) + " holds the control character " +
-                      Printable(std::string(1, static_cast<char>(c)), 1));
+                      Quoted(std::string_view(bytes_.data() + i, 1)));
         }
       }
       SkipBlanks();
@@ -419,7 +401,8 @@ MeshFileData LoadMeshFile(const std::string& path) {
   std::string start(4096, '\0');
   start.resize(static_cast<std::size_t>(
       std::ifstream(path, std::ios::binary).read(start.data(), 4096).gcount()));
-  if (start.starts_with("ply\n") || start.starts_with("ply\r\n")) {
+  if (start.starts_with("ply") && start.size() > 3 &&
+      std::isspace(static_cast<unsigned char>(start[3]))) {
     CheckPly(path, ReadFileBytes(path));
   } else if (start.find("<COLLADA") != std::string::npos) {
     CheckCollada(path, ReadFileBytes(path));
@@ -434,7 +417,7 @@ MeshFileData LoadMeshFile(const std::string& path) {
                                   aiProcess_SortByPType | aiProcess_JoinIdenticalVertices);
   if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0) {
     throw InputError(path + ": not a readable mesh file (OBJ, STL, PLY or DAE expected): " +
-                     Printable(importer.GetErrorString(), 300));
+                     Quoted(importer.GetErrorString(), 300));
   }
   MeshFileData data;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
