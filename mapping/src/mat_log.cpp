@@ -8,9 +8,11 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <iomanip>
 #include <map>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include "sonarbench/mapping/atomic_file.hpp"
@@ -112,9 +114,10 @@ class MatV5Check {
       tag.type &= 0xffff;
       tag.data = at + 4;
       tag.end = at + 8;
-      if (tag.bytes > 4)
+      if (tag.bytes > 4) {
         throw fail_("a small element states " + std::to_string(tag.bytes) +
                     " bytes, more than the 4 it can hold");
+      }
       return tag;
     }
     tag.bytes = U32(bytes, at + 4);
@@ -188,8 +191,10 @@ class MatV5Check {
         const std::size_t size = TypeBytes(values.type);
         if (size == 0 || static_cast<double>(values.bytes / size) != elements ||
             values.bytes % size != 0) {
-          throw fail_("an array of " + std::to_string(static_cast<long long>(elements)) +
-                      " elements holds " + std::to_string(values.bytes) + " bytes of values");
+          std::ostringstream stated;  // a product of dimensions may pass any integer type
+          stated << std::setprecision(15) << elements;
+          throw fail_("an array of " + stated.str() + " elements holds " +
+                      std::to_string(values.bytes) + " bytes of values");
         }
         at = values.end;
       }
