@@ -167,13 +167,6 @@ TEST(SceneFile, BadSceneNamesItsFileAndKey) {
       ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, {path, "'sweeps'", "got '-3'"}));
 }
 
-// Writes `text` to the file `name` in `dir`; returns its path.
-std::string WriteText(const test::TempDir& dir, const std::string& name, const std::string& text) {
-  const std::string path = (dir.path() / name).string();
-  std::ofstream(path) << text;
-  return path;
-}
-
 // The message a small scene (one material, one mesh, the trajectory; `acoustics`, if any, as its
 // sonar_acoustics from line 5) is refused with; "" if it is not.
 std::string SmallSceneRefusal(const std::string& material, const std::string& mesh,
@@ -266,12 +259,13 @@ TEST(SceneFile, EmptyNamesAreRefused) {
            {"name: x\nsensor_model: ''" + scene_tail, "'sensor_model'"},
            {"name: x\nextends: ''\n", "'extends'"}}) {
     SCOPED_TRACE(text);
-    const std::string path = WriteText(dir, "empty.yaml", text);
+    const std::string path = test::WriteFile(dir, "empty.yaml", text);
     EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
                                      {"empty.yaml:", "key " + key, kEmpty}));
   }
   // A refused base is the one error: the keys it would have given are not reported missing.
-  const std::string refused_base = WriteText(dir, "refused_base.yaml", "name: x\nextends: [a]\n");
+  const std::string refused_base =
+      test::WriteFile(dir, "refused_base.yaml", "name: x\nextends: [a]\n");
   EXPECT_EQ(test::InputErrorOf([&] { (void)sim::LoadScene(refused_base); }),
             refused_base + ":2:10: key 'extends': expected a string, got a list");
 }
@@ -642,7 +636,7 @@ TEST(SceneFile, TankScenesShareTheFittedTank) {
 TEST(SceneFile, ExtendsChangesOnlyWhatItNames) {
   test::TempDir dir;
   const auto write = [&](const std::string& name, const std::string& text) {
-    return WriteText(dir, name, text);
+    return test::WriteFile(dir, name, text);
   };
   write("base.yaml",
         "name: base\nsensor_model: " + test::SourcePath("sensor-models/shad-micron.yaml") +
@@ -724,7 +718,7 @@ TEST(SceneFile, ExtendsChangesOnlyWhatItNames) {
 TEST(SceneFile, ExtendsRefusesWhatItCannotMean) {
   test::TempDir dir;
   const auto write = [&](const std::string& name, const std::string& text) {
-    return WriteText(dir, name, text);
+    return test::WriteFile(dir, name, text);
   };
   const std::string model = test::SourcePath("sensor-models/shad-micron.yaml");
   write("base.yaml", "name: base\nsensor_model: " + model +
@@ -765,10 +759,10 @@ TEST(SceneFile, VehiclePartsAreReadAndRefusedWithReasons) {
                            "meshes: [{name: bed, type: plane, size_m: [9, 9, 0], material: hull}]\n"
                            "trajectory: {type: static, position_m: [0, 0, 1]}\n";
   const std::string good =
-      WriteText(dir, "good.yaml",
-                head +
-                    "vehicle:\n  - {name: skid, type: box, size_m: [0.4, 0.1, 0.1], "
-                    "position_m: [0.5, 0.2, -0.1], material: hull}\n");
+      test::WriteFile(dir, "good.yaml",
+                      head +
+                          "vehicle:\n  - {name: skid, type: box, size_m: [0.4, 0.1, 0.1], "
+                          "position_m: [0.5, 0.2, -0.1], material: hull}\n");
   const sim::Scene scene = sim::LoadScene(good);
   ASSERT_EQ(scene.vehicle.size(), 1u);
   EXPECT_EQ(scene.vehicle[0].name, "skid");
@@ -777,23 +771,24 @@ TEST(SceneFile, VehiclePartsAreReadAndRefusedWithReasons) {
   EXPECT_NEAR(scene.vehicle[0].T_world_mesh.translation().x(), 0.5, 1e-12);
   EXPECT_EQ(scene.meshes.size(), 1u);
   const std::string derived =
-      WriteText(dir, "derived.yaml",
-                "name: y\nextends: good.yaml\nvehicle:\n  - {name: fin, type: plane, "
-                "size_m: [0.1, 0.1, 0], material: hull}\n");
+      test::WriteFile(dir, "derived.yaml",
+                      "name: y\nextends: good.yaml\nvehicle:\n  - {name: fin, type: plane, "
+                      "size_m: [0.1, 0.1, 0], material: hull}\n");
   EXPECT_EQ(sim::LoadScene(derived).vehicle.size(), 2u);
 
   // A part from a mesh file: the dataset's configuration hash covers the file's bytes.
-  const std::string obj = WriteText(dir, "fin.obj", "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n");
-  const std::string with_file =
-      WriteText(dir, "with_file.yaml",
-                head + "vehicle:\n  - {name: fin, type: file, file: fin.obj, material: hull}\n");
+  const std::string obj =
+      test::WriteFile(dir, "fin.obj", "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n");
+  const std::string with_file = test::WriteFile(
+      dir, "with_file.yaml",
+      head + "vehicle:\n  - {name: fin, type: file, file: fin.obj, material: hull}\n");
   const std::string hash = sim::SceneConfigHash(sim::LoadScene(with_file), 1);
-  WriteText(dir, "fin.obj", "v 0 0 0\nv 0.2 0 0\nv 0 0.1 0\nf 1 2 3\n");
+  test::WriteFile(dir, "fin.obj", "v 0 0 0\nv 0.2 0 0\nv 0 0.1 0\nf 1 2 3\n");
   EXPECT_NE(sim::SceneConfigHash(sim::LoadScene(with_file), 1), hash);
 
   const auto refused = [&](const std::string& name, const std::string& part,
                            const std::vector<std::string>& parts) {
-    const std::string path = WriteText(dir, name, head + "vehicle:\n  - " + part + "\n");
+    const std::string path = test::WriteFile(dir, name, head + "vehicle:\n  - " + part + "\n");
     return ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); }, parts);
   };
   EXPECT_TRUE(refused("mirror.yaml", "{name: p, type: plane, size_m: [1, 1, 0], material: glass}",
@@ -806,13 +801,13 @@ TEST(SceneFile, VehiclePartsAreReadAndRefusedWithReasons) {
   EXPECT_TRUE(refused("mud.yaml", "{name: p, type: plane, size_m: [1, 1, 0], material: mud}",
                       {"mud.yaml:10:", "'vehicle[0].material'", "'mud'"}));
   // An unknown material is reported alone, not also as the scene's first one, a mirror here.
-  const std::string glass_first =
-      WriteText(dir, "glass_first.yaml",
-                "name: x\nsensor_model: " + model +
-                    "\nsweeps: 1\nmaterials:\n  - {name: glass, reflectivity: 0.1, specular: 0.5}\n"
-                    "meshes: [{name: bed, type: plane, size_m: [9, 9, 0], material: glass}]\n"
-                    "trajectory: {type: static, position_m: [0, 0, 1]}\n"
-                    "vehicle:\n  - {name: p, type: plane, size_m: [1, 1, 0], material: mud}\n");
+  const std::string glass_first = test::WriteFile(
+      dir, "glass_first.yaml",
+      "name: x\nsensor_model: " + model +
+          "\nsweeps: 1\nmaterials:\n  - {name: glass, reflectivity: 0.1, specular: 0.5}\n"
+          "meshes: [{name: bed, type: plane, size_m: [9, 9, 0], material: glass}]\n"
+          "trajectory: {type: static, position_m: [0, 0, 1]}\n"
+          "vehicle:\n  - {name: p, type: plane, size_m: [1, 1, 0], material: mud}\n");
   const std::string message = test::InputErrorOf([&] { (void)sim::LoadScene(glass_first); });
   EXPECT_NE(message.find("key 'vehicle[0].material': the name of a material under 'materials', "
                          "got 'mud'"),

@@ -144,13 +144,8 @@ TEST(MeshFile, MissingOrUnreadableFilesNameTheFile) {
   EXPECT_NE(error.find(garbage.string() + ": "), std::string::npos) << error;
 }
 
-// The shipped PLY file's text, and a file in `dir` holding `text`.
+// The shipped PLY file's text.
 std::string QuayWallPly() { return ReadFileBytes(test::SourcePath("scenes/meshes/quay_wall.ply")); }
-std::string WriteFile(const test::TempDir& dir, const std::string& name, const std::string& text) {
-  const std::string path = (dir.path() / name).string();
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
-}
 
 // Assimp 5.2 loops for ever on a PLY header without end_header, aborts on a body shorter than the
 // header's counts, on a face of no vertices or on a form feed inside a number (it ends a line
@@ -183,14 +178,15 @@ TEST(MeshFile, PlyFilesAssimpCannotReadAreClearErrors) {
            {changed("\n3 0 1 6\n", "\n3 0 1 99\n"),
             "element 'face' 0: vertex index 99, expected a whole index from 0 of the 10 vertices"},
            {changed("\n3 0 1 6\n", "\n0\n"), "element 'face' 0: a face of no vertices"}}) {
-    const std::string path = WriteFile(dir, "bad.ply", text);
+    const std::string path = test::WriteFile(dir, "bad.ply", text);
     EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(path); }),
               path + ": not a readable PLY file: " + expected);
   }
   // Blank lines and CRLF line ends are read as the shipped file.
   std::string crlf;
   for (const char c : ply.substr(body)) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
-  const std::string loose = WriteFile(dir, "loose.ply", ply.substr(0, body) + "\n" + crlf + "\n");
+  const std::string loose =
+      test::WriteFile(dir, "loose.ply", ply.substr(0, body) + "\n" + crlf + "\n");
   EXPECT_EQ(LoadMeshFile(loose).triangles,
             LoadMeshFile(test::SourcePath("scenes/meshes/quay_wall.ply")).triangles);
 }
@@ -200,7 +196,7 @@ TEST(MeshFile, PlyFilesAssimpCannotReadAreClearErrors) {
 TEST(MeshFile, BinaryPlyOfEitherOrderLoadsAsTheAscii) {
   test::TempDir dir;
   const std::string ascii = QuayWallPly();
-  const MeshFileData expected = LoadMeshFile(WriteFile(dir, "ascii.ply", ascii));
+  const MeshFileData expected = LoadMeshFile(test::WriteFile(dir, "ascii.ply", ascii));
   const std::size_t body = ascii.find("end_header\n") + 11;
   std::istringstream numbers(ascii.substr(body));
   std::vector<float> xyz(30);
@@ -225,13 +221,13 @@ TEST(MeshFile, BinaryPlyOfEitherOrderLoadsAsTheAscii) {
       text += '\x03';
       for (std::size_t k = f; k < f + 3; ++k) put(&faces[k], sizeof faces[k]);
     }
-    const MeshFileData read = LoadMeshFile(WriteFile(dir, "binary.ply", text));
+    const MeshFileData read = LoadMeshFile(test::WriteFile(dir, "binary.ply", text));
     EXPECT_EQ(read.triangles, expected.triangles);
     ASSERT_EQ(read.vertices.size(), expected.vertices.size());
     for (std::size_t v = 0; v < read.vertices.size(); ++v) {
       EXPECT_EQ(read.vertices[v], expected.vertices[v]);
     }
-    const std::string cut = WriteFile(dir, "cut.ply", text.substr(0, text.size() - 1));
+    const std::string cut = test::WriteFile(dir, "cut.ply", text.substr(0, text.size() - 1));
     EXPECT_NE(test::InputErrorOf([&] {
                 (void)LoadMeshFile(cut);
               }).find("the body ends in element 'face' 15 of the 16"),
@@ -251,7 +247,7 @@ TEST(MeshFile, ColladaFilesAssimpCannotReadAreClearErrors) {
   for (const std::string item : {"x", "1.5", "-1", "4000000000"}) {
     std::string text = dae;
     text.replace(list, 6, "<p>0 " + item);
-    const std::string path = WriteFile(dir, "bad.dae", text);
+    const std::string path = test::WriteFile(dir, "bad.dae", text);
     EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(path); }),
               path + ":22: not a readable COLLADA file: <p> holds '" + item +
                   "' where an index (a whole number from 0 to 2^31 - 1) belongs");
@@ -262,7 +258,7 @@ TEST(MeshFile, ColladaFilesAssimpCannotReadAreClearErrors) {
   for (const std::string said : {"xount=\"24\"", "count=\"10\"", "count=\"x\""}) {
     std::string text = dae;
     text.replace(array, 10, said);
-    const std::string path = WriteFile(dir, "bad.dae", text);
+    const std::string path = test::WriteFile(dir, "bad.dae", text);
     EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(path); }),
               path + ":12: not a readable COLLADA file: <float_array> holds 24 items, expected " +
                   "its count attribute to say so, as count=\"24\"");
@@ -271,10 +267,10 @@ TEST(MeshFile, ColladaFilesAssimpCannotReadAreClearErrors) {
   const auto triangles = LoadMeshFile(test::SourcePath("scenes/meshes/crate.dae")).triangles;
   std::string plus = dae;
   plus.replace(list, 6, "<p>0 +2");
-  EXPECT_EQ(LoadMeshFile(WriteFile(dir, "plus.dae", plus)).triangles, triangles);
+  EXPECT_EQ(LoadMeshFile(test::WriteFile(dir, "plus.dae", plus)).triangles, triangles);
   std::string quoted = dae;
   quoted.replace(array, 10, "count = '+024'");
-  EXPECT_EQ(LoadMeshFile(WriteFile(dir, "quoted.dae", quoted)).triangles, triangles);
+  EXPECT_EQ(LoadMeshFile(test::WriteFile(dir, "quoted.dae", quoted)).triangles, triangles);
 }
 
 }  // namespace

@@ -182,14 +182,13 @@ TEST(MatLog, AnArrayLargerThanItsBytesIsRefused) {
   u32(5), u32(8), u32(1), u32(2000000000);  // 1 x 2e9
   u32(1), u32(10), mat += std::string("parsedData\0\0\0\0\0\0", 16);
   u32(9), u32(8), mat += std::string("\0\0\0\0\0\0\xf0\x3f", 8);  // one double, 1.0
-  const std::string path = (dir.path() / "huge.mat").string();
-  std::ofstream(path, std::ios::binary) << mat;
+  const std::string path = test::WriteFile(dir, "huge.mat", mat);
   EXPECT_EQ(
       test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
       path + ": a corrupt MAT file (an array of 2000000000 elements holds 8 bytes of values)");
   // The same file stating the one element it holds is read as far as its layout: not a struct.
   mat.replace(128 + 8 + 16 + 8 + 4, 4, std::string("\x01\0\0\0", 4));
-  std::ofstream(path, std::ios::binary) << mat;
+  test::WriteFile(dir, "huge.mat", mat);
   EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
             path + ": 'parsedData' is not a struct array");
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <string>
 
@@ -38,6 +39,13 @@ inline std::string InputErrorOf(const std::function<void()>& f) {
     return e.what();
   }
   return "";
+}
+
+/// Writes `text` byte for byte to the file `name` in `dir`; returns its path.
+inline std::string WriteFile(const TempDir& dir, const std::string& name, const std::string& text) {
+  const std::string path = (dir.path() / name).string();
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
 }
 
 inline std::string SourcePath(const std::string& relative) {
