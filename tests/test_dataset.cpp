@@ -234,14 +234,26 @@ TEST_F(TankDataset, NeverOverwritesWithoutForceAndNeverDeletesStrangers) {
   EXPECT_TRUE(sim::SimulateDataset(*scene_, out.string(), other_seed).complete);
   EXPECT_EQ(mapping::ReadDataset(out.string()).manifest["seed"], 99);
 
+  // A directory sonarbench did not write: a file of a name a dataset uses is refused, even with
+  // --force; other files stay as they are beside a dataset, whatever --force.
   const auto stranger = dir.path() / "home";
-  fs::create_directories(stranger);
+  fs::create_directories(stranger / "src");
   std::ofstream(stranger / "thesis.tex") << "precious";
+  std::ofstream(stranger / "src/main.c") << "int main;";
+  std::ofstream(stranger / "manifest.json") << R"({"name": "webapp"})";
   EXPECT_NE(test::InputErrorOf([&] {
               (void)sim::SimulateDataset(*scene_, stranger.string(), other_seed);
-            }).find("not a sonarbench dataset"),
+            }).find("holds files sonarbench did not write: manifest.json"),
             std::string::npos);
+  EXPECT_EQ(Bytes(stranger / "manifest.json"), R"({"name": "webapp"})");
+  EXPECT_FALSE(fs::exists(stranger / ".sonarbench.lock"));
+  fs::remove(stranger / "manifest.json");
+  EXPECT_TRUE(sim::SimulateDataset(*scene_, stranger.string(), other_seed).complete);
+  other_seed.seed = 98;
+  EXPECT_TRUE(sim::SimulateDataset(*scene_, stranger.string(), other_seed).complete);
+  EXPECT_EQ(mapping::ReadDataset(stranger.string()).manifest["seed"], 98);
   EXPECT_EQ(Bytes(stranger / "thesis.tex"), "precious");
+  EXPECT_EQ(Bytes(stranger / "src/main.c"), "int main;");
 }
 
 TEST_F(TankDataset, ADamagedFileIsNamed) {

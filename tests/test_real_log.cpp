@@ -17,10 +17,12 @@
 
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mat_log.hpp"
+#include "sonarbench/sim/dataset_writer.hpp"
 #include "sonarbench/sim/fidelity.hpp"
 #include "sonarbench/sim/map_log.hpp"
 #include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/scenario.hpp"
+#include "sonarbench/sim/scenario_report.hpp"
 #include "sonarbench/sim/scene.hpp"
 #include "sonarbench/sim/score.hpp"
 #include "sonarbench/sim/simulation.hpp"
@@ -31,15 +33,12 @@ namespace {
 
 using mapping::kDegToRad;
 
-// The real log ships beside the repository, in shared/ (see shared/data/cras-tank-static).
+// The real log ships in the repository (data/cras-tank-static/README.md).
 std::string RealLogPath() {
-  return test::SourcePath("../shared/data/cras-tank-static/dataset_static.mat");
+  return test::SourcePath("data/cras-tank-static/dataset_static.mat");
 }
 
-#define REQUIRE_REAL_LOG()                                                                     \
-  if (!std::filesystem::exists(RealLogPath())) {                                               \
-    GTEST_SKIP() << "no real log at " << RealLogPath() << " (shared/ is not beside the repo)"; \
-  }
+#define REQUIRE_REAL_LOG() ASSERT_TRUE(std::filesystem::exists(RealLogPath())) << RealLogPath()
 
 // The facts the data folder's README lists, which an importer must reproduce.
 TEST(MatLog, ReadsTheRealLogAsItsReadmeDescribes) {
@@ -266,6 +265,37 @@ TEST(RealLogMap, FolderHoldingOneLogMeansThatLog) {
 // The real tank through `sonarbench map`'s defaults: its walls must come out straight and the
 // square closed. Wall candidates are the occupied cells at the sonar's height (|z| ≤ one cell)
 // beyond 1.6 m (inside lie the floor ring and the vehicle's own echoes), binned by 1° of bearing.
+// `import LOG --out DIR; map DIR --scene S --score` and `map LOG --scene S --score` map the same
+// beams from the same pose (the scene's static sonar): the same metrics, field for field.
+TEST(RealLogMap, AnImportedLogScoresAsTheMatLogDoes) {
+  REQUIRE_REAL_LOG();
+  test::TempDir dir;
+  const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  const std::string imported = (dir.path() / "imported").string();
+  (void)sim::ImportLogDataset(RealLogPath(), mapping::ReadMatLog(RealLogPath()),
+                              mapping::SensorGeometry{}, imported, false);
+  const sim::LogMapResult from_mat =
+      sim::MapLog(RealLogPath(), scene.sensor.geometry, scene.mapping, &scene);
+  const sim::LogMapResult from_dataset =
+      sim::MapLog(imported, scene.sensor.geometry, scene.mapping, &scene);
+  const nlohmann::json a = sim::MetricsJson(sim::ScoreLogMap(from_mat, scene));
+  const nlohmann::json b = sim::MetricsJson(sim::ScoreLogMap(from_dataset, scene));
+  EXPECT_GT(a["counts"]["true_positive_cells"].get<std::size_t>(), 100u);
+  EXPECT_EQ(a, b);
+  // A dataset simulated from one scene is not scored against another.
+  const sim::Scene harbour = sim::LoadScene(test::SourcePath("scenes/harbour-wall.yaml"));
+  sim::Scene one_sweep = scene;
+  one_sweep.sweeps = 1;
+  const std::string simulated = (dir.path() / "simulated").string();
+  (void)sim::SimulateDataset(one_sweep, simulated, {});
+  const std::string error = test::InputErrorOf(
+      [&] { (void)sim::MapLog(simulated, harbour.sensor.geometry, harbour.mapping, &harbour); });
+  EXPECT_NE(error.find("a dataset of scene 'cras-tank' (manifest.json); it cannot be scored "
+                       "against scene 'harbour-wall'"),
+            std::string::npos)
+      << error;
+}
+
 TEST(RealLogMap, TankWallsAreStraightAndClosed) {
   REQUIRE_REAL_LOG();
   const auto result =
@@ -751,7 +781,7 @@ TEST(Fidelity, NearRangeIsMeasuredPerHeadAngle) {
 }
 
 // The real log's statistics that the guard below holds the simulated tank to, as `sonarbench
-// fidelity scenes/cras-tank.yaml ../shared/data/cras-tank-static/dataset_static.mat` measures
+// fidelity scenes/cras-tank.yaml data/cras-tank-static/dataset_static.mat` measures
 // them (its "real" side; docs/fidelity.md), recorded here so that the guard runs where the log
 // is not (CI's fresh clone); RecordedRealLogStatisticsAreTheLogs checks them against the log.
 struct RealTank {

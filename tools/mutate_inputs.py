@@ -2,7 +2,7 @@
 """Feeds sonarbench damaged copies of a good input and checks that it never crashes.
 
     python3 tools/mutate_inputs.py build/sim/sonarbench scene scenes/cras-tank.yaml --cases 400
-    python3 tools/mutate_inputs.py build/sim/sonarbench mat ../shared/data/cras-tank-static/dataset_static.mat
+    python3 tools/mutate_inputs.py build/sim/sonarbench mat data/cras-tank-static/dataset_static.mat
     python3 tools/mutate_inputs.py build/sim/sonarbench mesh scenes/meshes/quay_wall.ply --seed 9
 
 scene: each `key: value` line's value replaced by one of a set of bad values (a negative, zero,

@@ -13,25 +13,36 @@
 #include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench {
+namespace {
+
+// The OS's reason for the last failed call, or a plain word when the stream library left none.
+std::string Reason() { return errno != 0 ? std::strerror(errno) : "write failed"; }
+
+}  // namespace
 
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
   const std::string temp = path + ".tmp." + std::to_string(::getpid());
   try {
     {
+      errno = 0;
       std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-      if (!out) throw std::runtime_error(path + ": cannot create " + temp);
+      if (!out) throw EnvironmentError(path + ": cannot be written (" + Reason() + ")");
       write(out);
       out.flush();
-      if (!out) throw std::runtime_error(path + ": write failed");
+      if (!out) throw EnvironmentError(path + ": cannot be written (" + Reason() + ")");
+      out.close();
+      if (!out) throw EnvironmentError(path + ": cannot be written (" + Reason() + ")");
     }
     const int fd = ::open(temp.c_str(), O_RDONLY);
     if (fd < 0 || ::fsync(fd) != 0) {
       const std::string reason = std::strerror(errno);
       if (fd >= 0) ::close(fd);
-      throw std::runtime_error(path + ": fsync failed: " + reason);
+      throw EnvironmentError(path + ": cannot be written (fsync: " + reason + ")");
     }
     ::close(fd);
-    std::filesystem::rename(temp, path);
+    std::error_code error;
+    std::filesystem::rename(temp, path, error);
+    if (error) throw EnvironmentError(path + ": cannot be written (" + error.message() + ")");
   } catch (...) {
     std::error_code ignored;
     std::filesystem::remove(temp, ignored);
@@ -61,7 +72,7 @@ void CheckOutputDirectory(const std::string& dir) {
     why = ": no permission to make a directory in it";
   }
   if (!why.empty()) {
-    throw InputError(dir + ": cannot be made the output directory (" + ancestor.string() + why +
+    throw EnvironmentError(dir + ": cannot be made the output directory (" + ancestor.string() + why +
                      "; expected a path where a directory can be made)");
   }
 }
@@ -71,7 +82,7 @@ void CreateOutputDirectory(const std::string& dir) {
   std::error_code error;
   std::filesystem::create_directories(dir, error);
   if (error) {
-    throw InputError(dir + ": cannot be made the output directory (" + error.message() +
+    throw EnvironmentError(dir + ": cannot be made the output directory (" + error.message() +
                      "; expected a path where a directory can be made)");
   }
 }

@@ -23,6 +23,7 @@
 #include "sonarbench/sim/fidelity.hpp"
 #include "sonarbench/sim/map_log.hpp"
 #include "sonarbench/sim/mesh.hpp"
+#include "sonarbench/sim/output_directory.hpp"
 #include "sonarbench/sim/scenario.hpp"
 #include "sonarbench/sim/scenario_report.hpp"
 #include "sonarbench/sim/scene.hpp"
@@ -130,6 +131,24 @@ void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::Sc
   for (const auto& reason : v.reasons) std::cout << "  " << reason << "\n";
 }
 
+// What a one-shot command (run, map, fidelity) claims in its --out: `files`, `record` last; the
+// files it reads are never written or removed.
+sonarbench::sim::OutputClaim OneShotClaim(std::string command, std::vector<std::string> files,
+                                          std::vector<std::string> inputs) {
+  namespace sim = sonarbench::sim;
+  std::erase(inputs, std::string());
+  std::string what = command;
+  for (const std::string& input : inputs) what += "\n" + input;
+  sim::OutputClaim claim;
+  claim.command = std::move(command);
+  claim.config_sha256 = sonarbench::mapping::Sha256(what);
+  claim.mode = sim::OutputMode::kReplace;
+  claim.record = files.front();
+  claim.files = std::move(files);
+  claim.inputs = std::move(inputs);
+  return claim;
+}
+
 struct MapArgs {
   std::string input;
   std::string out = "out/map";
@@ -159,12 +178,18 @@ int Map(const MapArgs& args) {
   // A .mat log scored against the scene is mapped from the scene's sonar pose.
   std::optional<sonarbench::sim::Scene> scene;
   if (args.score) scene = sonarbench::sim::LoadScene(args.scene);
+  std::vector<std::string> files = sonarbench::sim::kLogMapOutputFiles;
+  std::rotate(files.begin(), files.end() - 1, files.end());  // the record, report.json, first
+  sonarbench::sim::OutputDirectory out(
+      args.out, OneShotClaim("map", files, {args.input, args.scene, args.sensor, args.mapping}));
   auto result = sonarbench::sim::MapLog(args.input, sensor, config, scene ? &*scene : nullptr);
   if (scene) result.metrics = sonarbench::sim::ScoreLogMap(result, *scene);
-  sonarbench::sim::WriteLogMapOutputs(args.out, result);
+  sonarbench::sim::WriteLogMapOutputs(out.write_root().string(), result);
+  out.Commit();
   const auto& t = result.totals;
   std::cout << result.beams << " beams (" << result.truncated_beams << " truncated) in "
             << result.sweeps << " sweeps; " << t.beams_with_obstacle << " with an obstacle\n";
+  for (const std::string& warning : result.warnings) std::cout << "warning: " << warning << "\n";
   if (result.metrics)
     std::cout << "against " << args.scene << ": " << MetricsLine(*result.metrics) << "\n";
   std::cout << "timing [s]: import " << result.import_s << ", map " << result.map_s << "\n"
@@ -218,6 +243,9 @@ int Fidelity(const FidelityArgs& args) {
   }
   const sonarbench::mapping::MatLog log = sonarbench::mapping::ReadMatLog(args.log);
   const auto meshes = sim::BuildSceneMeshes(scene);
+  std::vector<std::string> inputs = sim::SceneInputFiles(scene);
+  inputs.push_back(args.log);
+  sim::OutputDirectory out(args.out, OneShotClaim("fidelity", sim::kFidelityOutputFiles, inputs));
   const sim::RayTracer tracer(meshes);
   const auto synthesized =
       sim::SimulateScene(scene, tracer, args.seed.value_or(scene.seed), args.threads);
@@ -227,9 +255,10 @@ int Fidelity(const FidelityArgs& args) {
   const auto per_sweep = static_cast<std::size_t>(g.BeamsPerSweep());
   const std::span<const sonarbench::mapping::Beam> sim_all(beams);
   const std::span<const sonarbench::mapping::Beam> real_all(log.beams);
-  sim::WriteFidelityOutputs(args.out, report, sim_all.first(std::min(per_sweep, sim_all.size())),
+  sim::WriteFidelityOutputs(out.write_root().string(), report, sim_all.first(std::min(per_sweep, sim_all.size())),
                             real_all.first(std::min(per_sweep, real_all.size())), g, args.scene,
                             args.log);
+  out.Commit();
   std::cout << "mean intensity vs range: correlation " << report.profile_correlation_all
             << " (all bins), " << report.profile_correlation_usable
             << " (past self-reflection); mean |difference| " << report.profile_mean_abs_difference
@@ -462,37 +491,49 @@ void AddThreadsOption(CLI::App* command, int& threads) {
       ->capture_default_str();
 }
 
-int Run(const RunArgs& args) {
-  // Made before any work: a run writes its junit.xml there even when the scene is refused.
-  sonarbench::CreateOutputDirectory(args.out);
-  const sonarbench::sim::Scene scene = sonarbench::sim::LoadScene(args.scene);
-  sonarbench::sim::RunOptions options;
-  options.seed = args.seed;
-  options.threads = args.threads;
-  ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
-  options.progress = [&](std::string_view stage, std::size_t done, std::size_t total) {
-    progress.Update(stage, done, total);
-  };
-  const auto result = sonarbench::sim::RunScenario(scene, options);
-  progress.Clear();
-  sonarbench::sim::WriteScenarioOutputs(args.out, scene, result);
-  PrintSummary(scene, result, args.out);
-  return result.verdict.passed ? 0 : kExitCriteriaFailed;
-}
-
-// A run that broke still leaves a junit.xml saying so, for the CI system that collects it.
-void WriteErrorJunit(const RunArgs& args, std::string_view type, const std::string& message) {
-  // Not where the output directory itself is refused: that error was the message.
-  std::error_code unusable;
-  std::filesystem::create_directories(args.out, unusable);
-  if (unusable) return;
+// A run that broke still leaves a junit.xml saying so (and nothing of an earlier run), for the CI
+// system that collects it.
+void CommitErrorJunit(sonarbench::sim::OutputDirectory& out, const RunArgs& args,
+                      std::string_view type, const std::string& message) {
   try {
     const std::string xml = sonarbench::sim::ErrorJunitXml(
         std::filesystem::path(args.scene).stem().string(), type, message);
-    sonarbench::WriteFileAtomically((std::filesystem::path(args.out) / "junit.xml").string(),
-                                    [&](std::ostream& out) { out << xml; });
+    sonarbench::WriteFileAtomically((out.write_root() / "junit.xml").string(),
+                                    [&](std::ostream& file) { file << xml; });
+    out.Commit();
   } catch (const std::exception& e) {
     std::cerr << "sonarbench: could not write junit.xml: " << e.what() << "\n";
+  }
+}
+
+int Run(const RunArgs& args) {
+  namespace sim = sonarbench::sim;
+  std::vector<std::string> files = sim::kScenarioOutputFiles;
+  std::erase(files, "report.json");
+  files.insert(files.begin(), "report.json");
+  // Taken before any work: a run writes its junit.xml there even when the scene is refused.
+  sim::OutputDirectory out(args.out, OneShotClaim("run", files, {args.scene}));
+  try {
+    const sim::Scene scene = sim::LoadScene(args.scene);
+    sim::RunOptions options;
+    options.seed = args.seed;
+    options.threads = args.threads;
+    ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
+    options.progress = [&](std::string_view stage, std::size_t done, std::size_t total) {
+      progress.Update(stage, done, total);
+    };
+    const auto result = sim::RunScenario(scene, options);
+    progress.Clear();
+    sim::WriteScenarioOutputs(out.write_root().string(), scene, result);
+    out.Commit();
+    PrintSummary(scene, result, args.out);
+    return result.verdict.passed ? 0 : kExitCriteriaFailed;
+  } catch (const sonarbench::InputError& e) {
+    CommitErrorJunit(out, args, "input_error", e.what());
+    throw;
+  } catch (const std::exception& e) {
+    CommitErrorJunit(out, args, "internal_error", e.what());
+    throw;
   }
 }
 
@@ -695,11 +736,13 @@ int main(int argc, char** argv) {
     if (*sweep_cmd) return Sweep(sweep);
   } catch (const sonarbench::InputError& e) {
     std::cerr << "sonarbench: error: " << e.what() << "\n";
-    if (*run_cmd) WriteErrorJunit(run, "input_error", e.what());
+    return kExitBadInput;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // The machine's refusal (a read-only or full disk, no permission), with the OS's reason.
+    std::cerr << "sonarbench: error: " << e.what() << "\n";
     return kExitBadInput;
   } catch (const std::exception& e) {
     std::cerr << "sonarbench: internal error: " << e.what() << "\n";
-    if (*run_cmd) WriteErrorJunit(run, "internal_error", e.what());
     return kExitInternalError;
   }
   return kExitInternalError;

@@ -15,6 +15,7 @@
 #include "sonarbench/sim/ground_truth.hpp"
 #include "sonarbench/sim/images.hpp"
 #include "sonarbench/sim/mesh.hpp"
+#include "sonarbench/sim/output_directory.hpp"
 #include "sonarbench/sim/ray_tracer.hpp"
 #include "sonarbench/sim/report.hpp"
 #include "sonarbench/sim/simulation.hpp"
@@ -39,51 +40,45 @@ std::string Number(double value) {
   return text;
 }
 
-// The config hash stored in a manifest or partial marker; "" when the file is absent, "?" when
-// it is unreadable.
+// The config hash stored in a manifest; nullopt when it is absent or unreadable.
 std::optional<std::string> StoredConfig(const fs::path& file) {
   if (!fs::is_regular_file(file)) return std::nullopt;
   try {
     return json::parse(ReadFileBytes(file.string())).at("config_sha256").get<std::string>();
   } catch (const std::exception&) {
-    return std::string("?");
+    return std::nullopt;
   }
 }
 
-// Readies `dir` for the dataset of `config`. Returns true when a complete dataset of that very
-// configuration is already there (nothing to do).
-bool PrepareDirectory(const std::string& dir, const std::string& config, bool force) {
-  const fs::path root(dir);
-  CheckOutputDirectory(dir);
-  const auto complete = StoredConfig(root / "manifest.json");
-  const auto partial = StoredConfig(root / kPartialMarker);
-  const bool is_dataset = complete || partial;
-  const bool empty = !fs::exists(root) || fs::is_empty(root);
-  if (!empty && !is_dataset) {
-    throw InputError(dir +
-                     ": holds files that are not a sonarbench dataset; choose an empty or "
-                     "new directory (--force never deletes what is not a dataset)");
+// Every file a dataset of `sweeps` sweeps holds (with truth when simulated), and the partial
+// marker: what its output directory claims.
+OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sweeps,
+                         bool simulated, bool force) {
+  OutputClaim claim;
+  claim.command = std::move(command);
+  claim.config_sha256 = std::move(config);
+  claim.mode = OutputMode::kResume;
+  claim.files = {"manifest.json", kPartialMarker, "poses/sonar.tum"};
+  if (simulated) {
+    claim.files.insert(claim.files.end(),
+                       {"poses/sonar_true.tum", "poses/vehicle.tum", "truth/occupancy.bt"});
   }
-  if (force) {
-    if (!empty) fs::remove_all(root);
-  } else if (complete) {
-    if (*complete == config) return true;
-    throw InputError(dir + ": holds a dataset of another configuration (config_sha256 " +
-                     *complete + "); pass --force to replace it");
-  } else if (partial && *partial != config) {
-    throw InputError(dir +
-                     ": holds a partial dataset of another configuration; pass --force to "
-                     "replace it");
+  for (std::size_t s = 0; s < sweeps; ++s) {
+    claim.files.push_back(mapping::SweepFile("beams", s, "bin"));
+    claim.files.push_back(mapping::SweepFile("images", s, "png"));
+    if (simulated) claim.files.push_back(mapping::SweepFile("truth", s, "csv"));
   }
-  CreateOutputDirectory(dir);
+  claim.record = "manifest.json";
+  claim.force = force;
+  return claim;
+}
+
+// Readies an owned dataset directory for `config`. Returns true when a complete dataset of that
+// very configuration is already there (nothing to do).
+bool PrepareDirectory(const OutputDirectory& out, const std::string& config) {
+  const fs::path& root = out.root();
+  if (StoredConfig(root / "manifest.json") == config) return true;
   for (const char* sub : {"beams", "images", "truth", "poses"}) fs::create_directories(root / sub);
-  // Temporary files of a killed run are never whole: remove them.
-  for (const auto& entry : fs::recursive_directory_iterator(root)) {
-    if (entry.is_regular_file() &&
-        entry.path().filename().string().find(".tmp.") != std::string::npos) {
-      fs::remove(entry.path());
-    }
-  }
   if (!fs::exists(root / kPartialMarker)) {
     WriteText(root / kPartialMarker,
               json{{"format", mapping::kDatasetFormat}, {"config_sha256", config}}.dump(2) + "\n");
@@ -91,18 +86,15 @@ bool PrepareDirectory(const std::string& dir, const std::string& config, bool fo
   return false;
 }
 
-// Writes manifest.json over every file in `dir` (sha256 and size), then drops the marker.
-void Finalize(const std::string& dir, json manifest) {
-  const fs::path root(dir);
+// Writes manifest.json over the claimed files present (sha256 and size), then drops the marker.
+void Finalize(const OutputDirectory& out, const std::vector<std::string>& claimed, json manifest) {
+  const fs::path& root = out.root();
   std::vector<std::string> files;
-  for (const auto& entry : fs::recursive_directory_iterator(root)) {
-    if (!entry.is_regular_file()) continue;
-    const std::string relative = fs::relative(entry.path(), root).generic_string();
-    if (relative == "manifest.json" || relative == kPartialMarker ||
-        relative.find(".tmp.") != std::string::npos) {
-      continue;
+  for (const std::string& relative : claimed) {
+    if (relative != "manifest.json" && relative != kPartialMarker &&
+        fs::is_regular_file(root / relative)) {
+      files.push_back(relative);
     }
-    files.push_back(relative);
   }
   std::sort(files.begin(), files.end());
   json list = json::array();
@@ -223,6 +215,17 @@ std::string SceneConfigHash(const Scene& scene, std::uint64_t seed) {
   return mapping::Sha256(inputs.dump());
 }
 
+std::vector<std::string> SceneInputFiles(const Scene& scene) {
+  std::vector<std::string> files = {scene.file, scene.sensor_model_file};
+  files.insert(files.end(), scene.extends.begin(), scene.extends.end());
+  for (const auto* list : {&scene.meshes, &scene.vehicle}) {
+    for (const MeshSpec& mesh : *list) {
+      if (!mesh.file.empty()) files.push_back(mesh.file);
+    }
+  }
+  return files;
+}
+
 Shard ParseShard(const std::string& text) {
   int k = 0;
   int n = 0;
@@ -272,11 +275,15 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
   const BeamSynthesizer synthesizer = SceneSynthesizer(scene, tracer, seed);
-  if (PrepareDirectory(dir, summary.config_sha256, options.force)) {
+  OutputClaim claim =
+      DatasetClaim("simulate", summary.config_sha256, summary.sweeps_total, true, options.force);
+  claim.inputs = SceneInputFiles(scene);
+  const OutputDirectory out(dir, claim);
+  if (PrepareDirectory(out, summary.config_sha256)) {
     summary.complete = summary.already_complete = true;
     return summary;
   }
-  const fs::path root(dir);
+  const fs::path& root = out.root();
   const std::size_t beam_count = ScenarioBeamCount(scene);
   const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
   const auto first_sweep = static_cast<std::size_t>(options.shard.index);
@@ -340,7 +347,7 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   json mesh_names = json::array();
   for (const MeshSpec& mesh : scene.meshes) mesh_names.push_back(mesh.name);
   manifest["meshes"] = mesh_names;
-  Finalize(dir, manifest);
+  Finalize(out, claim.files, manifest);
   summary.complete = true;
   return summary;
 }
@@ -355,11 +362,16 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const mapping::MatL
                        {"log_sha256", mapping::Sha256OfFile(log_path)},
                        {"sensor", mapping::SensorGeometryJson(sensor)}};
   summary.config_sha256 = mapping::Sha256(inputs.dump());
-  if (PrepareDirectory(dir, summary.config_sha256, force)) {
+  CheckOutputDirectory(dir);
+  OutputClaim claim =
+      DatasetClaim("import", summary.config_sha256, summary.sweeps_total, false, force);
+  claim.inputs = {log_path};
+  const OutputDirectory out(dir, claim);
+  if (PrepareDirectory(out, summary.config_sha256)) {
     summary.complete = summary.already_complete = true;
     return summary;
   }
-  const fs::path root(dir);
+  const fs::path& root = out.root();
   const std::span<const mapping::Beam> all(log.beams);
   std::string poses;
   for (std::size_t s = 0; s < summary.sweeps_total; ++s) {
@@ -381,7 +393,7 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const mapping::MatL
   manifest["log"] = {{"file", log_path}, {"truncated_beams", log.truncated_beams}};
   manifest["seed"] = nullptr;
   manifest["truth"] = nullptr;
-  Finalize(dir, manifest);
+  Finalize(out, claim.files, manifest);
   summary.complete = true;
   return summary;
 }

@@ -15,6 +15,8 @@
 #include "sonarbench/sim/ground_truth.hpp"
 #include "sonarbench/sim/images.hpp"
 #include "sonarbench/sim/mesh.hpp"
+#include "sonarbench/sim/dataset_writer.hpp"
+#include "sonarbench/sim/output_directory.hpp"
 #include "sonarbench/sim/ray_tracer.hpp"
 #include "sonarbench/sim/report.hpp"
 #include "sonarbench/sim/score.hpp"
@@ -206,22 +208,25 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
       mapping::Sha256(SceneConfigHash(scene, seed) + "/sweeps " + std::to_string(scene.sweeps) +
                       "/coverage_beams " + std::to_string(options.coverage_beams) + "/items " +
                       std::to_string(options.items.size()));
-  const fs::path root(dir);
   CheckOutputDirectory(dir);
   // The meshes' preflight before the directory is made: bad input leaves none.
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
-  if (options.force) {
-    for (const char* f :
-         {"divisions.csv", "coverage_vs_divisions.png", "time_vs_divisions.png", "study.json"}) {
-      fs::remove(root / f);
-    }
-    fs::remove_all(root / "items");
-  }
-  CreateOutputDirectory(dir);
-  fs::create_directories(root / "items");
-
   const std::vector<StudyItem> items =
       options.items.empty() ? DivisionsStudyItems() : options.items;
+  OutputClaim claim;
+  claim.command = "sweep";
+  claim.config_sha256 = config;
+  claim.mode = OutputMode::kResume;
+  claim.files = {"divisions.csv", "coverage_vs_divisions.png", "time_vs_divisions.png",
+                 "study.json"};
+  for (std::size_t i = 0; i < items.size(); ++i) claim.files.push_back(ItemFile(i));
+  claim.record = "study.json";
+  claim.inputs = SceneInputFiles(scene);
+  claim.force = options.force;
+  const OutputDirectory out(dir, claim);
+  const fs::path& root = out.root();
+  fs::create_directories(root / "items");
+
   StudySummary summary;
   summary.items_total = items.size();
   std::vector<std::size_t> mine;

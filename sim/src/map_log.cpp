@@ -9,6 +9,7 @@
 #include "sonarbench/mapping/dataset.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mat_log.hpp"
+#include "sonarbench/sim/dataset_writer.hpp"
 #include "sonarbench/sim/images.hpp"
 #include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/ray_tracer.hpp"
@@ -39,6 +40,40 @@ std::string MatLogInDirectory(const std::string& input) {
                    " .mat logs; name the one to map:" + names);
 }
 
+namespace {
+
+// Where a dataset's beams are mapped to score them against `scene`: an imported log is static at
+// its own origin and goes to the scene's sonar pose, as a .mat log does; a simulated dataset keeps
+// its poses and must be of that scene. Differences that still allow a score go to `warnings`.
+std::optional<Eigen::Isometry3d> DatasetPlacement(const mapping::Dataset& dataset,
+                                                  const std::string& dir, const Scene& scene,
+                                                  std::vector<std::string>& warnings) {
+  const nlohmann::json& m = dataset.manifest;
+  const std::string source = m.value("source", "");
+  if (source == "import") return StaticSonarPose(scene);
+  if (source != "simulate") {
+    throw InputError(dir + "/manifest.json: 'source' is " + Quoted(source) +
+                     "; expected 'simulate' or 'import' to score it against a scene");
+  }
+  const nlohmann::json named = m.value("scene", nlohmann::json::object());
+  const std::string name = named.is_object() ? named.value("name", "") : "";
+  if (name != scene.name) {
+    throw InputError(dir + ": a dataset of scene " + Quoted(name) + " (manifest.json); it " +
+                     "cannot be scored against scene " + Quoted(scene.name) + " (" + scene.file +
+                     "): score it against the scene it was simulated from");
+  }
+  const nlohmann::json seed = m.value("seed", nlohmann::json());
+  if (seed.is_number_unsigned() &&
+      SceneConfigHash(scene, seed.get<std::uint64_t>()) != m.value("config_sha256", "")) {
+    warnings.push_back(dir + " was simulated from other files than " + scene.file +
+                       " and its meshes and sensor model now hold (config_sha256 differs): the "
+                       "truth is the scene's as it is now");
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
                     const mapping::MapperConfig& config, const Scene* place_in) {
   LogMapResult result;
@@ -50,8 +85,13 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
   if (log_file.empty() && std::filesystem::is_directory(input)) {
     mapping::Dataset dataset = mapping::ReadDataset(input);
     geometry = dataset.sensor;  // a dataset carries its sensor
+    const auto pose =
+        place_in ? DatasetPlacement(dataset, input, *place_in, result.warnings) : std::nullopt;
     beams = std::move(dataset.beams);
     result.source = "dataset";
+    if (pose) {
+      for (mapping::Beam& beam : beams) beam.T_world_sonar = *pose;
+    }
   } else {
     // The scene is checked before the log is read: a moving one is refused at once.
     const std::optional<Eigen::Isometry3d> pose =
@@ -152,6 +192,7 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) 
                    {"polar", "polar.png"},
                    {"fan", "fan.png"}}}});
   if (result.metrics) report["metrics"] = MetricsJson(*result.metrics);
+  if (!result.warnings.empty()) report["warnings"] = result.warnings;
   WriteJson((dir / "report.json").string(), report);
 }
 

@@ -14,6 +14,13 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The machine refused what the user asked of it: a read-only or full disk, no permission. The
+/// message names the path and gives the OS's reason; exit status 2 as for bad input.
+class EnvironmentError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 /// `text` quoted for a message: bytes outside printable ASCII as \xNN, and past `max` bytes cut
 /// with "..." (a damaged file's line may be binary, or megabytes without a newline).
 [[nodiscard]] std::string Quoted(std::string_view text, std::size_t max = 80);

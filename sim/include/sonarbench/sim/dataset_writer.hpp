@@ -4,6 +4,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "sonarbench/mapping/dataset.hpp"
 #include "sonarbench/mapping/mat_log.hpp"
@@ -18,6 +19,10 @@ struct Shard {
   int index = 0;
   int count = 1;
 };
+
+/// The files a scene reads: the scene, the scenes it extends, its sensor model and mesh files.
+/// Outputs never overwrite them.
+[[nodiscard]] std::vector<std::string> SceneInputFiles(const Scene& scene);
 
 /// Parses "K/N" (1 <= K <= N, K 1-based as cluster array jobs count); throws InputError.
 [[nodiscard]] Shard ParseShard(const std::string& text);

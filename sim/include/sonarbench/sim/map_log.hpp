@@ -32,6 +32,8 @@ struct LogMapResult {
   std::vector<BeamPose> poses;
   /// The map scored against a scene's surfaces (ScoreLogMap), if it was.
   std::optional<MapMetrics> metrics;
+  /// What the user should know about the score (a dataset simulated from other scene files).
+  std::vector<std::string> warnings;
 };
 
 /// The `.mat` log to read when `input` is a directory that is not a dataset (no manifest.json)
@@ -44,7 +46,8 @@ struct LogMapResult {
 /// sweep by sweep (BeamsPerSweep() consecutive beams each; the last sweep may be partial). A
 /// `.mat` log's vehicle is static at its own origin: with `place_in` every beam of one is mapped
 /// from that scene's static sonar pose instead (StaticSonarPose, to score it against the scene);
-/// a dataset's beams keep their own. Throws InputError for input that is not a readable log.
+/// a dataset's beams keep their own, but for an imported log's, which are placed the same way. A
+/// simulated dataset scored against another scene than its manifest names is refused. Throws InputError for input that is not a readable log.
 [[nodiscard]] LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
                                   const mapping::MapperConfig& config,
                                   const Scene* place_in = nullptr);
@@ -59,6 +62,10 @@ struct LogMapResult {
 /// from the poses the log's beams were mapped from, rays twice as dense as the scene's sensor
 /// samples each beam, over the log's own beam geometry.
 [[nodiscard]] MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene);
+
+/// The files WriteLogMapOutputs writes, relative to its `out_dir`.
+inline const std::vector<std::string> kLogMapOutputFiles = {
+    "map.bt", "map.ot", "map_top.png", "polar.png", "fan.png", "report.json"};
 
 /// Writes `map.bt`, `map.ot`, `map_top.png`, `polar.png`, `fan.png` and `report.json` (with the
 /// scores under "metrics" if the map was scored) into `out_dir`, each atomically, the report last.

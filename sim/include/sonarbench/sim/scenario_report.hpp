@@ -31,6 +31,11 @@ inline constexpr int kScenarioReportSchema = 2;
 [[nodiscard]] std::string ErrorJunitXml(std::string_view scenario, std::string_view error_type,
                                         std::string_view message);
 
+/// The files WriteScenarioOutputs writes (and an error junit.xml), relative to its `out_dir`.
+inline const std::vector<std::string> kScenarioOutputFiles = {
+    "map.bt",      "polar.png",   "fan.png",   "map_top.png",
+    "map_side.png", "report.json", "junit.xml", "report.html"};
+
 /// Writes, each file atomically, into `out_dir` (created if needed): map.bt, polar.png (the first
 /// sweep), fan.png, map_top.png and map_side.png (map against truth), report.json, junit.xml and
 /// report.html (self-contained: the images are embedded).

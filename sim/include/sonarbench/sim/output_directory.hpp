@@ -1,0 +1,92 @@
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace sonarbench::sim {
+
+/// How a command's outputs meet those of an earlier run in the same directory.
+enum class OutputMode {
+  /// One shot (run, map, fidelity): outputs go to a staging folder inside the directory and
+  /// Commit moves them into place, the record last; the earlier run's outputs go whole.
+  kReplace,
+  /// Resumable (simulate, import, sweep): outputs are written in place, each file atomically; a
+  /// run of the same configuration resumes (shards of it write at once), another configuration
+  /// is refused unless `force`.
+  kResume,
+};
+
+/// What a command will write into its output directory.
+struct OutputClaim {
+  /// The command's name, for messages and the marker.
+  std::string command;
+  /// What determines the outputs: writers of another configuration are refused.
+  std::string config_sha256;
+  OutputMode mode = OutputMode::kReplace;
+  /// Every file the command may write, relative to the directory, '/'-separated.
+  std::vector<std::string> files;
+  /// The file a reader trusts the others by (report.json, manifest.json): one of `files`.
+  std::string record;
+  /// Files the command reads: never written or removed.
+  std::vector<std::string> inputs;
+  /// kResume: remove what an earlier run listed in the marker before writing.
+  bool force = false;
+};
+
+/// A command's output directory, owned through a marker (`kMarkerFile`) that lists every file
+/// sonarbench may write there, and guarded by a lock (`kLockFile`): one configuration writes at a
+/// time. Only files the marker lists are ever replaced or removed; a directory tree never is.
+/// Errors (another writer, files of the user's in the way, a read-only or full disk) throw
+/// InputError naming the directory, the files or the OS's reason.
+class OutputDirectory {
+ public:
+  static constexpr const char* kMarkerFile = ".sonarbench-outputs.json";
+  static constexpr const char* kLockFile = ".sonarbench.lock";
+  static constexpr const char* kStageDir = ".sonarbench-stage";
+
+  /// Makes `dir` (following a symlink to one), takes the lock and writes the marker.
+  OutputDirectory(const std::string& dir, OutputClaim claim);
+  /// Releases the lock. Uncommitted staged files are removed, and so is a directory this object
+  /// made when it holds nothing but the marker and the lock.
+  ~OutputDirectory();
+  OutputDirectory(const OutputDirectory&) = delete;
+  OutputDirectory& operator=(const OutputDirectory&) = delete;
+
+  /// The directory as the user named it, for messages.
+  [[nodiscard]] const std::string& name() const { return name_; }
+  /// Where outputs are written: the staging folder (kReplace) or the directory (kResume).
+  [[nodiscard]] const std::filesystem::path& write_root() const { return write_root_; }
+  /// The directory itself (a symlink's target).
+  [[nodiscard]] const std::filesystem::path& root() const { return root_; }
+
+  /// kReplace: removes the earlier record, then the earlier run's claimed files this run did not
+  /// stage, moves the staged files into place and the record last. Throws logic_error for a
+  /// staged file outside the claim.
+  void Commit();
+
+ private:
+  void Open();
+  void Release() noexcept;
+  void CheckInputsAndCollisions(const std::vector<std::string>& owned) const;
+  void RemoveFiles(const std::vector<std::string>& files) const;
+  void WriteMarker(const std::vector<std::string>& files) const;
+  void WriteHolder() const;
+  [[nodiscard]] std::string Holder() const;
+
+  std::string name_;
+  OutputClaim claim_;
+  std::filesystem::path root_;
+  std::filesystem::path write_root_;
+  int lock_fd_ = -1;
+  bool created_ = false;
+  bool lock_created_ = false;
+  bool committed_ = false;
+};
+
+/// The files an output directory's marker lists, or nullopt when it has none (a directory
+/// sonarbench did not write).
+[[nodiscard]] std::optional<std::vector<std::string>> OwnedFiles(const std::filesystem::path& dir);
+
+}  // namespace sonarbench::sim
