@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "sonarbench/mapping/error.hpp"
@@ -233,35 +234,45 @@ TEST(SceneFile, AMaterialNamedTwiceInOneFileIsRefused) {
 // "" names no material, mesh or file: refused where it stands, not taken as "none given" (a
 // mesh whose material was "" once went on without one and ran out of memory).
 TEST(SceneFile, EmptyNamesAreRefused) {
-  const char* kEmpty = "expected a non-empty string, got ''";
+  const char* kEmpty = "expected a non-empty string of at most 4096 bytes, got ''";
+  const char* kEmptyName = "expected a name of 1 to 200 bytes, got ''";
   EXPECT_TRUE(IsTheOneError(
       SmallSceneRefusal(kRock, "{name: m, type: plane, size_m: [1, 1, 0], material: ''}", kStatic),
-      std::string("bad.yaml:7:57: key 'meshes[0].material': ") + kEmpty));
+      std::string("bad.yaml:7:57: key 'meshes[0].material': ") + kEmptyName));
   EXPECT_TRUE(IsTheOneError(
       SmallSceneRefusal(kRock, "{name: '', type: plane, size_m: [1, 1, 0], material: rock}",
                         kStatic),
-      std::string("key 'meshes[0].name': ") + kEmpty));
+      std::string("key 'meshes[0].name': ") + kEmptyName));
   EXPECT_TRUE(IsTheOneError(
       SmallSceneRefusal(kRock, "{name: m, type: file, file: '', material: rock}", kStatic),
       std::string("key 'meshes[0].file': ") + kEmpty));
   // The material's name is refused; the mesh that names a material it cannot find then is not
   // reported as well.
   EXPECT_TRUE(IsTheOneError(SmallSceneRefusal("{name: '', reflectivity: 0.5}", kPlane, kStatic),
-                            std::string("key 'materials[0].name': ") + kEmpty));
+                            std::string("key 'materials[0].name': ") + kEmptyName));
+  // Names land in reports: one past the limit is refused, and the message quotes it cut short.
+  const std::string long_name(sonarbench::kMaxNameBytes + 1, 'n');
+  const std::string refusal = SmallSceneRefusal(
+      kRock, "{name: " + long_name + ", type: plane, size_m: [1, 1, 0], material: rock}", kStatic);
+  EXPECT_NE(refusal.find("key 'meshes[0].name': expected a name of 1 to 200 bytes"),
+            std::string::npos)
+      << refusal;
+  EXPECT_LT(refusal.size(), 400u);
   test::TempDir dir;
   const std::string model = test::SourcePath("sensor-models/shad-micron.yaml");
   const std::string scene_tail =
       "\nsweeps: 1\nmaterials: [{name: m, reflectivity: 0.5}]\n"
       "meshes: [{name: bed, type: plane, size_m: [1, 1, 0], material: m}]\n"
       "trajectory: {type: static, position_m: [0, 0, 1]}\n";
-  for (const auto& [text, key] : std::vector<std::pair<std::string, std::string>>{
-           {"name: ''\nsensor_model: " + model + scene_tail, "'name'"},
-           {"name: x\nsensor_model: ''" + scene_tail, "'sensor_model'"},
-           {"name: x\nextends: ''\n", "'extends'"}}) {
+  for (const auto& [text, key, expected] :
+       std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"name: ''\nsensor_model: " + model + scene_tail, "'name'", kEmptyName},
+           {"name: x\nsensor_model: ''" + scene_tail, "'sensor_model'", kEmpty},
+           {"name: x\nextends: ''\n", "'extends'", kEmpty}}) {
     SCOPED_TRACE(text);
     const std::string path = test::WriteFile(dir, "empty.yaml", text);
     EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(path); },
-                                     {"empty.yaml:", "key " + key, kEmpty}));
+                                     {"empty.yaml:", "key " + key, expected}));
   }
   // A refused base is the one error: the keys it would have given are not reported missing.
   const std::string refused_base =

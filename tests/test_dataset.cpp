@@ -106,7 +106,8 @@ TEST(Sha256, MatchesFips180Vectors) {
 TEST(Shard, ParsesKOfNAndSlurmArrays) {
   EXPECT_EQ(sim::ParseShard("3/8").index, 2);
   EXPECT_EQ(sim::ParseShard("3/8").count, 8);
-  for (const char* bad : {"0/3", "4/3", "a/b", "1/0", "2", "1/2/3"}) {
+  for (const char* bad : {"0/3", "4/3", "a/b", "1/0", "2", "1/2/3", "1/ 3", " 1/3", "1/3 ", "+1/3",
+                          "1/+3", "1/", "/3", "99999999999/3"}) {
     EXPECT_NE(test::InputErrorOf([&] { (void)sim::ParseShard(bad); }).find("expected K/N"),
               std::string::npos)
         << bad;
@@ -120,10 +121,27 @@ TEST(Shard, ParsesKOfNAndSlurmArrays) {
   ASSERT_TRUE(shard.has_value());
   EXPECT_EQ(shard->index, 1);
   EXPECT_EQ(shard->count, 3);
+  // --array=1-5:2 runs tasks 1, 3 and 5 (count 3, step 2): shards 1/3, 2/3 and 3/3.
+  ::setenv("SLURM_ARRAY_TASK_MIN", "1", 1);
+  ::setenv("SLURM_ARRAY_TASK_STEP", "2", 1);
+  for (const auto& [task, index] : {std::pair{"1", 0}, std::pair{"3", 1}, std::pair{"5", 2}}) {
+    ::setenv("SLURM_ARRAY_TASK_ID", task, 1);
+    ASSERT_TRUE(sim::ShardFromSlurm().has_value());
+    EXPECT_EQ(sim::ShardFromSlurm()->index, index) << task;
+  }
+  for (const char* off_step : {"2", "7"}) {
+    ::setenv("SLURM_ARRAY_TASK_ID", off_step, 1);
+    EXPECT_NE(test::InputErrorOf([] { (void)sim::ShardFromSlurm(); }).find("outside the array"),
+              std::string::npos);
+  }
   ::setenv("SLURM_ARRAY_TASK_ID", "x", 1);
   EXPECT_NE(test::InputErrorOf([] { (void)sim::ShardFromSlurm(); }).find("SLURM_ARRAY_TASK_ID='x'"),
             std::string::npos);
-  for (const char* v : {"SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_MIN", "SLURM_ARRAY_TASK_COUNT"})
+  ::setenv("SLURM_ARRAY_TASK_ID", " 3", 1);
+  EXPECT_NE(test::InputErrorOf([] { (void)sim::ShardFromSlurm(); }).find("non-negative integer"),
+            std::string::npos);
+  for (const char* v : {"SLURM_ARRAY_TASK_ID", "SLURM_ARRAY_TASK_MIN", "SLURM_ARRAY_TASK_COUNT",
+                        "SLURM_ARRAY_TASK_STEP"})
     ::unsetenv(v);
 }
 

@@ -509,6 +509,84 @@ TEST(Cli, MapScoresALogAgainstASceneAsRunScoresItsSimulation) {
       << output;
 }
 
+// sonarbench writes only into what it owns: a user's files of its outputs' names are refused by
+// name and left as they were, --force or not; --force never removes a tree or an input; a
+// symlinked --out is followed, not replaced.
+TEST(Cli, NeverReplacesOrRemovesWhatItDidNotWrite) {
+  namespace fs = std::filesystem;
+  test::TempDir dir;
+  const auto scene = TankSceneWithCriteria(dir.path(), "");
+  std::string output;
+  const auto project = dir.path() / "project";
+  fs::create_directories(project / "src");
+  std::ofstream(project / "manifest.json") << R"({"name": "webapp"})";
+  std::ofstream(project / "src/main.c") << "int main;";
+  EXPECT_EQ(RunCli("simulate " + scene.string() + " --out " + project.string() + " --force",
+                   &output),
+            2);
+  EXPECT_NE(output.find("holds files sonarbench did not write: manifest.json"), std::string::npos)
+      << output;
+  EXPECT_EQ(ReadFile(project / "src/main.c"), "int main;");
+  EXPECT_EQ(ReadFile(project / "manifest.json"), R"({"name": "webapp"})");
+
+  // The log's own folder: a manifest.json of the user's is refused; without one the dataset goes
+  // beside the log, which --force never removes.
+  const auto logs = dir.path() / "logs";
+  fs::create_directories(logs);
+  fs::copy_file(test::SourcePath("data/cras-tank-static/dataset_static.mat"),
+                logs / "LOG.mat");
+  std::ofstream(logs / "manifest.json") << "{}";
+  const std::string import = "import " + (logs / "LOG.mat").string() + " --out " + logs.string();
+  EXPECT_EQ(RunCli(import + " --force", &output), 2);
+  EXPECT_NE(output.find("did not write: manifest.json"), std::string::npos) << output;
+  fs::remove(logs / "manifest.json");
+  EXPECT_EQ(RunCli(import, &output), 0) << output;
+  EXPECT_EQ(RunCli(import + " --force", &output), 0) << output;
+  EXPECT_EQ(fs::file_size(logs / "LOG.mat"),
+            fs::file_size(test::SourcePath("data/cras-tank-static/dataset_static.mat")));
+
+  // run and map refuse to overwrite a report, junit.xml or map the user wrote.
+  const auto results = dir.path() / "results";
+  fs::create_directories(results);
+  std::ofstream(results / "junit.xml") << "mine";
+  EXPECT_EQ(RunCli("run " + scene.string() + " --out " + results.string(), &output), 2);
+  EXPECT_NE(output.find("did not write: junit.xml"), std::string::npos) << output;
+  EXPECT_EQ(RunCli("map " + logs.string() + " --out " + results.string(), &output), 0) << output;
+  std::ofstream(results / "junit.xml", std::ios::trunc) << "still mine";
+  fs::remove(results / "map.bt");
+  std::ofstream(results / "map.bt") << "my map";
+  // map.bt is listed as sonarbench's, so the user's copy under that name is replaced; junit.xml,
+  // which map never claimed, stays.
+  EXPECT_EQ(RunCli("map " + logs.string() + " --out " + results.string(), &output), 0) << output;
+  EXPECT_EQ(ReadFile(results / "junit.xml"), "still mine");
+
+  // A symlinked --out is followed.
+  fs::create_directories(dir.path() / "real");
+  fs::create_directory_symlink(dir.path() / "real", dir.path() / "link");
+  EXPECT_EQ(RunCli("run " + scene.string() + " --out " + (dir.path() / "link").string(), &output),
+            0)
+      << output;
+  EXPECT_TRUE(fs::is_symlink(dir.path() / "link"));
+  EXPECT_TRUE(fs::exists(dir.path() / "real/report.json"));
+}
+
+// A dataset is scored only against the scene it was simulated from.
+TEST(Cli, ADatasetIsScoredOnlyAgainstItsOwnScene) {
+  test::TempDir dir;
+  const auto scene = TankSceneWithCriteria(dir.path(), "");
+  const auto ds = dir.path() / "ds";
+  std::string output;
+  ASSERT_EQ(RunCli("simulate " + scene.string() + " --out " + ds.string(), &output), 0) << output;
+  const std::string harbour = test::SourcePath("scenes/harbour-wall.yaml");
+  EXPECT_EQ(RunCli("map " + ds.string() + " --scene " + harbour + " --score --out " +
+                       (dir.path() / "map").string(),
+                   &output),
+            2);
+  EXPECT_NE(output.find("cannot be scored against scene 'harbour-wall'"), std::string::npos)
+      << output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "map"));
+}
+
 TEST(Cli, MissingSceneAndBadOptionsExitTwo) {
   std::string output;
   EXPECT_EQ(RunCli("run /nonexistent.yaml", &output), 2);

@@ -358,8 +358,15 @@ YamlReader::Check<std::string> OneOf(std::vector<std::string> choices) {
 
 YamlReader::Check<std::string> NonEmpty() {
   return [](const std::string& v) -> std::optional<std::string> {
-    if (!v.empty()) return std::nullopt;
-    return "a non-empty string";
+    if (!v.empty() && v.size() <= 4096) return std::nullopt;
+    return "a non-empty string of at most 4096 bytes";
+  };
+}
+
+YamlReader::Check<std::string> Name() {
+  return [](const std::string& v) -> std::optional<std::string> {
+    if (!v.empty() && v.size() <= kMaxNameBytes) return std::nullopt;
+    return "a name of 1 to " + std::to_string(kMaxNameBytes) + " bytes";
   };
 }
 

@@ -36,6 +36,7 @@ constexpr int kExitBadInput = 2;
 constexpr int kExitInternalError = 3;
 
 struct RunArgs {
+  sonarbench::sim::Budgets budgets;
   std::string scene;
   std::string out = "out";
   std::optional<std::uint64_t> seed;
@@ -92,6 +93,13 @@ class ProgressLine {
   std::chrono::steady_clock::time_point last_event_ = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point last_print_;
 };
+
+// The scene at `path`, to be built within `budgets`.
+sonarbench::sim::Scene LoadScene(const std::string& path, const sonarbench::sim::Budgets& budgets) {
+  sonarbench::sim::Scene scene = sonarbench::sim::LoadScene(path);
+  scene.budgets = budgets;
+  return scene;
+}
 
 // "occupied precision P (tp/occupied), recall R (..), coverage C (..)": a map's scores.
 std::string MetricsLine(const sonarbench::sim::MapMetrics& m) {
@@ -150,6 +158,7 @@ sonarbench::sim::OutputClaim OneShotClaim(std::string command, std::vector<std::
 }
 
 struct MapArgs {
+  sonarbench::sim::Budgets budgets;
   std::string input;
   std::string out = "out/map";
   std::string scene;
@@ -164,7 +173,7 @@ int Map(const MapArgs& args) {
   sonarbench::mapping::SensorGeometry sensor;
   sonarbench::mapping::MapperConfig config;
   if (!args.scene.empty()) {
-    const sonarbench::sim::Scene scene = sonarbench::sim::LoadScene(args.scene);
+    const sonarbench::sim::Scene scene = LoadScene(args.scene, args.budgets);
     sensor = scene.sensor.geometry;
     config = scene.mapping;
   }
@@ -177,12 +186,16 @@ int Map(const MapArgs& args) {
   config.threads = args.threads;
   // A .mat log scored against the scene is mapped from the scene's sonar pose.
   std::optional<sonarbench::sim::Scene> scene;
-  if (args.score) scene = sonarbench::sim::LoadScene(args.scene);
+  if (args.score) {
+    scene = LoadScene(args.scene, args.budgets);
+    sonarbench::sim::CheckBudgets(*scene, args.budgets);
+  }
   std::vector<std::string> files = sonarbench::sim::kLogMapOutputFiles;
   std::rotate(files.begin(), files.end() - 1, files.end());  // the record, report.json, first
   sonarbench::sim::OutputDirectory out(
       args.out, OneShotClaim("map", files, {args.input, args.scene, args.sensor, args.mapping}));
-  auto result = sonarbench::sim::MapLog(args.input, sensor, config, scene ? &*scene : nullptr);
+  auto result = sonarbench::sim::MapLog(args.input, sensor, config, scene ? &*scene : nullptr,
+                                        args.budgets);
   if (scene) result.metrics = sonarbench::sim::ScoreLogMap(result, *scene);
   sonarbench::sim::WriteLogMapOutputs(out.write_root().string(), result);
   out.Commit();
@@ -199,6 +212,7 @@ int Map(const MapArgs& args) {
 }
 
 struct FidelityArgs {
+  sonarbench::sim::Budgets budgets;
   std::string scene;
   std::string log;
   std::string out = "out/fidelity";
@@ -234,7 +248,7 @@ std::string Slashed(const std::array<double, N>& values) {
 int Fidelity(const FidelityArgs& args) {
   namespace sim = sonarbench::sim;
   sonarbench::CheckOutputDirectory(args.out);
-  const sim::Scene scene = sim::LoadScene(args.scene);
+  const sim::Scene scene = LoadScene(args.scene, args.budgets);
   if (const double range = scene.sensor.geometry.MaxRangeM(); args.wall_min_range_m >= range) {
     std::ostringstream message;
     message << "--wall-min-range " << args.wall_min_range_m << ": expected less than the sonar's "
@@ -352,6 +366,7 @@ sonarbench::sim::Shard ResolveShard(const std::string& option) {
 }
 
 struct SimulateArgs {
+  sonarbench::sim::Budgets budgets;
   std::string scene;
   std::string out;
   std::optional<std::uint64_t> seed;
@@ -363,7 +378,7 @@ struct SimulateArgs {
 
 int Simulate(const SimulateArgs& args) {
   namespace sim = sonarbench::sim;
-  const sim::Scene scene = sim::LoadScene(args.scene);
+  const sim::Scene scene = LoadScene(args.scene, args.budgets);
   sim::DatasetOptions options;
   options.seed = args.seed;
   options.threads = args.threads;
@@ -395,6 +410,7 @@ int Simulate(const SimulateArgs& args) {
 }
 
 struct SweepArgs {
+  sonarbench::sim::Budgets budgets;
   std::string scene;
   std::string out;
   std::optional<std::uint64_t> seed;
@@ -409,7 +425,7 @@ struct SweepArgs {
 int Sweep(const SweepArgs& args) {
   namespace sim = sonarbench::sim;
   sonarbench::CheckOutputDirectory(args.out);
-  const sim::Scene scene = sim::LoadScene(args.scene);
+  const sim::Scene scene = LoadScene(args.scene, args.budgets);
   sim::StudyOptions options;
   options.seed = args.seed;
   options.sweeps = args.sweeps;
@@ -482,6 +498,22 @@ void AddSeedOption(CLI::App* command, std::optional<std::uint64_t>& seed,
           "UINT64"));
 }
 
+// --max-triangles and --max-cells: what a run may build (Budgets), checked before building.
+void AddBudgetOptions(CLI::App* command, sonarbench::sim::Budgets& budgets) {
+  command
+      ->add_option("--max-triangles", budgets.max_triangles,
+                   "Refuse a scene whose meshes would make more triangles (estimated from the "
+                   "scene before anything is built)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command
+      ->add_option("--max-cells", budgets.max_cells,
+                   "Refuse a scene whose ground truth or map would hold more cells (estimated "
+                   "from the scene, or the log's poses, before anything is built)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
 // The --threads option every subcommand has.
 void AddThreadsOption(CLI::App* command, int& threads) {
   command
@@ -514,7 +546,7 @@ int Run(const RunArgs& args) {
   // Taken before any work: a run writes its junit.xml there even when the scene is refused.
   sim::OutputDirectory out(args.out, OneShotClaim("run", files, {args.scene}));
   try {
-    const sim::Scene scene = sim::LoadScene(args.scene);
+    const sim::Scene scene = LoadScene(args.scene, args.budgets);
     sim::RunOptions options;
     options.seed = args.seed;
     options.threads = args.threads;
@@ -553,6 +585,7 @@ CLI::App* AddRunCommand(CLI::App& app, RunArgs& args) {
       ->capture_default_str();
   AddSeedOption(command, args.seed, "Seed of every random draw; overrides the scene's 'seed'");
   AddThreadsOption(command, args.threads);
+  AddBudgetOptions(command, args.budgets);
   command->add_flag("--no-progress", args.no_progress,
                     "Never show the progress line (it shows only on a terminal, and never when "
                     "the CI environment variable is set)");
@@ -598,6 +631,7 @@ CLI::App* AddMapCommand(CLI::App& app, MapArgs& args) {
                  "beams keep their poses")
       ->needs(scene_opt);
   AddThreadsOption(command, args.threads);
+  AddBudgetOptions(command, args.budgets);
   return command;
 }
 
@@ -620,6 +654,7 @@ CLI::App* AddFidelityCommand(CLI::App& app, FidelityArgs& args) {
   command->add_option("-o,--out", args.out, "Output directory")->capture_default_str();
   AddSeedOption(command, args.seed, "Overrides the scene's seed");
   AddThreadsOption(command, args.threads);
+  AddBudgetOptions(command, args.budgets);
   command
       ->add_option("--wall-min-range", args.wall_min_range_m,
                    "Strongest echoes are sought beyond this range [m] (past the floor's)")
@@ -647,6 +682,7 @@ CLI::App* AddSimulateCommand(CLI::App& app, SimulateArgs& args) {
   command->add_option("-o,--out", args.out, "Dataset directory")->required();
   AddSeedOption(command, args.seed, "Overrides the scene's seed");
   AddThreadsOption(command, args.threads);
+  AddBudgetOptions(command, args.budgets);
   command->add_flag("--force", args.force,
                     "Replace an existing dataset (never deletes a directory that is not one)");
   command->add_option(
@@ -679,6 +715,7 @@ CLI::App* AddSweepCommand(CLI::App& app, SweepArgs& args) {
       ->check(CLI::Range(1, 10000))
       ->capture_default_str();
   AddThreadsOption(command, args.threads);
+  AddBudgetOptions(command, args.budgets);
   command->add_flag("--force", args.force, "Discard the items of an earlier study in --out");
   command->add_option("--shard", args.shard,
                       "K/N: run only settings i with i mod N = K-1 (default from SLURM_ARRAY_*)");

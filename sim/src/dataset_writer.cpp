@@ -3,6 +3,8 @@
 #include <octomap/OcTree.h>
 
 #include <algorithm>
+#include <cctype>
+#include <charconv>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -227,13 +229,19 @@ std::vector<std::string> SceneInputFiles(const Scene& scene) {
 }
 
 Shard ParseShard(const std::string& text) {
+  // Digits, a slash, digits: nothing else, not even a blank.
   int k = 0;
   int n = 0;
-  char slash = 0;
-  std::istringstream in(text);
-  std::string rest;
-  if (!(in >> k >> slash >> n) || slash != '/' || (in >> rest) || n < 1 || k < 1 || k > n) {
-    throw InputError("--shard '" + text + "': expected K/N with 1 <= K <= N, e.g. 3/8");
+  const char* end = text.data() + text.size();
+  const auto [after_k, k_error] = std::from_chars(text.data(), end, k);
+  const bool slash = k_error == std::errc() && after_k != end && *after_k == '/';
+  const auto [after_n, n_error] =
+      slash ? std::from_chars(after_k + 1, end, n) : std::from_chars_result{end, std::errc()};
+  const bool digits = !text.empty() && std::isdigit(static_cast<unsigned char>(text.front())) &&
+                      slash && after_k + 1 != end &&
+                      std::isdigit(static_cast<unsigned char>(after_k[1]));
+  if (!digits || n_error != std::errc() || after_n != end || n < 1 || k < 1 || k > n) {
+    throw InputError("--shard " + Quoted(text) + ": expected K/N with 1 <= K <= N, e.g. 3/8");
   }
   return {k - 1, n};
 }
@@ -244,23 +252,28 @@ std::optional<Shard> ShardFromSlurm() {
   if (id == nullptr || count == nullptr) return std::nullopt;
   const char* min = std::getenv("SLURM_ARRAY_TASK_MIN");
   auto number = [](const char* name, const char* value) {
-    char* end = nullptr;
-    const long v = std::strtol(value, &end, 10);
-    if (end == value || *end != '\0' || v < 0) {
-      throw InputError(std::string("environment variable ") + name + "='" + value +
-                       "': expected a non-negative integer");
+    const std::string_view text(value);
+    int v = -1;
+    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (text.empty() || error != std::errc() || end != text.data() + text.size() || v < 0) {
+      throw InputError(std::string("environment variable ") + name + "=" + Quoted(text) +
+                       ": expected a non-negative integer");
     }
-    return static_cast<int>(v);
+    return v;
   };
   const int task = number("SLURM_ARRAY_TASK_ID", id);
   const int tasks = number("SLURM_ARRAY_TASK_COUNT", count);
   const int first = min != nullptr ? number("SLURM_ARRAY_TASK_MIN", min) : 0;
-  if (tasks < 1 || task < first || task - first >= tasks) {
+  // --array=1-5:2 runs tasks 1, 3 and 5: a step of 2 between them.
+  const char* step_text = std::getenv("SLURM_ARRAY_TASK_STEP");
+  const int step = step_text != nullptr ? number("SLURM_ARRAY_TASK_STEP", step_text) : 1;
+  if (tasks < 1 || step < 1 || task < first || (task - first) % step != 0 ||
+      (task - first) / step >= tasks) {
     throw InputError("SLURM_ARRAY_TASK_ID " + std::to_string(task) + " is outside the array (min " +
-                     std::to_string(first) + ", count " + std::to_string(tasks) +
-                     "): pass --shard K/N");
+                     std::to_string(first) + ", step " + std::to_string(step) + ", count " +
+                     std::to_string(tasks) + "): pass --shard K/N");
   }
-  return Shard{task - first, tasks};
+  return Shard{(task - first) / step, tasks};
 }
 
 DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,

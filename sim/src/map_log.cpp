@@ -75,7 +75,8 @@ std::optional<Eigen::Isometry3d> DatasetPlacement(const mapping::Dataset& datase
 }  // namespace
 
 LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
-                    const mapping::MapperConfig& config, const Scene* place_in) {
+                    const mapping::MapperConfig& config, const Scene* place_in,
+                    const Budgets& budgets) {
   LogMapResult result;
   result.input = input;
   auto start = std::chrono::steady_clock::now();
@@ -111,6 +112,15 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
   auto now = std::chrono::steady_clock::now();
   result.import_s = std::chrono::duration<double>(now - start).count();
   result.beams = beams.size();
+
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hi = Eigen::Vector3d::Zero();
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    const Eigen::Vector3d p = beams[b].T_world_sonar.translation();
+    lo = b == 0 ? p : lo.cwiseMin(p);
+    hi = b == 0 ? p : hi.cwiseMax(p);
+  }
+  CheckMapCells(MapCellsEstimate(geometry, config.resolution_m, lo, hi), budgets, input);
 
   start = now;
   result.sensor = geometry;

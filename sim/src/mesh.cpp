@@ -53,6 +53,11 @@ TriangleMesh BuildMesh(const MeshSpec& spec, std::uint64_t seed) {
       break;
     }
     case MeshSpec::Type::kHeightField: {
+      // CheckBudgets refuses far fewer cells; this keeps the int conversions defined.
+      if (!(spec.size_m[0] / spec.cell_m < 1e7 && spec.size_m[1] / spec.cell_m < 1e7)) {
+        throw InputError("mesh '" + spec.name + "': 'cell_m' " + std::to_string(spec.cell_m) +
+                         " makes over 1e7 cells a side (expected a coarser grid)");
+      }
       const int nx = std::max(1, static_cast<int>(std::lround(spec.size_m[0] / spec.cell_m)));
       const int ny = std::max(1, static_cast<int>(std::lround(spec.size_m[1] / spec.cell_m)));
       const double k = 2.0 * std::numbers::pi / spec.wavelength_m;
@@ -167,6 +172,7 @@ std::vector<TriangleMesh> BuildMeshes(const Scene& scene, const std::vector<Mesh
 }  // namespace
 
 std::vector<TriangleMesh> BuildSceneMeshes(const Scene& scene) {
+  CheckBudgets(scene, scene.budgets);
   return BuildMeshes(scene, scene.meshes, 0x6d657368ULL);  // "mesh"
 }
 

@@ -26,7 +26,7 @@ Eigen::Isometry3d ReadPose(YamlReader& node) {
 MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
   MeshSpec m;
   std::string type;
-  node.Required("name", m.name, NonEmpty());
+  node.Required("name", m.name, Name());
   node.Required("type", type, OneOf({"tank", "box", "plane", "height_field", "file"}));
   m.type = type == "tank"           ? MeshSpec::Type::kTank
            : type == "plane"        ? MeshSpec::Type::kPlane
@@ -66,7 +66,7 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
   node.Optional("fill", m.fill);
   node.Optional("truth", m.truth);
   std::string material;
-  node.Required("material", material, NonEmpty());
+  node.Required("material", material, Name());
   bool found = false;
   for (std::size_t i = 0; i < materials.size(); ++i) {
     if (materials[i].name == material) {
@@ -158,7 +158,7 @@ void ReadMaterials(YamlReader& root, bool extending, std::vector<Material>& mate
   std::vector<std::string> names;
   for (YamlReader& item : root.Sequence("materials")) {
     Material m;
-    item.Required("name", m.name, NonEmpty());
+    item.Required("name", m.name, Name());
     item.Required("reflectivity", m.reflectivity, InRange(0.0, 1.0));
     item.Optional("backscatter_exponent", m.backscatter_exponent, InRange(0.0, 100.0));
     item.Optional("specular", m.specular, InRange(0.0, 1.0));
@@ -274,7 +274,7 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
   Scene scene = base ? *base : Scene{};
   scene.file = path;
   if (base) scene.extends.insert(scene.extends.begin(), base->file);
-  root.Required("name", scene.name, NonEmpty());
+  root.Required("name", scene.name, Name());
   if (!base) {
     root.Required("sensor_model", scene.sensor_model_file, NonEmpty());
   } else if (root.Has("sensor_model")) {

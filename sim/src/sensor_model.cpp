@@ -124,7 +124,7 @@ void CheckAcoustics(YamlReader& node, const Acoustics& merged,
 
 SensorModel ReadSensorModel(YamlReader& root) {
   SensorModel model;
-  root.Required("name", model.name, NonEmpty());
+  root.Required("name", model.name, Name());
   YamlReader geometry = root.Child("geometry");
   model.geometry = mapping::ReadSensorGeometry(geometry);
   YamlReader node = root.Child("acoustics");

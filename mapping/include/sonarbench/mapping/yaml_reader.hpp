@@ -100,5 +100,8 @@ class YamlReader {
 [[nodiscard]] YamlReader::Check<std::string> OneOf(std::vector<std::string> choices);
 /// A name or a path: "" names nothing, so it is refused rather than taken as "none given".
 [[nodiscard]] YamlReader::Check<std::string> NonEmpty();
+/// Names land in reports: 1 to kMaxNameBytes bytes.
+inline constexpr std::size_t kMaxNameBytes = 200;
+[[nodiscard]] YamlReader::Check<std::string> Name();
 
 }  // namespace sonarbench

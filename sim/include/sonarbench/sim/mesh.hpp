@@ -43,7 +43,7 @@ MeshCheck CheckMesh(TriangleMesh& mesh, const std::string& where);
 [[nodiscard]] TriangleMesh BuildMesh(const MeshSpec& spec, std::uint64_t seed);
 
 /// Builds every mesh of a scene, in scene order (the index is the Embree geometry id), each
-/// checked by CheckMesh.
+/// checked by CheckMesh, once the scene's estimate is within its budgets (CheckBudgets).
 [[nodiscard]] std::vector<TriangleMesh> BuildSceneMeshes(const Scene& scene);
 
 /// Builds the scene's vehicle parts (Scene::vehicle) as BuildSceneMeshes does, in the vehicle's

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sonarbench/mapping/mapper_config.hpp"
+#include "sonarbench/sim/budget.hpp"
 #include "sonarbench/sim/criteria.hpp"
 #include "sonarbench/sim/sensor_model.hpp"
 
@@ -134,6 +135,9 @@ struct Scene {
   mapping::MapperConfig mapping;
   /// Pass/fail bounds on the map's metrics (none: the scenario passes when it runs).
   Criteria criteria;
+  /// What a run of it may build: set by the command line, not the scene file; checked by
+  /// BuildSceneMeshes before anything is built.
+  Budgets budgets;
 };
 
 /// Loads a scene YAML file and the sensor model it names (relative to the scene file).
