@@ -73,9 +73,8 @@ class ProgressLine {
     const double elapsed = std::chrono::duration<double>(now - stage_start_).count();
     const double rate = elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0;
     char line[160];
-    std::snprintf(line, sizeof line, "\r%-9s sweep %zu/%zu  %.1f sweeps/s  %.0f s left   ",
-                  std::string(stage).c_str(), done, total, rate,
-                  rate > 0 ? static_cast<double>(total - done) / rate : 0.0);
+    std::snprintf(line, sizeof line, "\r%-10s %zu/%zu  %.0f s left   ", std::string(stage).c_str(),
+                  done, total, rate > 0 ? static_cast<double>(total - done) / rate : 0.0);
     std::cerr << line << std::flush;
     shown_ = true;
   }

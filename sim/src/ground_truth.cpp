@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 namespace sonarbench::sim {
@@ -92,17 +93,30 @@ bool TriangleBoxOverlap(const Vector3d& box_centre, const Vector3d& box_half_siz
 namespace {
 
 // Adds every cell whose centre lies inside the closed mesh.
-void AddInteriorCells(const TriangleMesh& mesh, const octomap::OcTree& key_space,
-                      mapping::KeySet& cells) {
-  if (mesh.triangles.empty()) return;
+// The keys of the corners of a mesh's bounding box.
+std::pair<octomap::OcTreeKey, octomap::OcTreeKey> KeyBounds(const TriangleMesh& mesh,
+                                                            const octomap::OcTree& key_space) {
   Vector3d lo = Vector3d::Constant(1e300);
   Vector3d hi = Vector3d::Constant(-1e300);
   for (const auto& v : mesh.vertices) {
     lo = lo.cwiseMin(v.cast<double>());
     hi = hi.cwiseMax(v.cast<double>());
   }
-  const octomap::OcTreeKey k_lo = key_space.coordToKey(lo.x(), lo.y(), lo.z());
-  const octomap::OcTreeKey k_hi = key_space.coordToKey(hi.x(), hi.y(), hi.z());
+  return {key_space.coordToKey(lo.x(), lo.y(), lo.z()),
+          key_space.coordToKey(hi.x(), hi.y(), hi.z())};
+}
+
+// Rows of cells AddInteriorCells walks (one per y key).
+std::size_t FillRows(const TriangleMesh& mesh, const octomap::OcTree& key_space) {
+  if (!mesh.fill || !mesh.truth || mesh.triangles.empty()) return 0;
+  const auto [k_lo, k_hi] = KeyBounds(mesh, key_space);
+  return static_cast<std::size_t>(k_hi[1] - k_lo[1] + 1);
+}
+
+void AddInteriorCells(const TriangleMesh& mesh, const octomap::OcTree& key_space,
+                      mapping::KeySet& cells, const std::function<void()>& row_done) {
+  if (mesh.triangles.empty()) return;
+  const auto [k_lo, k_hi] = KeyBounds(mesh, key_space);
   const double res = key_space.getResolution();
   // A row of cell centres along x crosses the closed surface an even number of times; the cells
   // between the 1st and 2nd, 3rd and 4th, ... crossing are inside. The row is nudged off the
@@ -142,35 +156,50 @@ void AddInteriorCells(const TriangleMesh& mesh, const octomap::OcTree& key_space
         }
       }
     }
+    row_done();
   }
 }
 
 }  // namespace
 
 mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
-                               const octomap::OcTree& key_space) {
+                               const octomap::OcTree& key_space, const StageProgress& progress) {
+  std::size_t total = 0;
+  std::size_t done = 0;
+  for (const TriangleMesh& mesh : meshes) {
+    total += mesh.truth ? mesh.triangles.size() + FillRows(mesh, key_space) : 0;
+  }
+  const auto step = [&] {
+    if (progress && (++done % 1024 == 0 || done == total)) progress(done, total);
+  };
   mapping::KeySet cells;
   for (const TriangleMesh& mesh : meshes) {
     if (!mesh.truth) continue;
     for (const auto& t : mesh.triangles) {
       AddTriangleCells(mesh.vertices[t[0]].cast<double>(), mesh.vertices[t[1]].cast<double>(),
                        mesh.vertices[t[2]].cast<double>(), key_space, cells);
+      step();
     }
-    if (mesh.fill) AddInteriorCells(mesh, key_space, cells);
+    if (mesh.fill) AddInteriorCells(mesh, key_space, cells, step);
   }
   return cells;
 }
 
 mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer, std::span<const BeamPose> beams,
                                        const mapping::SensorGeometry& sensor, int rays_horizontal,
-                                       int rays_vertical, const octomap::OcTree& key_space) {
+                                       int rays_vertical, const octomap::OcTree& key_space,
+                                       const StageProgress& progress) {
   const std::vector<Eigen::Vector3d> directions =
       mapping::BeamRayDirections(sensor, rays_horizontal, rays_vertical);
   const auto max_range = static_cast<float>(sensor.MaxRangeM());
   std::vector<mapping::KeySet> per_thread(static_cast<std::size_t>(omp_get_max_threads()));
   const auto count = static_cast<std::int64_t>(beams.size());
+  std::atomic<std::size_t> done = 0;
 #pragma omp parallel for schedule(dynamic, 8)
   for (std::int64_t b = 0; b < count; ++b) {
+    // The first thread alone reports, so the callback needs no lock.
+    const std::size_t finished = done.fetch_add(1, std::memory_order_relaxed);
+    if (progress && omp_get_thread_num() == 0) progress(finished, beams.size());
     const BeamPose& pose = beams[static_cast<std::size_t>(b)];
     mapping::KeySet& cells = per_thread[static_cast<std::size_t>(omp_get_thread_num())];
     const Eigen::Matrix3d R =
@@ -186,6 +215,7 @@ mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer, std::span<const 
       }
     }
   }
+  if (progress) progress(beams.size(), beams.size());
   mapping::KeySet all;
   for (const auto& cells : per_thread) all.insert(cells.begin(), cells.end());
   return all;
@@ -193,9 +223,10 @@ mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer, std::span<const 
 
 mapping::KeySet PerfectSensorCells(const RayTracer& tracer, std::span<const BeamPose> beams,
                                    const mapping::SensorGeometry& sensor,
-                                   const Acoustics& acoustics, const octomap::OcTree& key_space) {
+                                   const Acoustics& acoustics, const octomap::OcTree& key_space,
+                                   const StageProgress& progress) {
   return ObservableSurfaceCells(tracer, beams, sensor, 2 * acoustics.rays_horizontal,
-                                2 * acoustics.rays_vertical, key_space);
+                                2 * acoustics.rays_vertical, key_space, progress);
 }
 
 }  // namespace sonarbench::sim

@@ -62,15 +62,16 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
   result.timings.map_s = clock.Lap();
 
   const octomap::OcTree& map = result.mapper->tree();
-  result.truth = VoxelizeMeshes(meshes, map);
+  result.truth = VoxelizeMeshes(meshes, map, report("truth"));
   std::vector<BeamPose> poses;
   for (std::size_t b = 0; b < synthesized.size(); ++b) poses.push_back(ScheduleBeam(scene, b).pose);
   if (!poses.empty()) result.sonar_start_m = poses.front().T_world_sonar.translation();
   result.observable =
-      PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics, map);
+      PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics, map,
+                         report("observable"));
   result.timings.ground_truth_s = clock.Lap();
 
-  result.metrics = ScoreMap(map, result.truth, result.observable, meshes);
+  result.metrics = ScoreMap(map, result.truth, result.observable, meshes, report("score"));
   result.verdict = Evaluate(scene.criteria, result.metrics);
   result.timings.score_s = clock.Lap();
   return result;

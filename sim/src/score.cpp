@@ -113,7 +113,8 @@ MapCells CollectMapCells(const octomap::OcTree& map) {
 }
 
 MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
-                    const mapping::KeySet& observable, std::span<const TriangleMesh> meshes) {
+                    const mapping::KeySet& observable, std::span<const TriangleMesh> meshes,
+                    const StageProgress& progress) {
   const MapCells cells = CollectMapCells(map);
   MapMetrics m;
   m.truth_cells = truth.size();
@@ -147,6 +148,12 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
   for (const TriangleMesh& mesh : meshes) {
     if (mesh.truth) truth_meshes.push_back(mesh);
   }
+  std::size_t passes = 0;
+  const std::size_t total = truth_meshes.size() + 3;
+  const auto pass_done = [&] {
+    if (progress) progress(++passes, total);
+  };
+  pass_done();
   for (const TriangleMesh& mesh : truth_meshes) {
     MapMetrics::MeshRecall r;
     r.name = mesh.name;
@@ -157,6 +164,7 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
     }
     r.recall = Ratio(r.observed_occupied_cells, r.observable_cells);
     m.per_mesh.push_back(r);
+    pass_done();
   }
 
   const double res = map.getResolution();
@@ -170,6 +178,7 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
     }
     m.map_to_mesh = Summarise(std::move(d));
   }
+  pass_done();
   if (!cells.occupied.empty()) {
     // Occupied cells bucketed in blocks of 8³ cells: rings of blocks around a query skip empty
     // space 8 cells at a time. A block `ring` blocks out is at least (ring - 1) blocks away.
@@ -202,6 +211,7 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
     }
     m.mesh_to_map = Summarise(std::move(d));
   }
+  pass_done();
   return m;
 }
 

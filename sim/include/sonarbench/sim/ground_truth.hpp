@@ -3,6 +3,7 @@
 #include <octomap/OcTree.h>
 
 #include <Eigen/Core>
+#include <functional>
 #include <span>
 
 #include "sonarbench/mapping/beam_volume.hpp"
@@ -11,6 +12,9 @@
 #include "sonarbench/sim/sensor_model.hpp"
 
 namespace sonarbench::sim {
+
+/// Called as a long stage goes: work done and the stage's total, in the stage's own units.
+using StageProgress = std::function<void(std::size_t done, std::size_t total)>;
 
 /// Exact triangle / axis-aligned box overlap (separating axis theorem, Akenine-Möller 2001).
 /// Touching counts as overlapping, so a surface on a cell face marks both cells.
@@ -22,8 +26,10 @@ namespace sonarbench::sim {
 /// Every cell of `key_space`'s grid whose box the surface of a mesh crosses (cells half-open, as
 /// OctoMap assigns points), and, for a mesh with `fill`, every cell whose centre lies inside it.
 /// Meshes that are not `truth` (the water surface) add nothing.
+/// `progress` counts triangles and, for filled meshes, rows of cells.
 [[nodiscard]] mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
-                                             const octomap::OcTree& key_space);
+                                             const octomap::OcTree& key_space,
+                                             const StageProgress& progress = {});
 
 /// The sonar's pose and head angle for one beam.
 struct BeamPose {
@@ -38,7 +44,8 @@ struct BeamPose {
                                                      std::span<const BeamPose> beams,
                                                      const mapping::SensorGeometry& sensor,
                                                      int rays_horizontal, int rays_vertical,
-                                                     const octomap::OcTree& key_space);
+                                                     const octomap::OcTree& key_space,
+                                                     const StageProgress& progress = {});
 
 /// ObservableSurfaceCells as every score takes it: a perfect sensor, with rays twice as dense in
 /// each direction as the synthesis samples a beam (`acoustics`).
@@ -46,6 +53,7 @@ struct BeamPose {
                                                  std::span<const BeamPose> beams,
                                                  const mapping::SensorGeometry& sensor,
                                                  const Acoustics& acoustics,
-                                                 const octomap::OcTree& key_space);
+                                                 const octomap::OcTree& key_space,
+                                                 const StageProgress& progress = {});
 
 }  // namespace sonarbench::sim

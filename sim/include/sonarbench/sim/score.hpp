@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sonarbench/mapping/beam_volume.hpp"
+#include "sonarbench/sim/ground_truth.hpp"
 #include "sonarbench/sim/mesh.hpp"
 
 namespace sonarbench::sim {
@@ -65,9 +66,11 @@ struct MapMetrics {
 /// Scores `map` against the surface cells `truth` and the subset `observable` a perfect sensor
 /// could see (cells of `observable` outside `truth` are ignored); `meshes` give the exact surface
 /// for distances (none: distances are not computed); meshes that are not `truth` are left out.
+/// `progress` counts its passes: the counts, each mesh's recall, the two distances.
 [[nodiscard]] MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
                                   const mapping::KeySet& observable,
-                                  std::span<const TriangleMesh> meshes = {});
+                                  std::span<const TriangleMesh> meshes = {},
+                                  const StageProgress& progress = {});
 
 /// Exact distance [m] from `p` to the triangle a, b, c (Ericson, Real-Time Collision Detection,
 /// 5.1.5).
