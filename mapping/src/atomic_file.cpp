@@ -69,7 +69,7 @@ void CheckOutputDirectory(const std::string& dir) {
   if (!fs::is_directory(ancestor, error)) {
     why = " is not a directory";
   } else if (::access(ancestor.c_str(), W_OK | X_OK) != 0) {
-    why = ": no permission to make a directory in it";
+    why = std::string(": ") + std::strerror(errno);  // "Permission denied", "Read-only file system"
   }
   if (!why.empty()) {
     throw EnvironmentError(dir + ": cannot be made the output directory (" + ancestor.string() + why +

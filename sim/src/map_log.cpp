@@ -203,6 +203,9 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) 
                    {"fan", "fan.png"}}}});
   if (result.metrics) report["metrics"] = MetricsJson(*result.metrics);
   if (!result.warnings.empty()) report["warnings"] = result.warnings;
+  std::vector<std::string> covered = kLogMapOutputFiles;
+  std::erase(covered, "report.json");
+  report["files_sha256"] = FilesSha256(out_dir, covered);
   WriteJson((dir / "report.json").string(), report);
 }
 

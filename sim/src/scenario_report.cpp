@@ -428,9 +428,14 @@ void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
                 static_cast<std::streamsize>(image.png.size()));
     });
   }
-  WriteJson((dir / "report.json").string(), ScenarioReportJson(scene, result));
   WriteText((dir / "junit.xml").string(), ScenarioJunitXml(scene, result));
   WriteText((dir / "report.html").string(), ScenarioHtml(scene, result, images));
+  // The report last, naming what it covers.
+  nlohmann::json report = ScenarioReportJson(scene, result);
+  std::vector<std::string> covered = kScenarioOutputFiles;
+  std::erase(covered, "report.json");
+  report["files_sha256"] = FilesSha256(out_dir, covered);
+  WriteJson((dir / "report.json").string(), report);
 }
 
 std::string XmlEscape(std::string_view text) {

@@ -71,7 +71,8 @@ inline const std::vector<std::string> kLogMapOutputFiles = {
     "map.bt", "map.ot", "map_top.png", "polar.png", "fan.png", "report.json"};
 
 /// Writes `map.bt`, `map.ot`, `map_top.png`, `polar.png`, `fan.png` and `report.json` (with the
-/// scores under "metrics" if the map was scored) into `out_dir`, each atomically, the report last.
+/// scores under "metrics" if the map was scored, and the sha256 of the others under
+/// "files_sha256") into `out_dir`, each atomically, the report last.
 void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result);
 
 }  // namespace sonarbench::sim

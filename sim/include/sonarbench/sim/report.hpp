@@ -2,14 +2,24 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/dataset.hpp"
 
 namespace sonarbench::sim {
 
 /// The fields every JSON report starts with: its schema version and the tool that wrote it.
 [[nodiscard]] inline nlohmann::json ReportHeader() {
   return {{"schema_version", 1}, {"tool", {{"name", "sonarbench"}, {"version", "0.1.0"}}}};
+}
+
+/// {name: sha256} of each of `files` in `dir`: what a report covers, for a reader to check.
+[[nodiscard]] inline nlohmann::json FilesSha256(const std::string& dir,
+                                                const std::vector<std::string>& files) {
+  nlohmann::json hashes = nlohmann::json::object();
+  for (const std::string& file : files) hashes[file] = mapping::Sha256OfFile(dir + "/" + file);
+  return hashes;
 }
 
 /// Writes `report` as indented JSON to `path`, atomically.

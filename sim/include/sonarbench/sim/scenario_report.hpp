@@ -37,8 +37,9 @@ inline const std::vector<std::string> kScenarioOutputFiles = {
     "map_side.png", "report.json", "junit.xml", "report.html"};
 
 /// Writes, each file atomically, into `out_dir` (created if needed): map.bt, polar.png (the first
-/// sweep), fan.png, map_top.png and map_side.png (map against truth), report.json, junit.xml and
-/// report.html (self-contained: the images are embedded).
+/// sweep), fan.png, map_top.png and map_side.png (map against truth), junit.xml, report.html
+/// (self-contained: the images are embedded) and, last, report.json with the sha256 of the others
+/// (files_sha256).
 void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
                           const ScenarioResult& result);
 
