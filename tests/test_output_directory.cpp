@@ -63,7 +63,8 @@ TEST(OutputDirectory, AForeignMarkerIsNotOwnership) {
   fs::remove(dir.path() / "map.bt");
   const fs::path inner = dir.path() / "out";
   Put(inner / OutputDirectory::kMarkerFile,
-      R"({"tool": "sonarbench", "config_sha256": "b", "files": ["../outside.txt", "/etc/x"]})");
+      R"({"tool": "sonarbench",
+          "outputs": {"test": {"config_sha256": "b", "files": ["../outside.txt", "/etc/x"]}}})");
   Put(inner / "report.json", "old");
   OutputClaim claim = Claim(OutputMode::kResume);
   claim.force = true;
@@ -163,6 +164,45 @@ TEST(OutputDirectory, ForceRemovesOnlyListedFilesNeverATree) {
   EXPECT_EQ(*OwnedFiles(dir.path()),
             (std::vector<std::string>{OutputDirectory::kMarkerFile, OutputDirectory::kLockFile,
                                       "report.json"}));
+}
+
+TEST(OutputDirectory, ForceRemovesOnlyTheSameCommandsFiles) {
+  test::TempDir dir;
+  OutputClaim dataset = Claim(OutputMode::kResume, "a");
+  dataset.command = "simulate";
+  { WriteAll(OutputDirectory(dir.path().string(), dataset), dataset, "dataset"); }
+  OutputClaim study = Claim(OutputMode::kResume, "b");
+  study.command = "sweep";
+  study.files = {"study.json"};
+  study.record = "study.json";
+  { WriteAll(OutputDirectory(dir.path().string(), study), study, "study"); }
+  study.config_sha256 = "c";
+  study.force = true;
+  { const OutputDirectory out(dir.path().string(), study); }
+  EXPECT_FALSE(fs::exists(dir.path() / "study.json"));
+  for (const std::string& file : dataset.files) EXPECT_EQ(Bytes(dir.path() / file), "dataset");
+  const auto owned = ReadOwnership(dir.path());
+  ASSERT_TRUE(owned);
+  EXPECT_EQ(owned->at("simulate").files.size(), dataset.files.size());
+  EXPECT_EQ(owned->at("sweep").config_sha256, "c");
+}
+
+TEST(OutputDirectory, NothingIsWrittenOrRemovedThroughASymlinkedFolder) {
+  test::TempDir dir;
+  OutputClaim claim = Claim(OutputMode::kResume, "a");
+  {
+    const OutputDirectory out((dir.path() / "out").string(), claim);
+    WriteAll(out, claim, "ours");
+  }
+  // The user swaps the folder for a link to their own files of the same names.
+  Put(dir.path() / "mine/item.json", "theirs");
+  fs::remove_all(dir.path() / "out/sub");
+  fs::create_directory_symlink(dir.path() / "mine", dir.path() / "out/sub");
+  claim.force = true;
+  const std::string error =
+      test::InputErrorOf([&] { const OutputDirectory out((dir.path() / "out").string(), claim); });
+  EXPECT_NE(error.find("/sub is a symlink"), std::string::npos) << error;
+  EXPECT_EQ(Bytes(dir.path() / "mine/item.json"), "theirs");
 }
 
 TEST(OutputDirectory, OneConfigurationWritesAtATime) {

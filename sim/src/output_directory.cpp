@@ -69,16 +69,15 @@ bool Exists(const fs::path& path) {
   return fs::exists(fs::symlink_status(path, error));
 }
 
-// The config_sha256 an earlier run recorded: the marker's, else a dataset manifest's.
-std::optional<std::string> PreviousConfig(const fs::path& root) {
-  for (const char* file : {OutputDirectory::kMarkerFile, "manifest.json"}) {
-    const auto stored = ReadJson(root / file);
-    if (stored && stored->is_object() && stored->contains("config_sha256") &&
-        (*stored)["config_sha256"].is_string()) {
-      return (*stored)["config_sha256"].get<std::string>();
-    }
+// The first folder on `relative`'s way down from `root` that is a symlink, or "".
+std::string SymlinkedFolder(const fs::path& root, const std::string& relative) {
+  fs::path folder;
+  for (const auto& part : fs::path(relative).parent_path()) {
+    folder /= part;
+    std::error_code error;
+    if (fs::is_symlink(fs::symlink_status(root / folder, error))) return folder.generic_string();
   }
-  return std::nullopt;
+  return {};
 }
 
 std::vector<std::string> SortedUnion(std::vector<std::string> a, const std::vector<std::string>& b) {
@@ -97,31 +96,48 @@ void RemoveEmptyParents(const fs::path& root, const std::string& relative) {
 
 }  // namespace
 
-std::optional<std::vector<std::string>> OwnedFiles(const fs::path& dir) {
-  std::vector<std::string> files;
-  auto take = [&](const json& list, const char* key) {
+std::optional<Ownership> ReadOwnership(const fs::path& dir) {
+  const auto names = [](const json& list, const char* key) {
+    std::vector<std::string> files;
     for (const json& entry : list) {
-      const json& name = key ? entry.value(key, json()) : entry;
+      const json name = key ? (entry.is_object() ? entry.value(key, json()) : json()) : entry;
       if (name.is_string() && SafeRelative(name.get<std::string>())) files.push_back(name);
     }
+    return SortedUnion(files, {});
   };
+  Ownership owned;
   if (const auto marker = ReadJson(dir / OutputDirectory::kMarkerFile);
       marker && marker->is_object() && marker->value("tool", "") == "sonarbench" &&
-      marker->contains("files") && (*marker)["files"].is_array()) {
-    take((*marker)["files"], nullptr);
-    return SortedUnion(files, {OutputDirectory::kMarkerFile, OutputDirectory::kLockFile});
+      marker->contains("outputs") && (*marker)["outputs"].is_object()) {
+    for (const auto& [command, claimed] : (*marker)["outputs"].items()) {
+      if (!claimed.is_object() || !claimed.contains("files") || !claimed["files"].is_array()) {
+        continue;
+      }
+      owned[command] = {claimed.value("config_sha256", ""), names(claimed["files"], nullptr)};
+    }
+    return owned;
   }
   // A dataset written before markers existed: its manifest lists its files.
   if (const auto manifest = ReadJson(dir / "manifest.json");
       manifest && manifest->is_object() && manifest->value("format", "") == mapping::kDatasetFormat &&
       manifest->contains("files") && (*manifest)["files"].is_array()) {
-    for (const json& entry : (*manifest)["files"]) {
-      if (!entry.is_object()) return std::nullopt;
-    }
-    take((*manifest)["files"], "path");
-    return SortedUnion(files, {"manifest.json"});
+    owned[manifest->value("source", "simulate")] = {
+        manifest->value("config_sha256", ""),
+        SortedUnion(names((*manifest)["files"], "path"), {"manifest.json"})};
+    return owned;
   }
   return std::nullopt;
+}
+
+std::optional<std::vector<std::string>> OwnedFiles(const fs::path& dir) {
+  const auto owned = ReadOwnership(dir);
+  if (!owned) return std::nullopt;
+  std::vector<std::string> files;
+  for (const auto& [command, claimed] : *owned) files = SortedUnion(files, claimed.files);
+  if (Exists(dir / OutputDirectory::kMarkerFile)) {
+    files = SortedUnion(files, {OutputDirectory::kMarkerFile, OutputDirectory::kLockFile});
+  }
+  return files;
 }
 
 OutputDirectory::OutputDirectory(const std::string& dir, OutputClaim claim)
@@ -166,11 +182,10 @@ void OutputDirectory::Open() {
     throw EnvironmentError(name_ + ": cannot write in it (" + std::strerror(errno) + ")");
   }
   if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
-    const auto marker = ReadJson(root_ / kMarkerFile);
-    const bool same = claim_.mode == OutputMode::kResume && !claim_.force && marker &&
-                      marker->is_object() &&
-                      marker->value("config_sha256", "") == claim_.config_sha256 &&
-                      marker->value("command", "") == claim_.command;
+    const auto owned = ReadOwnership(root_);
+    const bool same = claim_.mode == OutputMode::kResume && !claim_.force && owned &&
+                      owned->contains(claim_.command) &&
+                      owned->at(claim_.command).config_sha256 == claim_.config_sha256;
     if (!same || ::flock(lock_fd_, LOCK_SH) != 0) {
       throw InputError(name_ + ": another sonarbench is writing here (" + Holder() +
                        "); wait for it to finish or choose another --out" +
@@ -180,25 +195,33 @@ void OutputDirectory::Open() {
     lock_created_ = false;
     return;
   }
-  std::vector<std::string> owned = OwnedFiles(root_).value_or(std::vector<std::string>{});
-  CheckInputsAndCollisions(owned);
+  Ownership owned = ReadOwnership(root_).value_or(Ownership{});
+  CheckInputsAndCollisions(OwnedFiles(root_).value_or(std::vector<std::string>{}));
+  Claimed& mine = owned[claim_.command];
   std::vector<std::string> outputs;
-  for (const std::string& file : owned) {
-    if (file != kMarkerFile && file != kLockFile && Exists(root_ / file)) outputs.push_back(file);
+  for (const std::string& file : mine.files) {
+    if (Exists(root_ / file)) outputs.push_back(file);
   }
   if (claim_.mode == OutputMode::kResume) {
-    const auto previous = PreviousConfig(root_);
     if (claim_.force) {
       RemoveFiles(outputs);
-      owned.clear();
-    } else if (previous && *previous != claim_.config_sha256 && !outputs.empty()) {
-      throw InputError(name_ + ": holds sonarbench outputs of another configuration " +
-                       "(config_sha256 " + *previous +
-                       "); pass --force to replace them (only the files sonarbench listed in " +
-                       kMarkerFile + " are removed)");
+      mine.files.clear();
+    } else if (mine.config_sha256 != claim_.config_sha256 && !outputs.empty()) {
+      throw InputError(name_ + ": holds sonarbench " + claim_.command +
+                       " outputs of another configuration (config_sha256 " + mine.config_sha256 +
+                       "); pass --force to replace them (only the files " + claim_.command +
+                       " listed in " + kMarkerFile + " are removed)");
     }
   }
-  WriteMarker(SortedUnion(owned, claim_.files));
+  // A file this claim writes is this command's now, whichever wrote it before.
+  for (auto& [command, claimed] : owned) {
+    if (command == claim_.command) continue;
+    std::erase_if(claimed.files, [&](const std::string& file) {
+      return std::find(claim_.files.begin(), claim_.files.end(), file) != claim_.files.end();
+    });
+  }
+  mine = {claim_.config_sha256, SortedUnion(mine.files, claim_.files)};
+  WriteMarker(owned);
   lock_created_ = false;  // listed in the marker now
   WriteHolder();
   // Temporary files of a killed writer are never whole.
@@ -222,6 +245,11 @@ void OutputDirectory::CheckInputsAndCollisions(const std::vector<std::string>& o
   const std::set<std::string> mine(owned.begin(), owned.end());
   if (Exists(root_ / kMarkerFile) && !OwnedFiles(root_)) foreign.push_back(kMarkerFile);
   for (const std::string& file : claim_.files) {
+    if (const std::string link = SymlinkedFolder(root_, file); !link.empty()) {
+      throw InputError(name_ + "/" + link +
+                       " is a symlink: sonarbench writes and removes nothing through one (make "
+                       "it a folder or choose another --out)");
+    }
     if (!mine.contains(file) && Exists(root_ / file)) foreign.push_back(file);
   }
   if (!foreign.empty()) {
@@ -245,6 +273,11 @@ void OutputDirectory::CheckInputsAndCollisions(const std::vector<std::string>& o
 
 void OutputDirectory::RemoveFiles(const std::vector<std::string>& files) const {
   for (const std::string& file : files) {
+    if (const std::string link = SymlinkedFolder(root_, file); !link.empty()) {
+      throw InputError(name_ + "/" + link +
+                       " is a symlink: sonarbench removes nothing through one (make it a folder "
+                       "or remove " + file + " by hand)");
+    }
     std::error_code error;
     fs::remove(root_ / file, error);
     if (error) {
@@ -276,14 +309,17 @@ void OutputDirectory::RemoveFiles(const std::vector<std::string>& files) const {
   for (const std::string& file : files) RemoveEmptyParents(root_, file);
 }
 
-void OutputDirectory::WriteMarker(const std::vector<std::string>& files) const {
+void OutputDirectory::WriteMarker(const Ownership& owned) const {
+  json outputs = json::object();
+  for (const auto& [command, claimed] : owned) {
+    if (claimed.files.empty()) continue;
+    outputs[command] = {{"config_sha256", claimed.config_sha256}, {"files", claimed.files}};
+  }
   const json marker = {{"tool", "sonarbench"},
                        {"about",
-                        "sonarbench wrote the files listed here and may replace or remove them; "
-                        "it touches nothing else in this directory"},
-                       {"command", claim_.command},
-                       {"config_sha256", claim_.config_sha256},
-                       {"files", SortedUnion(files, {kMarkerFile, kLockFile})}};
+                        "sonarbench wrote the files listed here, command by command, and may "
+                        "replace or remove them; it touches nothing else in this directory"},
+                       {"outputs", outputs}};
   WriteFileAtomically((root_ / kMarkerFile).string(),
                       [&](std::ostream& out) { out << marker.dump(2) << "\n"; });
 }

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,9 +36,19 @@ struct OutputClaim {
   bool force = false;
 };
 
-/// A command's output directory, owned through a marker (`kMarkerFile`) that lists every file
-/// sonarbench may write there, and guarded by a lock (`kLockFile`): one configuration writes at a
-/// time. Only files the marker lists are ever replaced or removed; a directory tree never is.
+/// What one command claimed in an output directory: its configuration and its files.
+struct Claimed {
+  std::string config_sha256;
+  std::vector<std::string> files;
+};
+/// Each command's claim, by the command's name.
+using Ownership = std::map<std::string, Claimed>;
+
+/// A command's output directory, owned through a marker (`kMarkerFile`) that lists, command by
+/// command, every file sonarbench may write there, and guarded by a lock (`kLockFile`): one
+/// configuration writes at a time. Only files the marker lists are ever replaced or removed (by
+/// --force, only the same command's); a directory tree never is, nor anything behind a symlink
+/// inside the directory.
 /// Errors (another writer, files of the user's in the way, a read-only or full disk) throw
 /// InputError naming the directory, the files or the OS's reason.
 class OutputDirectory {
@@ -71,7 +82,7 @@ class OutputDirectory {
   void Release() noexcept;
   void CheckInputsAndCollisions(const std::vector<std::string>& owned) const;
   void RemoveFiles(const std::vector<std::string>& files) const;
-  void WriteMarker(const std::vector<std::string>& files) const;
+  void WriteMarker(const Ownership& owned) const;
   void WriteHolder() const;
   [[nodiscard]] std::string Holder() const;
 
@@ -85,8 +96,12 @@ class OutputDirectory {
   bool committed_ = false;
 };
 
-/// The files an output directory's marker lists, or nullopt when it has none (a directory
-/// sonarbench did not write).
+/// The claims an output directory's marker records (or, for a dataset written before markers,
+/// its manifest), or nullopt when it has neither: a directory sonarbench did not write. Paths
+/// that are not plainly relative are dropped.
+[[nodiscard]] std::optional<Ownership> ReadOwnership(const std::filesystem::path& dir);
+
+/// Every file of ReadOwnership's claims, with the marker and the lock; nullopt as there.
 [[nodiscard]] std::optional<std::vector<std::string>> OwnedFiles(const std::filesystem::path& dir);
 
 }  // namespace sonarbench::sim
