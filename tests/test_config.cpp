@@ -376,9 +376,10 @@ TEST(SceneFile, SpecularSpreadIsReadInDegrees) {
         << "trajectory: {type: static, position_m: [0, 0, 0]}\n";
     return path;
   };
-  for (const auto& [material, expected] : cases) {
+  for (const auto& [material_text, expected] : cases) {
     std::vector<std::string> parts = {"bad.yaml:5:"};
     parts.insert(parts.end(), expected.begin(), expected.end());
+    const std::string& material = material_text;  // a lambda may not capture a binding (clang 14)
     EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(scene_with(material)); }, parts))
         << material;
   }

@@ -45,6 +45,14 @@ TEST(OutputDirectory, FilesOfTheUsersNamesAreRefusedAndLeftAsTheyWere) {
       [&] { const OutputDirectory out(dir.path().string(), Claim(OutputMode::kReplace)); });
   EXPECT_NE(error.find("holds files sonarbench did not write: map.bt"), std::string::npos) << error;
   EXPECT_EQ(Bytes(dir.path() / "map.bt"), "the user's map");
+  // A file where an output's folder goes is named as well.
+  fs::remove(dir.path() / "map.bt");
+  Put(dir.path() / "sub", "the user's file");
+  EXPECT_NE(test::InputErrorOf([&] {
+              const OutputDirectory out(dir.path().string(), Claim(OutputMode::kReplace));
+            }).find("did not write: sub (where a folder goes)"),
+            std::string::npos);
+  EXPECT_EQ(Bytes(dir.path() / "sub"), "the user's file");
   // The refused open leaves no lock or marker behind.
   EXPECT_FALSE(fs::exists(dir.path() / OutputDirectory::kLockFile));
   EXPECT_FALSE(fs::exists(dir.path() / OutputDirectory::kMarkerFile));

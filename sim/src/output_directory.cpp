@@ -80,6 +80,18 @@ std::string SymlinkedFolder(const fs::path& root, const std::string& relative) {
   return {};
 }
 
+// The first folder on `relative`'s way down from `root` that something else stands in, or "".
+std::string BlockedFolder(const fs::path& root, const std::string& relative) {
+  fs::path folder;
+  for (const auto& part : fs::path(relative).parent_path()) {
+    folder /= part;
+    std::error_code error;
+    const fs::file_status status = fs::symlink_status(root / folder, error);
+    if (fs::exists(status) && !fs::is_directory(status)) return folder.generic_string();
+  }
+  return {};
+}
+
 std::vector<std::string> SortedUnion(std::vector<std::string> a, const std::vector<std::string>& b) {
   a.insert(a.end(), b.begin(), b.end());
   std::sort(a.begin(), a.end());
@@ -154,6 +166,7 @@ OutputDirectory::OutputDirectory(const std::string& dir, OutputClaim claim)
 }
 
 void OutputDirectory::Open() {
+  if (name_.empty()) throw InputError("--out '': expected the path of an output directory");
   std::error_code error;
   const fs::path path(name_);
   if (Exists(path)) {
@@ -250,8 +263,14 @@ void OutputDirectory::CheckInputsAndCollisions(const std::vector<std::string>& o
                        " is a symlink: sonarbench writes and removes nothing through one (make "
                        "it a folder or choose another --out)");
     }
-    if (!mine.contains(file) && Exists(root_ / file)) foreign.push_back(file);
+    if (const std::string blocked = BlockedFolder(root_, file); !blocked.empty()) {
+      foreign.push_back(blocked + " (where a folder goes)");
+    } else if (!mine.contains(file) && Exists(root_ / file)) {
+      foreign.push_back(file);
+    }
   }
+  std::sort(foreign.begin(), foreign.end());
+  foreign.erase(std::unique(foreign.begin(), foreign.end()), foreign.end());
   if (!foreign.empty()) {
     throw InputError(name_ + ": holds files sonarbench did not write: " + Listed(foreign) +
                      "; sonarbench never replaces them (move them or choose another --out)");

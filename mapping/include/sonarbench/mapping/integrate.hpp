@@ -102,14 +102,11 @@ struct BatchStats {
   }
 };
 
-/// Brings a tree that IntegrateBatch updated up to date for reading and writing: OctoMap's node
-/// count, and the inner nodes' occupancy (the maximum of their children's). Updates leave both
-/// stale (lazy evaluation, no pruning): neither changes how a later update goes, so this is
-/// needed once after the last batch, not after each.
-inline void FinishUpdates(MapTree& tree) {
-  tree.RecountNodes();
-  tree.updateInnerOccupancy();
-}
+/// Brings a tree that IntegrateBatch updated up to date for reading and writing: the inner nodes'
+/// occupancy (the maximum of their children's). Updates leave it stale (lazy evaluation, no
+/// pruning): it does not change how a later update goes, so this is needed once after the last
+/// batch, not after each.
+inline void FinishUpdates(MapTree& tree) { tree.updateInnerOccupancy(); }
 
 /// What IntegrateBatch needs besides the tree: each thread's key sets and buffers, and each
 /// octant's updates. Kept from batch to batch, a workspace's tables are already grown to a
@@ -187,6 +184,7 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
   const float log_odds[2] = {tree.getProbMissLog(), tree.getProbHitLog()};
   std::array<std::size_t, 8> free_cells{};
   std::array<std::size_t, 8> occupied_cells{};
+  std::array<std::size_t, 8> created_nodes{};
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
   for (int o = 0; o < 8; ++o) {
     auto& updates = workspace.updates[static_cast<std::size_t>(o)];
@@ -209,10 +207,12 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
     for (const std::uint64_t u : updates) {
       (u & 1 ? occupied_cells : free_cells)[static_cast<std::size_t>(o)] += 1;
     }
-    tree.UpdateLeavesInOrder(
+    // Octant o's subtree hangs below the root's child o, made above: threads share no node.
+    created_nodes[static_cast<std::size_t>(o)] = tree.UpdateLeavesUncounted(
         updates.size(), [&updates](std::size_t i) { return KeyFromMortonCode(updates[i] >> 1); },
         [&updates, &log_odds](std::size_t i) { return log_odds[updates[i] & 1]; });
   }
+  for (const std::size_t created : created_nodes) tree.AddNodes(created);
 
   BatchStats stats;
   stats.beams = beams.size();

@@ -3,7 +3,28 @@
 #include <octomap/OcTree.h>
 
 #include <bit>
+#include <cstddef>
 #include <cstdint>
+
+namespace sonarbench::mapping::detail {
+struct ChildLinker;
+}  // namespace sonarbench::mapping::detail
+
+namespace octomap {
+// OcTreeDataNode befriends every OcTreeBaseImpl<NODE, I>. This one, for a type of ours, links a
+// new child into its parent and nothing else: OctoMap's createNodeChild also counts the tree's
+// nodes in a member that threads creating nodes in disjoint subtrees would race on.
+template <>
+class OcTreeBaseImpl<OcTreeNode, sonarbench::mapping::detail::ChildLinker> {
+ public:
+  static OcTreeNode* NewChild(OcTreeNode* parent, unsigned pos) {
+    if (parent->children == nullptr) parent->children = new AbstractOcTreeNode*[8]();
+    auto* child = new OcTreeNode();
+    parent->children[pos] = child;
+    return child;
+  }
+};
+}  // namespace octomap
 
 namespace sonarbench::mapping {
 
@@ -12,11 +33,10 @@ class MapTree : public octomap::OcTree {
  public:
   using octomap::OcTree::OcTree;
 
-  /// OctoMap counts nodes in a plain member that concurrent node creation in disjoint subtrees
-  /// races on, so after such updates the count is taken again from the tree itself (the .bt
-  /// header carries it).
-  void RecountNodes() {
-    tree_size = calcNumNodes();
+  /// Adds `created` nodes to OctoMap's count (the .bt header carries it), after updates that
+  /// left the count to the caller (UpdateLeavesUncounted in parallel).
+  void AddNodes(std::size_t created) {
+    tree_size += created;
     size_changed = true;
   }
 
@@ -34,7 +54,17 @@ class MapTree : public octomap::OcTree {
   /// to their deepest common node, which is then not walked again.
   template <typename Key, typename LogOdds>
   void UpdateLeavesInOrder(std::size_t count, Key&& key, LogOdds&& log_odds) {
+    AddNodes(UpdateLeavesUncounted(count, key, log_odds));
+  }
+
+  /// UpdateLeavesInOrder, but the nodes it creates are returned, not counted in the tree: threads
+  /// may update disjoint subtrees (below existing nodes) at once, then AddNodes their sum.
+  template <typename Key, typename LogOdds>
+  [[nodiscard]] std::size_t UpdateLeavesUncounted(std::size_t count, Key&& key,
+                                                  LogOdds&& log_odds) {
+    using Linker = octomap::OcTreeBaseImpl<octomap::OcTreeNode, detail::ChildLinker>;
     constexpr unsigned kDepth = 16;
+    std::size_t nodes = 0;
     octomap::OcTreeNode* path[kDepth + 1];
     octomap::OcTreeKey previous;
     for (std::size_t i = 0; i < count; ++i) {
@@ -49,7 +79,7 @@ class MapTree : public octomap::OcTree {
       } else {
         if (root == nullptr) {
           root = new octomap::OcTreeNode();
-          ++tree_size;
+          ++nodes;
           created = true;
         }
         path[0] = root;
@@ -61,9 +91,12 @@ class MapTree : public octomap::OcTree {
             ((k[0] >> bit) & 1u) | (((k[1] >> bit) & 1u) << 1) | (((k[2] >> bit) & 1u) << 2);
         if (!nodeChildExists(node, pos)) {
           if (!nodeHasChildren(node) && !created) {
-            expandNode(node);  // a pruned node
+            // A pruned node: its eight children take its value (OctoMap's expandNode).
+            for (unsigned c = 0; c < 8; ++c) Linker::NewChild(node, c)->copyData(*node);
+            nodes += 8;
           } else {
-            createNodeChild(node, pos);
+            Linker::NewChild(node, pos);
+            ++nodes;
             created = true;
           }
         } else {
@@ -74,6 +107,7 @@ class MapTree : public octomap::OcTree {
       updateNodeLogOdds(path[kDepth], log_odds(i));
       previous = k;
     }
+    return nodes;
   }
 };
 
