@@ -265,5 +265,19 @@ TEST(OutputDirectory, ADatasetWrittenBeforeMarkersIsOwnedThroughItsManifest) {
   EXPECT_FALSE(OwnedFiles(dir.path()));
 }
 
+TEST(OutputDirectory, AReportWrittenBeforeMarkersOwnsTheOutputsItNames) {
+  test::TempDir dir;
+  Put(dir.path() / "report.json",
+      R"({"tool": {"name": "sonarbench"}, "outputs": {"map": "map.bt", "bad": "../x"}})");
+  EXPECT_EQ(*OwnedFiles(dir.path()), (std::vector<std::string>{"map.bt", "report.json"}));
+  const OutputClaim claim = Claim(OutputMode::kReplace);
+  OutputDirectory out(dir.path().string(), claim);
+  WriteAll(out, claim, "new");
+  out.Commit();
+  EXPECT_EQ(Bytes(dir.path() / "map.bt"), "new");
+  Put(dir.path() / "other/report.json", R"({"tool": {"name": "webapp"}, "outputs": {}})");
+  EXPECT_FALSE(OwnedFiles(dir.path() / "other"));
+}
+
 }  // namespace
 }  // namespace sonarbench::sim

@@ -157,6 +157,7 @@ sonarbench::sim::OutputClaim OneShotClaim(std::string command, std::vector<std::
 }
 
 struct MapArgs {
+  bool no_progress = false;
   sonarbench::sim::Budgets budgets;
   std::string input;
   std::string out = "out/map";
@@ -193,8 +194,11 @@ int Map(const MapArgs& args) {
   std::rotate(files.begin(), files.end() - 1, files.end());  // the record, report.json, first
   sonarbench::sim::OutputDirectory out(
       args.out, OneShotClaim("map", files, {args.input, args.scene, args.sensor, args.mapping}));
-  auto result = sonarbench::sim::MapLog(args.input, sensor, config, scene ? &*scene : nullptr,
-                                        args.budgets);
+  ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
+  auto result = sonarbench::sim::MapLog(
+      args.input, sensor, config, scene ? &*scene : nullptr, args.budgets,
+      [&](std::size_t done, std::size_t total) { progress.Update("map", done, total); });
+  progress.Clear();
   if (scene) result.metrics = sonarbench::sim::ScoreLogMap(result, *scene);
   sonarbench::sim::WriteLogMapOutputs(out.write_root().string(), result);
   out.Commit();
@@ -211,6 +215,7 @@ int Map(const MapArgs& args) {
 }
 
 struct FidelityArgs {
+  bool no_progress = false;
   sonarbench::sim::Budgets budgets;
   std::string scene;
   std::string log;
@@ -260,8 +265,13 @@ int Fidelity(const FidelityArgs& args) {
   inputs.push_back(args.log);
   sim::OutputDirectory out(args.out, OneShotClaim("fidelity", sim::kFidelityOutputFiles, inputs));
   const sim::RayTracer tracer(meshes);
+  ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   const auto synthesized =
-      sim::SimulateScene(scene, tracer, args.seed.value_or(scene.seed), args.threads);
+      sim::SimulateScene(scene, tracer, args.seed.value_or(scene.seed), args.threads,
+                         [&](std::size_t done, std::size_t total) {
+                           progress.Update("simulate", done, total);
+                         });
+  progress.Clear();
   const std::vector<sonarbench::mapping::Beam> beams = sim::BeamsOf(synthesized);
   const auto& g = scene.sensor.geometry;
   const auto report = sim::CompareWithLog(beams, log.beams, g, args.wall_min_range_m);
@@ -631,6 +641,7 @@ CLI::App* AddMapCommand(CLI::App& app, MapArgs& args) {
       ->needs(scene_opt);
   AddThreadsOption(command, args.threads);
   AddBudgetOptions(command, args.budgets);
+  command->add_flag("--no-progress", args.no_progress, "Never show the progress line");
   return command;
 }
 
@@ -654,6 +665,7 @@ CLI::App* AddFidelityCommand(CLI::App& app, FidelityArgs& args) {
   AddSeedOption(command, args.seed, "Overrides the scene's seed");
   AddThreadsOption(command, args.threads);
   AddBudgetOptions(command, args.budgets);
+  command->add_flag("--no-progress", args.no_progress, "Never show the progress line");
   command
       ->add_option("--wall-min-range", args.wall_min_range_m,
                    "Strongest echoes are sought beyond this range [m] (past the floor's)")

@@ -76,7 +76,7 @@ std::optional<Eigen::Isometry3d> DatasetPlacement(const mapping::Dataset& datase
 
 LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
                     const mapping::MapperConfig& config, const Scene* place_in,
-                    const Budgets& budgets) {
+                    const Budgets& budgets, const StageProgress& progress) {
   LogMapResult result;
   result.input = input;
   auto start = std::chrono::steady_clock::now();
@@ -125,7 +125,7 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
   start = now;
   result.sensor = geometry;
   result.mapper = std::make_unique<mapping::Mapper>(config, geometry);
-  result.totals = result.mapper->IntegrateSweeps(beams);
+  result.totals = result.mapper->IntegrateSweeps(beams, progress);
   const auto per_sweep = static_cast<std::size_t>(geometry.BeamsPerSweep());
   result.sweeps = (beams.size() + per_sweep - 1) / per_sweep;
   result.first_sweep.assign(beams.begin(),

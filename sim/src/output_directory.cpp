@@ -129,6 +129,16 @@ std::optional<Ownership> ReadOwnership(const fs::path& dir) {
     }
     return owned;
   }
+  // A report written before markers existed: report.json and the outputs it names.
+  if (const auto report = ReadJson(dir / "report.json");
+      report && report->is_object() && report->contains("tool") && (*report)["tool"].is_object() &&
+      (*report)["tool"].value("name", "") == "sonarbench" && report->contains("outputs") &&
+      (*report)["outputs"].is_object()) {
+    json files = json::array({"report.json"});
+    for (const auto& [what, file] : (*report)["outputs"].items()) files.push_back(file);
+    owned["report"] = {"", names(files, nullptr)};
+    return owned;
+  }
   // A dataset written before markers existed: its manifest lists its files.
   if (const auto manifest = ReadJson(dir / "manifest.json");
       manifest && manifest->is_object() && manifest->value("format", "") == mapping::kDatasetFormat &&

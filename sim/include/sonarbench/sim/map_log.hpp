@@ -49,11 +49,12 @@ struct LogMapResult {
 /// a dataset's beams keep their own, but for an imported log's, which are placed the same way. A
 /// simulated dataset scored against another scene than its manifest names is refused. A map that
 /// would hold more than `budgets.max_cells` cells (MapCellsEstimate over the beams' poses) is
-/// refused before it is made. Throws InputError for input that is not a readable log.
+/// refused before it is made. `progress` counts the sweeps mapped. Throws InputError for input that is not a readable log.
 [[nodiscard]] LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
                                   const mapping::MapperConfig& config,
                                   const Scene* place_in = nullptr,
-                                  const Budgets& budgets = {});
+                                  const Budgets& budgets = {},
+                                  const StageProgress& progress = {});
 
 /// The static sonar pose of `scene` (its first beam's), where a `.mat` log of the place is mapped
 /// to score it against the scene. Throws InputError when the scene's sonar moves: a static log
