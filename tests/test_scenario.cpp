@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "sonarbench/sim/scenario.hpp"
+#include "sonarbench/sim/report.hpp"
 #include "sonarbench/sim/scenario_report.hpp"
 #include "test_util.hpp"
 
@@ -585,6 +586,20 @@ TEST(Cli, ADatasetIsScoredOnlyAgainstItsOwnScene) {
   EXPECT_NE(output.find("cannot be scored against scene 'harbour-wall'"), std::string::npos)
       << output;
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "map"));
+}
+
+TEST(Cli, VersionAndUnknownCommands) {
+  std::string output;
+  EXPECT_EQ(RunCli("--version", &output), 0);
+  EXPECT_EQ(output, "sonarbench " + std::string(kVersion) + "\n");
+  EXPECT_EQ(RunCli("frobnicate scenes", &output), 2);
+  EXPECT_NE(output.find("unknown command 'frobnicate'; the commands are run, map, fidelity, "
+                        "simulate, sweep, import"),
+            std::string::npos)
+      << output;
+  EXPECT_EQ(RunCli("", &output), 2);
+  EXPECT_NE(output.find("a command is required; the commands are run,"), std::string::npos)
+      << output;
 }
 
 TEST(Cli, MissingSceneAndBadOptionsExitTwo) {

@@ -24,6 +24,7 @@
 #include "sonarbench/sim/map_log.hpp"
 #include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/output_directory.hpp"
+#include "sonarbench/sim/report.hpp"
 #include "sonarbench/sim/scenario.hpp"
 #include "sonarbench/sim/scenario_report.hpp"
 #include "sonarbench/sim/scene.hpp"
@@ -755,6 +756,7 @@ int main(int argc, char** argv) {
       "sonarbench: simulate a mechanical scanning imaging sonar, map its beams into an OctoMap, "
       "and score the map against ground truth."};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("sonarbench ") + sonarbench::sim::kVersion);
 
   RunArgs run;
   CLI::App* run_cmd = AddRunCommand(app, run);
@@ -771,6 +773,18 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    // A missing or unknown command is named, with the commands there are.
+    if (app.get_subcommands().empty() && (argc == 1 || argv[1][0] != '-')) {
+      std::string commands;
+      for (const CLI::App* command : app.get_subcommands({})) {
+        commands += (commands.empty() ? "" : ", ") + command->get_name();
+      }
+      std::cerr << "sonarbench: error: "
+                << (argc == 1 ? std::string("a command is required")
+                              : "unknown command '" + std::string(argv[1]) + "'")
+                << "; the commands are " << commands << " (sonarbench --help)\n";
+      return kExitBadInput;
+    }
     const int code = app.exit(e);
     return code == 0 ? 0 : kExitBadInput;
   }

@@ -9,9 +9,12 @@
 
 namespace sonarbench::sim {
 
+/// sonarbench's version: CMake's project(VERSION).
+inline constexpr const char* kVersion = SONARBENCH_VERSION;
+
 /// The fields every JSON report starts with: its schema version and the tool that wrote it.
 [[nodiscard]] inline nlohmann::json ReportHeader() {
-  return {{"schema_version", 1}, {"tool", {{"name", "sonarbench"}, {"version", "0.1.0"}}}};
+  return {{"schema_version", 1}, {"tool", {{"name", "sonarbench"}, {"version", kVersion}}}};
 }
 
 /// {name: sha256} of each of `files` in `dir`: what a report covers, for a reader to check.
