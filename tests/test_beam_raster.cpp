@@ -10,12 +10,12 @@
 #include <unordered_set>
 #include <vector>
 
-#include "sonarbench/mapping/beam_raster.hpp"
-#include "sonarbench/mapping/beam_volume.hpp"
-#include "sonarbench/mapping/integrate.hpp"
-#include "sonarbench/mapping/map_tree.hpp"
+#include "sonarbench/mapping/detail/beam_raster.hpp"
+#include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/detail/integrate.hpp"
+#include "sonarbench/mapping/detail/map_tree.hpp"
+#include "sonarbench/mapping/detail/ray_keys.hpp"
 #include "sonarbench/mapping/mapper.hpp"
-#include "sonarbench/mapping/ray_keys.hpp"
 
 namespace sonarbench::mapping {
 namespace {

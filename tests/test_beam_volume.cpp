@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "sonarbench/mapping/beam_volume.hpp"
-#include "sonarbench/mapping/integrate.hpp"
+#include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/detail/integrate.hpp"
 
 namespace sonarbench::mapping {
 namespace {

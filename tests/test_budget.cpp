@@ -1,10 +1,9 @@
-#include "sonarbench/sim/budget.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
+#include "sonarbench/sim/budget.hpp"
 #include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/scene.hpp"
 #include "test_util.hpp"
@@ -35,10 +34,10 @@ TEST(Budgets, EstimatesAreTheMeshesTrianglesAreasAndVolumes) {
   EXPECT_NEAR(e.truth_cells, (52 + 200) / 0.01 + 24 / 0.001, 1e-6);
   // A static sonar sweeps the zone of its range sphere within ±17.5° of elevation.
   const double r = scene.sensor.geometry.MaxRangeM();
-  EXPECT_NEAR(e.map_cells,
-              4.0 / 3.0 * std::numbers::pi * r * r * r * std::sin(17.5 * std::numbers::pi / 180) /
-                  1e-3,
-              1e-6 * e.map_cells);
+  EXPECT_NEAR(
+      e.map_cells,
+      4.0 / 3.0 * std::numbers::pi * r * r * r * std::sin(17.5 * std::numbers::pi / 180) / 1e-3,
+      1e-6 * e.map_cells);
 }
 
 TEST(Budgets, ARefusalNamesTheKeyTheEstimateTheLimitAndTheOption) {

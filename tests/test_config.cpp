@@ -7,6 +7,7 @@
 #include <tuple>
 #include <vector>
 
+#include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/dataset_writer.hpp"

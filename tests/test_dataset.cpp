@@ -5,7 +5,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "sonarbench/mapping/dataset.hpp"
+#include "sonarbench/io/dataset.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/dataset_writer.hpp"
 #include "sonarbench/sim/mesh.hpp"

@@ -5,8 +5,8 @@
 #include <unordered_set>
 #include <vector>
 
-#include "sonarbench/mapping/beam_volume.hpp"
-#include "sonarbench/mapping/key_set.hpp"
+#include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/detail/key_set.hpp"
 
 namespace sonarbench::mapping {
 namespace {

@@ -1,5 +1,3 @@
-#include "sonarbench/sim/output_directory.hpp"
-
 #include <gtest/gtest.h>
 #include <sys/file.h>
 #include <unistd.h>
@@ -8,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/sim/output_directory.hpp"
 #include "test_util.hpp"
 
 namespace sonarbench::sim {
@@ -76,8 +75,9 @@ TEST(OutputDirectory, AForeignMarkerIsNotOwnership) {
   Put(inner / "report.json", "old");
   OutputClaim claim = Claim(OutputMode::kResume);
   claim.force = true;
-  EXPECT_NE(test::InputErrorOf([&] { const OutputDirectory out(inner.string(), claim); })
-                .find("did not write: report.json"),
+  EXPECT_NE(test::InputErrorOf([&] {
+              const OutputDirectory out(inner.string(), claim);
+            }).find("did not write: report.json"),
             std::string::npos);
   EXPECT_EQ(Bytes(dir.path() / "outside.txt"), "keep");
   const auto owned = OwnedFiles(inner);
@@ -156,8 +156,9 @@ TEST(OutputDirectory, ForceRemovesOnlyListedFilesNeverATree) {
   Put(dir.path() / "map.bt.tmp.123", "a half-written temporary file");
   Put(dir.path() / "thesis.tmp.1", "the user's too");
   claim.config_sha256 = "b";
-  EXPECT_NE(test::InputErrorOf([&] { const OutputDirectory out(dir.path().string(), claim); })
-                .find("another configuration (config_sha256 a); pass --force"),
+  EXPECT_NE(test::InputErrorOf([&] {
+              const OutputDirectory out(dir.path().string(), claim);
+            }).find("another configuration (config_sha256 a); pass --force"),
             std::string::npos);
   EXPECT_EQ(Bytes(dir.path() / "map.bt"), "a");
   claim.force = true;
@@ -228,8 +229,9 @@ TEST(OutputDirectory, OneConfigurationWritesAtATime) {
       << error;
   OutputClaim forced = mine;
   forced.force = true;
-  EXPECT_NE(test::InputErrorOf([&] { const OutputDirectory f(dir.path().string(), forced); })
-                .find("--force never removes a running writer's files"),
+  EXPECT_NE(test::InputErrorOf([&] {
+              const OutputDirectory f(dir.path().string(), forced);
+            }).find("--force never removes a running writer's files"),
             std::string::npos);
   EXPECT_NE(test::InputErrorOf([&] {
               const OutputDirectory one_shot(dir.path().string(), Claim(OutputMode::kReplace));

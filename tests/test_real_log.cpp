@@ -15,8 +15,8 @@
 #include <tuple>
 #include <vector>
 
+#include "sonarbench/io/mat_log.hpp"
 #include "sonarbench/mapping/error.hpp"
-#include "sonarbench/mapping/mat_log.hpp"
 #include "sonarbench/sim/dataset_writer.hpp"
 #include "sonarbench/sim/fidelity.hpp"
 #include "sonarbench/sim/map_log.hpp"
@@ -34,9 +34,7 @@ namespace {
 using mapping::kDegToRad;
 
 // The real log ships in the repository (data/cras-tank-static/README.md).
-std::string RealLogPath() {
-  return test::SourcePath("data/cras-tank-static/dataset_static.mat");
-}
+std::string RealLogPath() { return test::SourcePath("data/cras-tank-static/dataset_static.mat"); }
 
 #define REQUIRE_REAL_LOG() ASSERT_TRUE(std::filesystem::exists(RealLogPath())) << RealLogPath()
 

@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "sonarbench/sim/scenario.hpp"
 #include "sonarbench/sim/report.hpp"
+#include "sonarbench/sim/scenario.hpp"
 #include "sonarbench/sim/scenario_report.hpp"
 #include "test_util.hpp"
 
@@ -522,9 +522,8 @@ TEST(Cli, NeverReplacesOrRemovesWhatItDidNotWrite) {
   fs::create_directories(project / "src");
   std::ofstream(project / "manifest.json") << R"({"name": "webapp"})";
   std::ofstream(project / "src/main.c") << "int main;";
-  EXPECT_EQ(RunCli("simulate " + scene.string() + " --out " + project.string() + " --force",
-                   &output),
-            2);
+  EXPECT_EQ(
+      RunCli("simulate " + scene.string() + " --out " + project.string() + " --force", &output), 2);
   EXPECT_NE(output.find("holds files sonarbench did not write: manifest.json"), std::string::npos)
       << output;
   EXPECT_EQ(ReadFile(project / "src/main.c"), "int main;");
@@ -534,8 +533,7 @@ TEST(Cli, NeverReplacesOrRemovesWhatItDidNotWrite) {
   // beside the log, which --force never removes.
   const auto logs = dir.path() / "logs";
   fs::create_directories(logs);
-  fs::copy_file(test::SourcePath("data/cras-tank-static/dataset_static.mat"),
-                logs / "LOG.mat");
+  fs::copy_file(test::SourcePath("data/cras-tank-static/dataset_static.mat"), logs / "LOG.mat");
   std::ofstream(logs / "manifest.json") << "{}";
   const std::string import = "import " + (logs / "LOG.mat").string() + " --out " + logs.string();
   EXPECT_EQ(RunCli(import + " --force", &output), 2);

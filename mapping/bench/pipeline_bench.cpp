@@ -22,10 +22,10 @@
 #include <vector>
 
 #include "bench_sets.hpp"
+#include "sonarbench/io/mat_log.hpp"
+#include "sonarbench/mapping/detail/integrate.hpp"
 #include "sonarbench/mapping/detection.hpp"
-#include "sonarbench/mapping/integrate.hpp"
 #include "sonarbench/mapping/mapper.hpp"
-#include "sonarbench/mapping/mat_log.hpp"
 
 namespace sonarbench::mapping::bench {
 namespace {

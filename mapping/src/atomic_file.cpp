@@ -72,8 +72,8 @@ void CheckOutputDirectory(const std::string& dir) {
     why = std::string(": ") + std::strerror(errno);  // "Permission denied", "Read-only file system"
   }
   if (!why.empty()) {
-    throw EnvironmentError(dir + ": cannot be made the output directory (" + ancestor.string() + why +
-                     "; expected a path where a directory can be made)");
+    throw EnvironmentError(dir + ": cannot be made the output directory (" + ancestor.string() +
+                           why + "; expected a path where a directory can be made)");
   }
 }
 
@@ -83,7 +83,7 @@ void CreateOutputDirectory(const std::string& dir) {
   std::filesystem::create_directories(dir, error);
   if (error) {
     throw EnvironmentError(dir + ": cannot be made the output directory (" + error.message() +
-                     "; expected a path where a directory can be made)");
+                           "; expected a path where a directory can be made)");
   }
 }
 

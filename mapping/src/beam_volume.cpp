@@ -1,4 +1,4 @@
-#include "sonarbench/mapping/beam_volume.hpp"
+#include "sonarbench/mapping/detail/beam_volume.hpp"
 
 namespace sonarbench::mapping {
 namespace {

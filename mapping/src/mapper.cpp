@@ -5,25 +5,52 @@
 #include <algorithm>
 
 #include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/beam_volume.hpp"
+#include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/detail/integrate.hpp"
+#include "sonarbench/mapping/detail/key_set.hpp"
+#include "sonarbench/mapping/detail/map_tree.hpp"
 #include "sonarbench/mapping/detection.hpp"
-#include "sonarbench/mapping/key_set.hpp"
 
 namespace sonarbench::mapping {
 
+struct Mapper::State {
+  double free_range_m = 0.0;
+  int threads = 1;
+  std::vector<Eigen::Vector3d> directions;
+  MapTree tree;
+  /// The key sets and buffers of the batches, kept between them (the one of config.key_set).
+  BatchWorkspace<KeySet> std_workspace;
+  BatchWorkspace<KeyOpenSet> open_workspace;
+  /// Whether the tree's inner nodes lag its leaves (see FinishUpdates).
+  bool stale = false;
+
+  explicit State(double resolution_m) : tree(resolution_m) {}
+};
+
 Mapper::Mapper(const MapperConfig& config, const SensorGeometry& sensor)
-    : config_(config),
-      sensor_(sensor),
-      free_range_m_(!config.clear_without_obstacle ? 0.0
-                    : config.free_range_m > 0.0    ? config.free_range_m
-                                                   : sensor.MaxRangeM()),
-      threads_(config.threads > 0 ? config.threads : omp_get_max_threads()),
-      directions_(BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical)),
-      tree_(std::make_unique<MapTree>(config.resolution_m)) {
-  tree_->setProbHit(config.prob_hit);
-  tree_->setProbMiss(config.prob_miss);
-  tree_->setClampingThresMin(config.clamp_min);
-  tree_->setClampingThresMax(config.clamp_max);
+    : config_(config), sensor_(sensor), state_(std::make_unique<State>(config.resolution_m)) {
+  state_->free_range_m = !config.clear_without_obstacle ? 0.0
+                         : config.free_range_m > 0.0    ? config.free_range_m
+                                                        : sensor.MaxRangeM();
+  state_->threads = config.threads > 0 ? config.threads : omp_get_max_threads();
+  state_->directions = BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical);
+  MapTree& tree = state_->tree;
+  tree.setProbHit(config.prob_hit);
+  tree.setProbMiss(config.prob_miss);
+  tree.setClampingThresMin(config.clamp_min);
+  tree.setClampingThresMax(config.clamp_max);
+}
+
+Mapper::~Mapper() = default;
+Mapper::Mapper(Mapper&&) noexcept = default;
+Mapper& Mapper::operator=(Mapper&&) noexcept = default;
+
+const octomap::OcTree& Mapper::tree() const {
+  if (state_->stale) {
+    FinishUpdates(state_->tree);
+    state_->stale = false;
+  }
+  return state_->tree;
 }
 
 BatchStats Mapper::Integrate(std::span<const Beam> beams) {
@@ -47,13 +74,14 @@ BatchStats Mapper::IntegrateSweeps(
 
 BatchStats Mapper::Integrate(std::span<const Beam> beams,
                              std::span<const std::vector<double>> obstacles) {
-  stale_ = true;
+  State& s = *state_;
+  s.stale = true;
   if (config_.key_set == KeySetKind::kStd) {
-    return IntegrateBatch(*tree_, beams, obstacles, directions_, free_range_m_, threads_,
-                          std_workspace_);
+    return IntegrateBatch(s.tree, beams, obstacles, s.directions, s.free_range_m, s.threads,
+                          s.std_workspace);
   }
-  return IntegrateBatch(*tree_, beams, obstacles, directions_, free_range_m_, threads_,
-                        open_workspace_);
+  return IntegrateBatch(s.tree, beams, obstacles, s.directions, s.free_range_m, s.threads,
+                        s.open_workspace);
 }
 
 void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out) {

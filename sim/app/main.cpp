@@ -15,9 +15,10 @@
 #include <sstream>
 #include <string>
 
+#include "sonarbench/io/mapping_yaml.hpp"
+#include "sonarbench/io/mat_log.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
-#include "sonarbench/mapping/mat_log.hpp"
 #include "sonarbench/sim/dataset_writer.hpp"
 #include "sonarbench/sim/divisions_study.hpp"
 #include "sonarbench/sim/fidelity.hpp"
@@ -267,11 +268,9 @@ int Fidelity(const FidelityArgs& args) {
   sim::OutputDirectory out(args.out, OneShotClaim("fidelity", sim::kFidelityOutputFiles, inputs));
   const sim::RayTracer tracer(meshes);
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
-  const auto synthesized =
-      sim::SimulateScene(scene, tracer, args.seed.value_or(scene.seed), args.threads,
-                         [&](std::size_t done, std::size_t total) {
-                           progress.Update("simulate", done, total);
-                         });
+  const auto synthesized = sim::SimulateScene(
+      scene, tracer, args.seed.value_or(scene.seed), args.threads,
+      [&](std::size_t done, std::size_t total) { progress.Update("simulate", done, total); });
   progress.Clear();
   const std::vector<sonarbench::mapping::Beam> beams = sim::BeamsOf(synthesized);
   const auto& g = scene.sensor.geometry;
@@ -279,9 +278,9 @@ int Fidelity(const FidelityArgs& args) {
   const auto per_sweep = static_cast<std::size_t>(g.BeamsPerSweep());
   const std::span<const sonarbench::mapping::Beam> sim_all(beams);
   const std::span<const sonarbench::mapping::Beam> real_all(log.beams);
-  sim::WriteFidelityOutputs(out.write_root().string(), report, sim_all.first(std::min(per_sweep, sim_all.size())),
-                            real_all.first(std::min(per_sweep, real_all.size())), g, args.scene,
-                            args.log);
+  sim::WriteFidelityOutputs(
+      out.write_root().string(), report, sim_all.first(std::min(per_sweep, sim_all.size())),
+      real_all.first(std::min(per_sweep, real_all.size())), g, args.scene, args.log);
   out.Commit();
   std::cout << "mean intensity vs range: correlation " << report.profile_correlation_all
             << " (all bins), " << report.profile_correlation_usable

@@ -565,8 +565,7 @@ namespace {
 // when the program starts: the loop is the same element-wise products and sums at any vector
 // width, and the file is built without fused multiply-adds (sim/CMakeLists.txt), so every
 // clone gives the same bits; the wider ones in a fraction of the time (synthesis_bench).
-SONARBENCH_CLONES void AddScaled(
-    std::span<double> to, std::span<const double> from, double w) {
+SONARBENCH_CLONES void AddScaled(std::span<double> to, std::span<const double> from, double w) {
   for (std::size_t k = 0; k < to.size(); ++k) to[k] += w * from[k];
 }
 

@@ -34,8 +34,8 @@ MeshEstimate EstimateMesh(const MeshSpec& spec) {
       break;
     case MeshSpec::Type::kHeightField:
       // As BuildMesh grids it: at least one cell each way.
-      e = {2 * std::max(1.0, s[0] / spec.cell_m) * std::max(1.0, s[1] / spec.cell_m),
-           s[0] * s[1], 0, "cell_m"};
+      e = {2 * std::max(1.0, s[0] / spec.cell_m) * std::max(1.0, s[1] / spec.cell_m), s[0] * s[1],
+           0, "cell_m"};
       break;
     case MeshSpec::Type::kFile: {
       e.triangles = static_cast<double>(spec.file_triangles.size());
@@ -100,8 +100,8 @@ SceneEstimate EstimateScene(const Scene& scene) {
   }
   if (scene.trajectory.waypoints.empty()) lo = hi = Eigen::Vector3d::Zero();
   const double mount = scene.sensor.geometry.T_vehicle_sonar.translation().norm();
-  e.map_cells = MapCellsEstimate(scene.sensor.geometry, res, lo.array() - mount,
-                                 hi.array() + mount);
+  e.map_cells =
+      MapCellsEstimate(scene.sensor.geometry, res, lo.array() - mount, hi.array() + mount);
   return e;
 }
 
@@ -141,7 +141,7 @@ void CheckBudgets(const Scene& scene, const Budgets& budgets) {
         heaviest = &spec;
         key = triangles && spec.type == MeshSpec::Type::kFile ? "file"
               : !triangles && m.fill_m3 > 0                   ? "fill"
-                                                               : m.key;
+                                                              : m.key;
       }
     }
   }

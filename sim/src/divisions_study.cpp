@@ -7,15 +7,15 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "sonarbench/io/dataset.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/dataset.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/beam_coverage.hpp"
+#include "sonarbench/sim/dataset_writer.hpp"
 #include "sonarbench/sim/ground_truth.hpp"
 #include "sonarbench/sim/images.hpp"
 #include "sonarbench/sim/mesh.hpp"
-#include "sonarbench/sim/dataset_writer.hpp"
 #include "sonarbench/sim/output_directory.hpp"
 #include "sonarbench/sim/ray_tracer.hpp"
 #include "sonarbench/sim/report.hpp"

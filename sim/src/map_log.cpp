@@ -5,10 +5,10 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
+#include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/mat_log.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/dataset.hpp"
 #include "sonarbench/mapping/error.hpp"
-#include "sonarbench/mapping/mat_log.hpp"
 #include "sonarbench/sim/dataset_writer.hpp"
 #include "sonarbench/sim/images.hpp"
 #include "sonarbench/sim/mesh.hpp"

@@ -11,8 +11,8 @@
 #include <set>
 #include <stdexcept>
 
+#include "sonarbench/io/dataset.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/dataset.hpp"
 #include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::sim {
@@ -92,7 +92,8 @@ std::string BlockedFolder(const fs::path& root, const std::string& relative) {
   return {};
 }
 
-std::vector<std::string> SortedUnion(std::vector<std::string> a, const std::vector<std::string>& b) {
+std::vector<std::string> SortedUnion(std::vector<std::string> a,
+                                     const std::vector<std::string>& b) {
   a.insert(a.end(), b.begin(), b.end());
   std::sort(a.begin(), a.end());
   a.erase(std::unique(a.begin(), a.end()), a.end());
@@ -141,8 +142,9 @@ std::optional<Ownership> ReadOwnership(const fs::path& dir) {
   }
   // A dataset written before markers existed: its manifest lists its files.
   if (const auto manifest = ReadJson(dir / "manifest.json");
-      manifest && manifest->is_object() && manifest->value("format", "") == mapping::kDatasetFormat &&
-      manifest->contains("files") && (*manifest)["files"].is_array()) {
+      manifest && manifest->is_object() &&
+      manifest->value("format", "") == mapping::kDatasetFormat && manifest->contains("files") &&
+      (*manifest)["files"].is_array()) {
     owned[manifest->value("source", "simulate")] = {
         manifest->value("config_sha256", ""),
         SortedUnion(names((*manifest)["files"], "path"), {"manifest.json"})};
@@ -305,7 +307,8 @@ void OutputDirectory::RemoveFiles(const std::vector<std::string>& files) const {
     if (const std::string link = SymlinkedFolder(root_, file); !link.empty()) {
       throw InputError(name_ + "/" + link +
                        " is a symlink: sonarbench removes nothing through one (make it a folder "
-                       "or remove " + file + " by hand)");
+                       "or remove " +
+                       file + " by hand)");
     }
     std::error_code error;
     fs::remove(root_ / file, error);

@@ -5,6 +5,7 @@
 #include <optional>
 #include <sstream>
 
+#include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/mesh_file.hpp"
 

@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include "sonarbench/io/mapping_yaml.hpp"
+
 namespace sonarbench::sim {
 
 std::size_t MainLobeRays(const Acoustics& a) {

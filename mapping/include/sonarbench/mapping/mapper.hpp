@@ -8,10 +8,8 @@
 #include <span>
 #include <string>
 
+#include "sonarbench/mapping/batch_stats.hpp"
 #include "sonarbench/mapping/beam.hpp"
-#include "sonarbench/mapping/integrate.hpp"
-#include "sonarbench/mapping/key_set.hpp"
-#include "sonarbench/mapping/map_tree.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
@@ -29,6 +27,11 @@ void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out);
 class Mapper {
  public:
   Mapper(const MapperConfig& config, const SensorGeometry& sensor);
+  ~Mapper();
+  Mapper(Mapper&&) noexcept;
+  Mapper& operator=(Mapper&&) noexcept;
+  Mapper(const Mapper&) = delete;
+  Mapper& operator=(const Mapper&) = delete;
 
   /// Integrates a batch of beams (one sweep: Canny detection works on the sweep's image) as one
   /// update: each cell is updated at most once per batch, occupied winning over free.
@@ -42,14 +45,8 @@ class Mapper {
   /// The same, with obstacle ranges already detected (one list per beam).
   BatchStats Integrate(std::span<const Beam> beams, std::span<const std::vector<double>> obstacles);
 
-  /// The map, brought up to date (FinishUpdates) if a batch was integrated since the last call.
-  [[nodiscard]] const octomap::OcTree& tree() const {
-    if (stale_) {
-      FinishUpdates(*tree_);
-      stale_ = false;
-    }
-    return *tree_;
-  }
+  /// The map, its inner nodes brought up to date if a batch was integrated since the last call.
+  [[nodiscard]] const octomap::OcTree& tree() const;
   [[nodiscard]] const MapperConfig& config() const { return config_; }
 
   /// Writes the map as an OctoMap binary `.bt` file (maximum-likelihood occupancy), atomically.
@@ -60,15 +57,9 @@ class Mapper {
  private:
   MapperConfig config_;
   SensorGeometry sensor_;
-  double free_range_m_ = 0.0;
-  int threads_ = 1;
-  std::vector<Eigen::Vector3d> directions_;
-  std::unique_ptr<MapTree> tree_;
-  /// The key sets and buffers of the batches, kept between them (the one of config.key_set).
-  BatchWorkspace<KeySet> std_workspace_;
-  BatchWorkspace<KeyOpenSet> open_workspace_;
-  /// Whether the tree's node count and inner nodes lag its leaves (see FinishUpdates).
-  mutable bool stale_ = false;
+  /// The tree and the batches' workspaces (mapper.cpp): the public header needs no OpenMP.
+  struct State;
+  std::unique_ptr<State> state_;
 };
 
 }  // namespace sonarbench::mapping

@@ -2,8 +2,6 @@
 
 #include <string>
 
-#include "sonarbench/mapping/yaml_reader.hpp"
-
 namespace sonarbench::mapping {
 
 /// How obstacles are found along a beam. See detection.hpp.
@@ -64,9 +62,5 @@ struct MapperConfig {
   int threads = 0;
   KeySetKind key_set = KeySetKind::kOpenAddressing;
 };
-
-/// Reads a `mapping` mapping of a scene file over `base` (absent keys keep its values; by default
-/// the struct's defaults).
-[[nodiscard]] MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base = {});
 
 }  // namespace sonarbench::mapping

@@ -3,8 +3,6 @@
 #include <Eigen/Geometry>
 #include <numbers>
 
-#include "sonarbench/mapping/yaml_reader.hpp"
-
 namespace sonarbench::mapping {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
@@ -41,8 +39,5 @@ struct SensorGeometry {
   /// Index of the first bin at or beyond the self-reflection range.
   [[nodiscard]] int FirstUsableBin() const;
 };
-
-/// Reads a sensor model's `geometry` mapping (keys carry their units: `..._deg`, `..._m`).
-[[nodiscard]] SensorGeometry ReadSensorGeometry(YamlReader& node);
 
 }  // namespace sonarbench::mapping

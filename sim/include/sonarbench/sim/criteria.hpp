@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "sonarbench/mapping/yaml_reader.hpp"
+#include "sonarbench/io/yaml_reader.hpp"
 
 namespace sonarbench::sim {
 

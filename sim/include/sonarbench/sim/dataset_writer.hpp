@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "sonarbench/mapping/dataset.hpp"
-#include "sonarbench/mapping/mat_log.hpp"
+#include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/mat_log.hpp"
 #include "sonarbench/sim/scene.hpp"
 
 namespace sonarbench::sim {

@@ -216,11 +216,17 @@ std::size_t SecondTripProfile(std::span<const mapping::Beam> beams,
 /// profile.png (the two mean profiles), and polar and fan images of each run's first sweep side
 /// by side (sim left, real right) into `out_dir`.
 /// The files WriteFidelityOutputs writes, relative to its `out_dir`.
-inline const std::vector<std::string> kFidelityOutputFiles = {
-    "fidelity.json",       "profile.csv",  "profile.png",  "wall_range.csv",
-    "wall_profile.csv",    "direct_wall_profile.csv",      "second_trip_profile.csv",
-    "histogram.csv",       "by_head_angle.csv",            "polar.png",
-    "fan.png"};
+inline const std::vector<std::string> kFidelityOutputFiles = {"fidelity.json",
+                                                              "profile.csv",
+                                                              "profile.png",
+                                                              "wall_range.csv",
+                                                              "wall_profile.csv",
+                                                              "direct_wall_profile.csv",
+                                                              "second_trip_profile.csv",
+                                                              "histogram.csv",
+                                                              "by_head_angle.csv",
+                                                              "polar.png",
+                                                              "fan.png"};
 
 void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& report,
                           std::span<const mapping::Beam> sim_sweep,

@@ -6,7 +6,7 @@
 #include <functional>
 #include <span>
 
-#include "sonarbench/mapping/beam_volume.hpp"
+#include "sonarbench/mapping/detail/beam_volume.hpp"
 #include "sonarbench/sim/mesh.hpp"
 #include "sonarbench/sim/ray_tracer.hpp"
 #include "sonarbench/sim/sensor_model.hpp"

@@ -49,11 +49,11 @@ struct LogMapResult {
 /// a dataset's beams keep their own, but for an imported log's, which are placed the same way. A
 /// simulated dataset scored against another scene than its manifest names is refused. A map that
 /// would hold more than `budgets.max_cells` cells (MapCellsEstimate over the beams' poses) is
-/// refused before it is made. `progress` counts the sweeps mapped. Throws InputError for input that is not a readable log.
+/// refused before it is made. `progress` counts the sweeps mapped. Throws InputError for input that
+/// is not a readable log.
 [[nodiscard]] LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
                                   const mapping::MapperConfig& config,
-                                  const Scene* place_in = nullptr,
-                                  const Budgets& budgets = {},
+                                  const Scene* place_in = nullptr, const Budgets& budgets = {},
                                   const StageProgress& progress = {});
 
 /// The static sonar pose of `scene` (its first beam's), where a `.mat` log of the place is mapped
@@ -68,8 +68,8 @@ struct LogMapResult {
 [[nodiscard]] MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene);
 
 /// The files WriteLogMapOutputs writes, relative to its `out_dir`.
-inline const std::vector<std::string> kLogMapOutputFiles = {
-    "map.bt", "map.ot", "map_top.png", "polar.png", "fan.png", "report.json"};
+inline const std::vector<std::string> kLogMapOutputFiles = {"map.bt",    "map.ot",  "map_top.png",
+                                                            "polar.png", "fan.png", "report.json"};
 
 /// Writes `map.bt`, `map.ot`, `map_top.png`, `polar.png`, `fan.png` and `report.json` (with the
 /// scores under "metrics" if the map was scored, and the sha256 of the others under

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "sonarbench/io/dataset.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/dataset.hpp"
 
 namespace sonarbench::sim {
 

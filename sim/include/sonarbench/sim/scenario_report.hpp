@@ -33,7 +33,7 @@ inline constexpr int kScenarioReportSchema = 2;
 
 /// The files WriteScenarioOutputs writes (and an error junit.xml), relative to its `out_dir`.
 inline const std::vector<std::string> kScenarioOutputFiles = {
-    "map.bt",      "polar.png",   "fan.png",   "map_top.png",
+    "map.bt",       "polar.png",   "fan.png",   "map_top.png",
     "map_side.png", "report.json", "junit.xml", "report.html"};
 
 /// Writes, each file atomically, into `out_dir` (created if needed): map.bt, polar.png (the first

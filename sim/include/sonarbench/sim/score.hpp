@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "sonarbench/mapping/beam_volume.hpp"
+#include "sonarbench/mapping/detail/beam_volume.hpp"
 #include "sonarbench/sim/ground_truth.hpp"
 #include "sonarbench/sim/mesh.hpp"
 

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "sonarbench/io/yaml_reader.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
 namespace sonarbench::sim {

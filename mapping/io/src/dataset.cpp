@@ -1,4 +1,4 @@
-#include "sonarbench/mapping/dataset.hpp"
+#include "sonarbench/io/dataset.hpp"
 
 #include <openssl/evp.h>
 
@@ -12,9 +12,10 @@
 #include <memory>
 #include <sstream>
 
+#include "sonarbench/io/mapping_yaml.hpp"
+#include "sonarbench/io/yaml_reader.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
-#include "sonarbench/mapping/yaml_reader.hpp"
 
 namespace sonarbench::mapping {
 namespace {

@@ -1,4 +1,4 @@
-#include "sonarbench/mapping/yaml_reader.hpp"
+#include "sonarbench/io/yaml_reader.hpp"
 
 #include <cmath>
 #include <cstdint>

@@ -11,8 +11,9 @@
 #include <utility>
 #include <vector>
 
-#include "sonarbench/mapping/beam_volume.hpp"
-#include "sonarbench/mapping/map_tree.hpp"
+#include "sonarbench/mapping/batch_stats.hpp"
+#include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/detail/map_tree.hpp"
 
 namespace sonarbench::mapping {
 
@@ -68,39 +69,6 @@ inline void RadixSort(std::vector<std::uint64_t>& values, std::vector<std::uint6
     values.swap(scratch);
   }
 }
-
-/// Per-batch counts, for reports and benchmarks.
-struct BatchStats {
-  std::size_t beams = 0;
-  std::size_t beams_with_obstacle = 0;
-  std::size_t ray_casts = 0;
-  /// Cell visits by all rays, repeats included.
-  std::size_t cell_visits = 0;
-  /// Distinct free cells of each beam, summed over the beams: what goes into the key sets.
-  std::size_t beam_free_cells = 0;
-  /// Distinct cells updated free / occupied.
-  std::size_t free_cells = 0;
-  std::size_t occupied_cells = 0;
-  /// Wall time [s] of the stages: ray casting into the threads' sets, splitting the sets' cells
-  /// into octants, and per octant merging (occupied winning), sorting and applying the updates.
-  double cast_s = 0.0;
-  double split_s = 0.0;
-  double update_s = 0.0;
-
-  BatchStats& operator+=(const BatchStats& o) {
-    beams += o.beams;
-    beams_with_obstacle += o.beams_with_obstacle;
-    ray_casts += o.ray_casts;
-    cell_visits += o.cell_visits;
-    beam_free_cells += o.beam_free_cells;
-    free_cells += o.free_cells;
-    occupied_cells += o.occupied_cells;
-    cast_s += o.cast_s;
-    split_s += o.split_s;
-    update_s += o.update_s;
-    return *this;
-  }
-};
 
 /// Brings a tree that IntegrateBatch updated up to date for reading and writing: the inner nodes'
 /// occupancy (the maximum of their children's). Updates leave it stale (lazy evaluation, no

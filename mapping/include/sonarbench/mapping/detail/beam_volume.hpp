@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "sonarbench/mapping/beam.hpp"
-#include "sonarbench/mapping/beam_raster.hpp"
-#include "sonarbench/mapping/key_set.hpp"
+#include "sonarbench/mapping/detail/beam_raster.hpp"
+#include "sonarbench/mapping/detail/key_set.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
 namespace sonarbench::mapping {

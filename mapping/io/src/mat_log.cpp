@@ -1,4 +1,4 @@
-#include "sonarbench/mapping/mat_log.hpp"
+#include "sonarbench/io/mat_log.hpp"
 
 #include <matio.h>
 #include <zlib.h>

@@ -1,0 +1,16 @@
+#pragma once
+
+#include "sonarbench/io/yaml_reader.hpp"
+#include "sonarbench/mapping/mapper_config.hpp"
+#include "sonarbench/mapping/sensor_geometry.hpp"
+
+namespace sonarbench::mapping {
+
+/// Reads a `mapping` mapping of a scene file over `base` (absent keys keep its values; by default
+/// the struct's defaults).
+[[nodiscard]] MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base = {});
+
+/// Reads a sensor model's `geometry` mapping (keys carry their units: `..._deg`, `..._m`).
+[[nodiscard]] SensorGeometry ReadSensorGeometry(YamlReader& node);
+
+}  // namespace sonarbench::mapping
