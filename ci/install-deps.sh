@@ -9,7 +9,7 @@ packages=(
   libcli11-dev libmatio-dev zlib1g-dev nlohmann-json3-dev libabsl-dev libassimp-dev
   libxml2-utils libssl-dev
   libgtest-dev libbenchmark-dev
-  clang libomp-14-dev
+  clang libclang-rt-14-dev libomp-14-dev
 )
 
 missing=()
