@@ -105,7 +105,7 @@ def kill_trials(sonarbench, kind, scene, work, trials, rng):
         over_old = trial % 2 == 1 and kind != "import"
         if over_old:
             code, text = run(command(sonarbench, kind, scene, out, 2))
-            check(code in (0, 1), f"{kind}: the earlier run failed: {text}")
+            check(code in (0, 1), f"{kind}: the run of seed 2 failed: {text}")
         process = subprocess.Popen(command(sonarbench, kind, scene, out, 1, force=over_old),
                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         time.sleep(rng.uniform(0.0, 1.1 * full))

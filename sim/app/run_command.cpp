@@ -48,7 +48,7 @@ void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::Sc
   for (const auto& reason : v.reasons) std::cout << "  " << reason << "\n";
 }
 
-// A run that broke still leaves a junit.xml saying so (and nothing of an earlier run), for the CI
+// A run that broke still leaves a junit.xml saying so (and no other output), for the CI
 // system that collects it.
 void CommitErrorJunit(sonarbench::sim::OutputDirectory& out, const RunArgs& args,
                       std::string_view type, const std::string& message) {

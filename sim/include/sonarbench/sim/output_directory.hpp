@@ -8,10 +8,10 @@
 
 namespace sonarbench::sim {
 
-/// How a command's outputs meet those of an earlier run in the same directory.
+/// How a command's outputs meet the outputs already in its directory.
 enum class OutputMode {
   /// One shot (run, map, fidelity): outputs go to a staging folder inside the directory and
-  /// Commit moves them into place, the record last; the earlier run's outputs go whole.
+  /// Commit moves them into place, the record last; the outputs there before go whole.
   kReplace,
   /// Resumable (simulate, import, sweep): outputs are written in place, each file atomically; a
   /// run of the same configuration resumes (shards of it write at once), another configuration
@@ -32,7 +32,7 @@ struct OutputClaim {
   std::string record;
   /// Files the command reads: never written or removed.
   std::vector<std::string> inputs;
-  /// kResume: remove what an earlier run listed in the marker before writing.
+  /// kResume: remove what the marker lists for this command before writing.
   bool force = false;
 };
 
@@ -72,7 +72,7 @@ class OutputDirectory {
   /// The directory itself (a symlink's target).
   [[nodiscard]] const std::filesystem::path& root() const { return root_; }
 
-  /// kReplace: removes the earlier record, then the earlier run's claimed files this run did not
+  /// kReplace: removes the record there, then the claimed files this run did not
   /// stage, moves the staged files into place and the record last. Throws logic_error for a
   /// staged file outside the claim.
   void Commit();
