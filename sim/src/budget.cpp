@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <vector>
 
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/scene.hpp"
@@ -78,19 +79,36 @@ std::string Number(double value) {
                    " raises the limit; expected a scene this machine can hold)");
 }
 
+// A mesh's ground-truth cells at `res` [m]: its surface and, when filled, its inside.
+double TruthCells(const MeshEstimate& m, double res) {
+  return m.area_m2 / (res * res) + m.fill_m3 / (res * res * res);
+}
+
+// A mesh or vehicle part with its estimate; `truth` when it is scored (a scene mesh with truth).
+struct Weighed {
+  const MeshSpec* spec;
+  MeshEstimate estimate;
+  bool truth;
+};
+
+std::vector<Weighed> WeighMeshes(const Scene& scene) {
+  std::vector<Weighed> weighed;
+  for (const auto* list : {&scene.meshes, &scene.vehicle}) {
+    for (const MeshSpec& spec : *list) {
+      weighed.push_back({&spec, EstimateMesh(spec), list == &scene.meshes && spec.truth});
+    }
+  }
+  return weighed;
+}
+
 }  // namespace
 
 SceneEstimate EstimateScene(const Scene& scene) {
   SceneEstimate e;
   const double res = scene.mapping.resolution_m;
-  for (const auto* list : {&scene.meshes, &scene.vehicle}) {
-    for (const MeshSpec& spec : *list) {
-      const MeshEstimate m = EstimateMesh(spec);
-      e.triangles += m.triangles;
-      if (list == &scene.meshes && spec.truth) {
-        e.truth_cells += m.area_m2 / (res * res) + m.fill_m3 / (res * res * res);
-      }
-    }
+  for (const Weighed& mesh : WeighMeshes(scene)) {
+    e.triangles += mesh.estimate.triangles;
+    if (mesh.truth) e.truth_cells += TruthCells(mesh.estimate, res);
   }
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL);
   Eigen::Vector3d hi = -lo;
@@ -125,23 +143,24 @@ void CheckMapCells(double estimate, const Budgets& budgets, const std::string& w
 
 void CheckBudgets(const Scene& scene, const Budgets& budgets) {
   const SceneEstimate e = EstimateScene(scene);
-  // The mesh that weighs most names the key to change.
+  const bool triangles = !(e.triangles <= budgets.max_triangles);
+  const bool cells = !(e.truth_cells <= budgets.max_cells);
+  const double res = scene.mapping.resolution_m;
+  // The mesh that weighs most in what is over its limit names the key to change.
   const MeshSpec* heaviest = nullptr;
   const char* key = "size_m";
   double most = -1.0;
-  const double res = scene.mapping.resolution_m;
-  const bool triangles = !(e.triangles <= budgets.max_triangles);
-  for (const auto* list : {&scene.meshes, &scene.vehicle}) {
-    for (const MeshSpec& spec : *list) {
-      const MeshEstimate m = EstimateMesh(spec);
-      const double weight =
-          triangles ? m.triangles : m.area_m2 / (res * res) + m.fill_m3 / (res * res * res);
+  if (triangles || cells) {
+    for (const Weighed& mesh : WeighMeshes(scene)) {
+      if (!triangles && !mesh.truth) continue;
+      const MeshEstimate& m = mesh.estimate;
+      const double weight = triangles ? m.triangles : TruthCells(m, res);
       if (weight > most || std::isnan(weight)) {
         most = weight;
-        heaviest = &spec;
-        key = triangles && spec.type == MeshSpec::Type::kFile ? "file"
-              : !triangles && m.fill_m3 > 0                   ? "fill"
-                                                              : m.key;
+        heaviest = mesh.spec;
+        key = triangles && mesh.spec->type == MeshSpec::Type::kFile ? "file"
+              : !triangles && m.fill_m3 > 0                         ? "fill"
+                                                                    : m.key;
       }
     }
   }
@@ -151,7 +170,7 @@ void CheckBudgets(const Scene& scene, const Budgets& budgets) {
     Refuse(where, "its meshes make", e.triangles, "triangles", budgets.max_triangles,
            "--max-triangles");
   }
-  if (!(e.truth_cells <= budgets.max_cells)) {
+  if (cells) {
     Refuse(where + " at 'mapping.resolution_m' " + Number(res), "its ground truth takes",
            e.truth_cells, "cells", budgets.max_cells, "--max-cells");
   }

@@ -80,6 +80,16 @@ std::string SymlinkedFolder(const fs::path& root, const std::string& relative) {
   return {};
 }
 
+// Refuses `relative` when a folder on its way down from `root` (the directory named `name`) is a
+// symlink: nothing is written or removed through one.
+void RefuseSymlinkedFolder(const std::string& name, const fs::path& root,
+                           const std::string& relative) {
+  if (const std::string link = SymlinkedFolder(root, relative); !link.empty()) {
+    throw InputError(name + "/" + link + " is a symlink: sonarbench writes and removes nothing " +
+                     "through one (make it a folder or choose another --out)");
+  }
+}
+
 // The first folder on `relative`'s way down from `root` that something else stands in, or "".
 std::string BlockedFolder(const fs::path& root, const std::string& relative) {
   fs::path folder;
@@ -250,7 +260,7 @@ void OutputDirectory::Open() {
   lock_created_ = false;  // listed in the marker now
   WriteHolder();
   // Temporary files of a killed writer are never whole.
-  RemoveFiles({});
+  RemoveTemporaries({});
   write_root_ = root_;
   if (claim_.mode == OutputMode::kResume) {
     // Converted under the directory's lock, so no other writer can take it in between.
@@ -270,11 +280,7 @@ void OutputDirectory::CheckInputsAndCollisions(const std::vector<std::string>& o
   const std::set<std::string> mine(owned.begin(), owned.end());
   if (Exists(root_ / kMarkerFile) && !OwnedFiles(root_)) foreign.push_back(kMarkerFile);
   for (const std::string& file : claim_.files) {
-    if (const std::string link = SymlinkedFolder(root_, file); !link.empty()) {
-      throw InputError(name_ + "/" + link +
-                       " is a symlink: sonarbench writes and removes nothing through one (make "
-                       "it a folder or choose another --out)");
-    }
+    RefuseSymlinkedFolder(name_, root_, file);
     if (const std::string blocked = BlockedFolder(root_, file); !blocked.empty()) {
       foreign.push_back(blocked + " (where a folder goes)");
     } else if (!mine.contains(file) && Exists(root_ / file)) {
@@ -304,20 +310,19 @@ void OutputDirectory::CheckInputsAndCollisions(const std::vector<std::string>& o
 
 void OutputDirectory::RemoveFiles(const std::vector<std::string>& files) const {
   for (const std::string& file : files) {
-    if (const std::string link = SymlinkedFolder(root_, file); !link.empty()) {
-      throw InputError(name_ + "/" + link +
-                       " is a symlink: sonarbench removes nothing through one (make it a folder "
-                       "or remove " +
-                       file + " by hand)");
-    }
+    RefuseSymlinkedFolder(name_, root_, file);
     std::error_code error;
     fs::remove(root_ / file, error);
     if (error) {
       throw EnvironmentError(name_ + "/" + file + ": cannot be removed (" + error.message() + ")");
     }
   }
-  // Temporary files beside the listed ones ("NAME.tmp.PID", WriteFileAtomically's), then the
-  // folders that are left empty.
+  RemoveTemporaries(files);
+  for (const std::string& file : files) RemoveEmptyParents(root_, file);
+}
+
+void OutputDirectory::RemoveTemporaries(const std::vector<std::string>& files) const {
+  // "NAME.tmp.PID" beside a listed or given NAME: WriteFileAtomically's, of a writer that died.
   const auto listed = OwnedFiles(root_).value_or(std::vector<std::string>{});
   const std::set<std::string> names(listed.begin(), listed.end());
   std::set<fs::path> folders;
@@ -338,7 +343,6 @@ void OutputDirectory::RemoveFiles(const std::vector<std::string>& files) const {
       fs::remove(it->path(), ignored);
     }
   }
-  for (const std::string& file : files) RemoveEmptyParents(root_, file);
 }
 
 void OutputDirectory::WriteMarker(const Ownership& owned) const {

@@ -82,6 +82,7 @@ class OutputDirectory {
   void Release() noexcept;
   void CheckInputsAndCollisions(const std::vector<std::string>& owned) const;
   void RemoveFiles(const std::vector<std::string>& files) const;
+  void RemoveTemporaries(const std::vector<std::string>& files) const;
   void WriteMarker(const Ownership& owned) const;
   void WriteHolder() const;
   [[nodiscard]] std::string Holder() const;
