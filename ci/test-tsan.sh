@@ -11,8 +11,8 @@ mkdir -p build-tsan
 CC=clang CXX=clang++ cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DSONARBENCH_TSAN=ON -DSONARBENCH_BUILD_BENCHMARKS=OFF -DSONARBENCH_WERROR="$werror" \
   > build-tsan/configure.log 2>&1 || { cat build-tsan/configure.log; exit 1; }
-cmake --build build-tsan -j "$(nproc)" --target sonarbench test_beam_volume test_beam_raster \
-  test_beam_synthesis test_beam_coverage test_scenario
+cmake --build build-tsan -j "$(nproc)" --target sonarbench test_mapping test_sonar test_app \
+  test_scenario
 cd build-tsan
 export OMP_TOOL_LIBRARIES=/usr/lib/llvm-14/lib/libarcher.so
 export TSAN_OPTIONS="halt_on_error=1 ignore_noninstrumented_modules=1 suppressions=$PWD/../ci/tsan.supp"

@@ -1,4 +1,4 @@
-// Google Benchmark of beam synthesis against raw Embree (issue 3's speed goals), one sweep of the
+// Google Benchmark of beam synthesis against raw Embree, one sweep of the
 // default tank scenario (/tank: 14 triangles, 8 rough reflections per ray) and of the seabed
 // survey (/seabed: an 11.5 k-triangle height field, no multipath), each row for both but
 // BM_SynthesisNoMultipath (the tank's only: the seabed has none):
@@ -29,10 +29,10 @@
 #include <string>
 #include <vector>
 
-#include "sonarbench/sim/beam_synthesizer.hpp"
-#include "sonarbench/sim/mesh.hpp"
-#include "sonarbench/sim/random.hpp"
-#include "sonarbench/sim/simulation.hpp"
+#include "sonarbench/sim/sonar/beam_synthesizer.hpp"
+#include "sonarbench/sim/sonar/simulation.hpp"
+#include "sonarbench/sim/world/mesh.hpp"
+#include "sonarbench/sim/world/random.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -69,7 +69,7 @@ std::vector<SynthesizedBeam> SimulateSweep(const Scene& scene, const BeamSynthes
   return SimulateBeams(scene, synthesizer, kSeed, threads, 0, ScenarioBeamCount(scene));
 }
 
-// One sweep's primary rays, drawn as the synthesis draws them (BeamSynthesizer::DrawRays: the
+// One sweep's primary rays, drawn as the synthesis draws them (BeamPattern::DrawRays: the
 // same strata and jitter slots, from the benchmark's own seeds), generated once, outside any
 // timing.
 struct SweepRays {
@@ -89,7 +89,7 @@ SweepRays DrawSweepRays(const BenchScene& bench) {
         Eigen::AngleAxisd(s.pose.head_angle_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     out.origins.push_back(s.pose.T_world_sonar.translation().cast<float>());
     Rng rng(DeriveSeed(kSeed, static_cast<std::uint64_t>(b)));
-    synthesizer.DrawRays(R, rng, out.directions.emplace_back(), patterns);
+    synthesizer.pattern().DrawRays(R, rng, out.directions.emplace_back(), patterns);
   }
   return out;
 }

@@ -1,0 +1,124 @@
+#include <algorithm>
+#include <iostream>
+#include <memory>
+
+#include "cli.hpp"
+#include "sonarbench/io/mapping_yaml.hpp"
+#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/app/map_log.hpp"
+#include "sonarbench/sim/world/sensor_model.hpp"
+
+namespace sonarbench::app {
+namespace {
+
+struct MapArgs {
+  bool no_progress = false;
+  sonarbench::sim::Budgets budgets;
+  std::string input;
+  std::string out = "out/map";
+  std::string scene;
+  std::string sensor;
+  std::string mapping;
+  bool score = false;
+  int threads = 0;
+};
+
+int Map(const MapArgs& args) {
+  sonarbench::CheckOutputDirectory(args.out);
+  sonarbench::mapping::SensorGeometry sensor;
+  sonarbench::mapping::MapperConfig config;
+  if (!args.scene.empty()) {
+    const sonarbench::sim::Scene scene = LoadScene(args.scene, args.budgets);
+    sensor = scene.sensor.geometry;
+    config = scene.mapping;
+  }
+  if (!args.sensor.empty()) sensor = sonarbench::sim::LoadSensorModel(args.sensor).geometry;
+  if (!args.mapping.empty()) {
+    sonarbench::YamlReader reader = sonarbench::YamlReader::FromFile(args.mapping);
+    config = sonarbench::mapping::ReadMapperConfig(reader);
+    reader.ThrowIfErrors();
+  }
+  config.threads = args.threads;
+  // A .mat log scored against the scene is mapped from the scene's sonar pose.
+  std::optional<sonarbench::sim::Scene> scene;
+  if (args.score) {
+    scene = LoadScene(args.scene, args.budgets);
+    sonarbench::sim::CheckBudgets(*scene, args.budgets);
+  }
+  std::vector<std::string> files = sonarbench::sim::kLogMapOutputFiles;
+  std::rotate(files.begin(), files.end() - 1, files.end());  // the record, report.json, first
+  sonarbench::sim::OutputDirectory out(
+      args.out, OneShotClaim("map", files, {args.input, args.scene, args.sensor, args.mapping}));
+  ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
+  auto result = sonarbench::sim::MapLog(
+      args.input, sensor, config, scene ? &*scene : nullptr, args.budgets,
+      [&](std::size_t done, std::size_t total) { progress.Update("map", done, total); });
+  progress.Clear();
+  if (scene) result.metrics = sonarbench::sim::ScoreLogMap(result, *scene);
+  sonarbench::sim::WriteLogMapOutputs(out.write_root().string(), result);
+  out.Commit();
+  const auto& t = result.totals;
+  std::cout << result.beams << " beams (" << result.truncated_beams << " truncated) in "
+            << result.sweeps << " sweeps; " << t.beams_with_obstacle << " with an obstacle\n";
+  for (const std::string& warning : result.warnings) std::cout << "warning: " << warning << "\n";
+  if (result.metrics)
+    std::cout << "against " << args.scene << ": " << MetricsLine(*result.metrics) << "\n";
+  std::cout << "timing [s]: import " << result.import_s << ", map " << result.map_s << "\n"
+            << "wrote " << args.out
+            << "/report.json, map.bt, map.ot, map_top.png, polar.png, fan.png\n";
+  return 0;
+}
+
+// `sonarbench map`: its options, filled into `args` when parsed.
+CLI::App* AddOptions(CLI::App& app, MapArgs& args) {
+  CLI::App* command = app.add_subcommand(
+      "map",
+      "Map a recorded log with the production mapper: INPUT is a sonarbench dataset directory "
+      "(from `simulate` or `import`; its manifest's sensor is used) or a real MSIS log in MATLAB "
+      ".mat form (the CRAS lab's parsedData layout; the vehicle static at the origin), or a folder "
+      "holding one such log. Writes map.bt and map.ot (octovis), map_top.png (occupied cells "
+      "from above), polar.png and fan.png (the first sweep) and report.json into --out. The "
+      "sensor is the SHAD Micron and the mapper uses its defaults unless --scene, --sensor or "
+      "--mapping say otherwise.");
+  command
+      ->add_option("input", args.input,
+                   "A dataset directory, a .mat log, or a folder holding one .mat log")
+      ->required()
+      ->check(CLI::ExistingPath);
+  command->add_option("-o,--out", args.out, "Output directory (created if needed)")
+      ->capture_default_str();
+  auto* scene_opt =
+      command
+          ->add_option("--scene", args.scene,
+                       "Take the sensor model and the mapping section from this scene")
+          ->check(CLI::ExistingFile);
+  command->add_option("--sensor", args.sensor, "Sensor model YAML (its geometry is used)")
+      ->check(CLI::ExistingFile)
+      ->excludes(scene_opt);
+  command
+      ->add_option("--mapping", args.mapping,
+                   "YAML file of mapping parameters (the keys of a scene's 'mapping' section)")
+      ->check(CLI::ExistingFile)
+      ->excludes(scene_opt);
+  command
+      ->add_flag("--score", args.score,
+                 "Score the map against the --scene's surfaces as `run` scores a simulated one "
+                 "(precision, recall, coverage; report.json's metrics). A .mat log, static at its "
+                 "origin, is mapped from the scene's sonar pose, which must not move; a dataset's "
+                 "beams keep their poses")
+      ->needs(scene_opt);
+  AddThreadsOption(command, args.threads);
+  AddBudgetOptions(command, args.budgets);
+  command->add_flag("--no-progress", args.no_progress, "Never show the progress line");
+  return command;
+}
+
+}  // namespace
+
+Command AddMapCommand(CLI::App& app) {
+  auto args = std::make_shared<MapArgs>();
+  return {AddOptions(app, *args), [args] { return Map(*args); }};
+}
+
+}  // namespace sonarbench::app

@@ -1,0 +1,127 @@
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "cli.hpp"
+#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/app/scenario.hpp"
+#include "sonarbench/sim/report/scenario_report.hpp"
+
+namespace sonarbench::app {
+namespace {
+
+struct RunArgs {
+  sonarbench::sim::Budgets budgets;
+  std::string scene;
+  std::string out = "out";
+  std::optional<std::uint64_t> seed;
+  int threads = 0;
+  bool no_progress = false;
+};
+
+void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::ScenarioResult& r,
+                  const std::string& out) {
+  const auto& t = r.timings;
+  const auto& v = r.verdict;
+  std::cout << "beams " << r.beams << ", seed " << r.seed << ", threads " << r.threads << "\n"
+            << MetricsLine(r.metrics) << "\n"
+            << "timing [s]: scene " << t.build_scene_s << ", simulate " << t.simulate_s << ", map "
+            << t.map_s << ", ground truth " << t.ground_truth_s << ", score " << t.score_s << "\n"
+            << "wrote " << out << "/report.json, junit.xml, report.html, map.bt and images\n";
+  std::size_t met = 0;
+  for (const auto& c : v.results) met += c.status != sonarbench::sim::CriterionStatus::kFail;
+  for (const auto& mesh : r.meshes) {
+    if (mesh.check.zero_area_triangles > 0) {
+      std::cout << "warning: mesh '" << mesh.name << "': " << mesh.check.zero_area_triangles
+                << " zero-area triangles dropped\n";
+    }
+    if (mesh.check.non_manifold_edges > 0) {
+      std::cout << "warning: mesh '" << mesh.name << "': " << mesh.check.non_manifold_edges
+                << " non-manifold edges (three or more triangles share them)\n";
+    }
+  }
+  for (const auto& w : v.warnings) std::cout << "warning: " << w << "\n";
+  std::cout << (v.passed ? "PASS " : "FAIL ") << scene.name << ": " << met << "/"
+            << v.results.size() << " criteria met"
+            << (v.expect_fail ? " (the scene expects a failure)" : "") << "\n";
+  for (const auto& reason : v.reasons) std::cout << "  " << reason << "\n";
+}
+
+// A run that broke still leaves a junit.xml saying so (and no other output), for the CI
+// system that collects it.
+void CommitErrorJunit(sonarbench::sim::OutputDirectory& out, const RunArgs& args,
+                      std::string_view type, const std::string& message) {
+  try {
+    const std::string xml = sonarbench::sim::ErrorJunitXml(
+        std::filesystem::path(args.scene).stem().string(), type, message);
+    sonarbench::WriteFileAtomically((out.write_root() / "junit.xml").string(),
+                                    [&](std::ostream& file) { file << xml; });
+    out.Commit();
+  } catch (const std::exception& e) {
+    std::cerr << "sonarbench: could not write junit.xml: " << e.what() << "\n";
+  }
+}
+
+int Run(const RunArgs& args) {
+  namespace sim = sonarbench::sim;
+  std::vector<std::string> files = sim::kScenarioOutputFiles;
+  std::erase(files, "report.json");
+  files.insert(files.begin(), "report.json");
+  // Taken before any work: a run writes its junit.xml there even when the scene is refused.
+  sim::OutputDirectory out(args.out, OneShotClaim("run", files, {args.scene}));
+  try {
+    const sim::Scene scene = LoadScene(args.scene, args.budgets);
+    sim::RunOptions options;
+    options.seed = args.seed;
+    options.threads = args.threads;
+    ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
+    options.progress = [&](std::string_view stage, std::size_t done, std::size_t total) {
+      progress.Update(stage, done, total);
+    };
+    const auto result = sim::RunScenario(scene, options);
+    progress.Clear();
+    sim::WriteScenarioOutputs(out.write_root().string(), scene, result);
+    out.Commit();
+    PrintSummary(scene, result, args.out);
+    return result.verdict.passed ? 0 : kExitCriteriaFailed;
+  } catch (const sonarbench::InputError& e) {
+    CommitErrorJunit(out, args, "input_error", e.what());
+    throw;
+  } catch (const std::exception& e) {
+    CommitErrorJunit(out, args, "internal_error", e.what());
+    throw;
+  }
+}
+
+// `sonarbench run`: its options, filled into `args` when parsed.
+CLI::App* AddOptions(CLI::App& app, RunArgs& args) {
+  CLI::App* command = app.add_subcommand(
+      "run",
+      "Run a scenario end to end: simulate every sweep of SCENE, map them, score the map against "
+      "the scene's ground truth and its criteria, and write report.json, junit.xml, report.html, "
+      "map.bt (open it in octovis), polar.png (the first sweep, beams x bins), fan.png, "
+      "map_top.png and map_side.png into --out. Exit status 0 when the criteria pass, 1 when "
+      "they fail, 2 on bad input, 3 on an internal error.");
+  command->add_option("scene", args.scene, "Scene YAML file (see scenes/)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("-o,--out", args.out, "Output directory (created if needed)")
+      ->capture_default_str();
+  AddSeedOption(command, args.seed, "Seed of every random draw; overrides the scene's 'seed'");
+  AddThreadsOption(command, args.threads);
+  AddBudgetOptions(command, args.budgets);
+  command->add_flag("--no-progress", args.no_progress,
+                    "Never show the progress line (it shows only on a terminal, and never when "
+                    "the CI environment variable is set)");
+  return command;
+}
+
+}  // namespace
+
+Command AddRunCommand(CLI::App& app) {
+  auto args = std::make_shared<RunArgs>();
+  return {AddOptions(app, *args), [args] { return Run(*args); }};
+}
+
+}  // namespace sonarbench::app

@@ -1,0 +1,73 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/mat_log.hpp"
+#include "sonarbench/sim/world/scene.hpp"
+
+namespace sonarbench::sim {
+
+/// Which part of a run this process writes: shard `index` (0-based) of `count`. Sweep s belongs
+/// to shard s mod count. Every beam's random draws come from DeriveSeed(seed, beam index), a
+/// hash, so the bytes of a sweep do not depend on the sharding.
+struct Shard {
+  int index = 0;
+  int count = 1;
+};
+
+/// The files a scene reads: the scene, the scenes it extends, its sensor model and mesh files.
+/// Outputs never overwrite them.
+[[nodiscard]] std::vector<std::string> SceneInputFiles(const Scene& scene);
+
+/// Parses "K/N" (1 <= K <= N, K 1-based as cluster array jobs count); throws InputError.
+[[nodiscard]] Shard ParseShard(const std::string& text);
+/// The shard of a SLURM array job, from SLURM_ARRAY_TASK_ID, _MIN and _COUNT; nullopt outside
+/// one. Throws InputError when the variables are malformed.
+[[nodiscard]] std::optional<Shard> ShardFromSlurm();
+
+/// SHA-256 of what determines a scene's outputs: the tool and schema versions, the seed, and the
+/// SHA-256 of the scene file, the sensor model file and every mesh file.
+[[nodiscard]] std::string SceneConfigHash(const Scene& scene, std::uint64_t seed);
+
+struct DatasetOptions {
+  std::optional<std::uint64_t> seed;
+  int threads = 0;
+  /// Replace an existing dataset (or a partial one of another configuration).
+  bool force = false;
+  Shard shard;
+  /// Called after each sweep this process handles: sweeps handled and the shard's total.
+  std::function<void(std::size_t done, std::size_t total)> progress;
+};
+
+struct DatasetSummary {
+  std::size_t sweeps_total = 0;
+  std::size_t sweeps_written = 0;
+  /// Sweeps of this shard already complete on disk (a resumed run), skipped.
+  std::size_t sweeps_skipped = 0;
+  /// manifest.json written: every sweep present.
+  bool complete = false;
+  /// The dataset was already complete with this configuration: nothing was written.
+  bool already_complete = false;
+  std::string config_sha256;
+};
+
+/// Simulates a scene into a dataset directory (mapping::ReadDataset's format). Every file is
+/// written atomically; a sweep is complete when its beam, truth and image files all exist, and
+/// a rerun skips complete sweeps. manifest.json is written last, once every sweep is present (by
+/// whichever shard finishes last, or by a rerun without --shard). A directory holding another
+/// configuration's dataset, or files that are not a dataset, is refused unless `force`.
+DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
+                               const DatasetOptions& options);
+
+/// Writes a real log as a dataset: its beams by sweep, polar images, the sonar's poses (the
+/// identity: the vehicle was static), no truth. Same atomicity and overwrite rules.
+DatasetSummary ImportLogDataset(const std::string& log_path, const mapping::MatLog& log,
+                                const mapping::SensorGeometry& sensor, const std::string& dir,
+                                bool force);
+
+}  // namespace sonarbench::sim

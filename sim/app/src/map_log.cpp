@@ -1,0 +1,212 @@
+#include "sonarbench/sim/app/map_log.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/mat_log.hpp"
+#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/app/dataset_writer.hpp"
+#include "sonarbench/sim/eval/score.hpp"
+#include "sonarbench/sim/report/images.hpp"
+#include "sonarbench/sim/report/report.hpp"
+#include "sonarbench/sim/report/scenario_report.hpp"
+#include "sonarbench/sim/sonar/simulation.hpp"
+#include "sonarbench/sim/world/mesh.hpp"
+#include "sonarbench/sim/world/ray_tracer.hpp"
+
+namespace sonarbench::sim {
+
+std::string MatLogInDirectory(const std::string& input) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_directory(input, error) || fs::exists(fs::path(input) / "manifest.json", error)) {
+    return {};
+  }
+  std::vector<std::string> logs;
+  for (const auto& entry : fs::directory_iterator(input, error)) {
+    if (entry.is_regular_file(error) && entry.path().extension() == ".mat") {
+      logs.push_back(entry.path().string());
+    }
+  }
+  if (logs.size() <= 1) return logs.empty() ? std::string() : logs.front();
+  std::sort(logs.begin(), logs.end());
+  std::string names;
+  for (const auto& log : logs) names += "\n  " + log;
+  throw InputError(input + ": not a sonarbench dataset and holds " + std::to_string(logs.size()) +
+                   " .mat logs; name the one to map:" + names);
+}
+
+namespace {
+
+// Where a dataset's beams are mapped to score them against `scene`: an imported log is static at
+// its own origin and goes to the scene's sonar pose, as a .mat log does; a simulated dataset keeps
+// its poses and must be of that scene. Differences that still allow a score go to `warnings`.
+std::optional<Eigen::Isometry3d> DatasetPlacement(const mapping::Dataset& dataset,
+                                                  const std::string& dir, const Scene& scene,
+                                                  std::vector<std::string>& warnings) {
+  const nlohmann::json& m = dataset.manifest;
+  const std::string source = m.value("source", "");
+  if (source == "import") return StaticSonarPose(scene);
+  if (source != "simulate") {
+    throw InputError(dir + "/manifest.json: 'source' is " + Quoted(source) +
+                     "; expected 'simulate' or 'import' to score it against a scene");
+  }
+  const nlohmann::json named = m.value("scene", nlohmann::json::object());
+  const std::string name = named.is_object() ? named.value("name", "") : "";
+  if (name != scene.name) {
+    throw InputError(dir + ": a dataset of scene " + Quoted(name) + " (manifest.json); it " +
+                     "cannot be scored against scene " + Quoted(scene.name) + " (" + scene.file +
+                     "): score it against the scene it was simulated from");
+  }
+  const nlohmann::json seed = m.value("seed", nlohmann::json());
+  if (seed.is_number_unsigned() &&
+      SceneConfigHash(scene, seed.get<std::uint64_t>()) != m.value("config_sha256", "")) {
+    warnings.push_back(dir + " was simulated from other files than " + scene.file +
+                       " and its meshes and sensor model now hold (config_sha256 differs): the "
+                       "truth is the scene's as it is now");
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sensor,
+                    const mapping::MapperConfig& config, const Scene* place_in,
+                    const Budgets& budgets, const StageProgress& progress) {
+  LogMapResult result;
+  result.input = input;
+  auto start = std::chrono::steady_clock::now();
+  std::vector<mapping::Beam> beams;
+  mapping::SensorGeometry geometry = sensor;
+  const std::string log_file = MatLogInDirectory(input);
+  if (log_file.empty() && std::filesystem::is_directory(input)) {
+    mapping::Dataset dataset = mapping::ReadDataset(input);
+    geometry = dataset.sensor;  // a dataset carries its sensor
+    const auto pose =
+        place_in ? DatasetPlacement(dataset, input, *place_in, result.warnings) : std::nullopt;
+    beams = std::move(dataset.beams);
+    result.source = "dataset";
+    if (pose) {
+      for (mapping::Beam& beam : beams) beam.T_world_sonar = *pose;
+    }
+  } else {
+    // The scene is checked before the log is read: a moving one is refused at once.
+    const std::optional<Eigen::Isometry3d> pose =
+        place_in ? std::optional(StaticSonarPose(*place_in)) : std::nullopt;
+    mapping::MatLog log = mapping::ReadMatLog(log_file.empty() ? input : log_file);
+    beams = std::move(log.beams);
+    result.truncated_beams = log.truncated_beams;
+    result.source = "mat";
+    if (!log_file.empty()) result.input = log_file;
+    if (pose) {
+      for (mapping::Beam& beam : beams) beam.T_world_sonar = *pose;
+    }
+  }
+  for (const mapping::Beam& beam : beams) {
+    result.poses.push_back({beam.T_world_sonar, beam.head_angle_rad});
+  }
+  auto now = std::chrono::steady_clock::now();
+  result.import_s = std::chrono::duration<double>(now - start).count();
+  result.beams = beams.size();
+
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hi = Eigen::Vector3d::Zero();
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    const Eigen::Vector3d p = beams[b].T_world_sonar.translation();
+    lo = b == 0 ? p : lo.cwiseMin(p);
+    hi = b == 0 ? p : hi.cwiseMax(p);
+  }
+  CheckMapCells(MapCellsEstimate(geometry, config.resolution_m, lo, hi), budgets, input);
+
+  start = now;
+  result.sensor = geometry;
+  result.mapper = std::make_unique<mapping::Mapper>(config, geometry);
+  result.totals = result.mapper->IntegrateSweeps(beams, progress);
+  const auto per_sweep = static_cast<std::size_t>(geometry.BeamsPerSweep());
+  result.sweeps = (beams.size() + per_sweep - 1) / per_sweep;
+  result.first_sweep.assign(beams.begin(),
+                            beams.begin() + static_cast<long>(std::min(per_sweep, beams.size())));
+  result.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+Eigen::Isometry3d StaticSonarPose(const Scene& scene) {
+  const std::size_t beams = static_cast<std::size_t>(scene.sweeps) *
+                            static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
+  const Eigen::Isometry3d first = ScheduleBeam(scene, 0).pose.T_world_sonar;
+  for (std::size_t b = 1; b < beams; ++b) {
+    if (!ScheduleBeam(scene, b).pose.T_world_sonar.isApprox(first, 1e-12)) {
+      throw InputError(scene.file + ": the sonar moves along the scene's trajectory (beam " +
+                       std::to_string(b) +
+                       "); a .mat log is static and can be scored only against a scene whose "
+                       "sonar is, or simulate and map the scene as a dataset");
+    }
+  }
+  return first;
+}
+
+MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene) {
+  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
+  const RayTracer tracer(meshes);
+  const octomap::OcTree& map = result.mapper->tree();
+  return ScoreMap(
+      map, VoxelizeMeshes(meshes, map),
+      PerfectSensorCells(tracer, result.poses, result.sensor, scene.sensor.acoustics, map), meshes);
+}
+
+void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) {
+  namespace fs = std::filesystem;
+  CreateOutputDirectory(out_dir);
+  const fs::path dir(out_dir);
+  result.mapper->WriteBinary((dir / "map.bt").string());
+  result.mapper->WriteFull((dir / "map.ot").string());
+  const MapCells cells = CollectMapCells(result.mapper->tree());
+  WriteTopDownImage((dir / "map_top.png").string(), cells, {}, {});
+  WritePolarImage((dir / "polar.png").string(), result.first_sweep);
+  WriteFanImage((dir / "fan.png").string(), result.first_sweep, 0.01);
+  const auto& t = result.totals;
+  const auto& c = result.mapper->config();
+  nlohmann::json report = ReportHeader();
+  report.update({{"input", result.input},
+                 {"input_kind", result.source},
+                 {"beams", result.beams},
+                 {"sweeps", result.sweeps},
+                 {"truncated_beams", result.truncated_beams},
+                 {"mapping",
+                  {{"resolution_m", c.resolution_m},
+                   {"rays_horizontal", c.rays_horizontal},
+                   {"rays_vertical", c.rays_vertical},
+                   {"threshold", c.detection.threshold},
+                   {"max_obstacles", c.detection.max_obstacles}}},
+                 {"map",
+                  {{"occupied_cells", cells.occupied.size()},
+                   {"free_cells", cells.free.size()},
+                   {"beams_with_obstacle", t.beams_with_obstacle},
+                   {"ray_casts", t.ray_casts},
+                   {"cell_visits", t.cell_visits},
+                   {"cell_updates", t.free_cells + t.occupied_cells},
+                   {"visits_per_updated_cell",
+                    t.free_cells + t.occupied_cells == 0
+                        ? 0.0
+                        : static_cast<double>(t.cell_visits) /
+                              static_cast<double>(t.free_cells + t.occupied_cells)}}},
+                 {"timing", {{"import_s", result.import_s}, {"map_s", result.map_s}}},
+                 {"outputs",
+                  {{"map", "map.bt"},
+                   {"map_full", "map.ot"},
+                   {"map_top", "map_top.png"},
+                   {"polar", "polar.png"},
+                   {"fan", "fan.png"}}}});
+  if (result.metrics) report["metrics"] = MetricsJson(*result.metrics);
+  if (!result.warnings.empty()) report["warnings"] = result.warnings;
+  std::vector<std::string> covered = kLogMapOutputFiles;
+  std::erase(covered, "report.json");
+  report["files_sha256"] = FilesSha256(out_dir, covered);
+  WriteJson((dir / "report.json").string(), report);
+}
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,79 @@
+#include "sonarbench/sim/app/scenario.hpp"
+
+#include <omp.h>
+
+#include <chrono>
+
+#include "sonarbench/sim/eval/ground_truth.hpp"
+#include "sonarbench/sim/sonar/simulation.hpp"
+#include "sonarbench/sim/world/mesh.hpp"
+#include "sonarbench/sim/world/ray_tracer.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+class Stopwatch {
+ public:
+  double Lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double seconds = std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+    return seconds;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace
+
+ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
+  ScenarioResult result;
+  result.seed = options.seed.value_or(scene.seed);
+  result.threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  Stopwatch clock;
+
+  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
+  for (const TriangleMesh& mesh : meshes)
+    result.meshes.push_back({mesh.name, mesh.triangles.size(), mesh.check});
+  for (const TriangleMesh& part : BuildVehicleMeshes(scene))
+    result.meshes.push_back({part.name, part.triangles.size(), part.check, true});
+  const RayTracer tracer(meshes);
+  result.timings.build_scene_s = clock.Lap();
+
+  auto report = [&](std::string_view stage) {
+    return [&options, stage](std::size_t done, std::size_t total) {
+      if (options.progress) options.progress(stage, done, total);
+    };
+  };
+  const std::vector<SynthesizedBeam> synthesized =
+      SimulateScene(scene, tracer, result.seed, result.threads, report("simulate"));
+  result.beams = synthesized.size();
+  result.timings.simulate_s = clock.Lap();
+
+  mapping::MapperConfig mapper_config = scene.mapping;
+  mapper_config.threads = result.threads;
+  result.mapper = std::make_unique<mapping::Mapper>(mapper_config, scene.sensor.geometry);
+  const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
+  result.mapping_totals = result.mapper->IntegrateSweeps(beams, report("map"));
+  const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
+  result.first_sweep.assign(beams.begin(),
+                            beams.begin() + static_cast<long>(std::min(per_sweep, beams.size())));
+  result.timings.map_s = clock.Lap();
+
+  const octomap::OcTree& map = result.mapper->tree();
+  result.truth = VoxelizeMeshes(meshes, map, report("truth"));
+  std::vector<BeamPose> poses;
+  for (std::size_t b = 0; b < synthesized.size(); ++b) poses.push_back(ScheduleBeam(scene, b).pose);
+  if (!poses.empty()) result.sonar_start_m = poses.front().T_world_sonar.translation();
+  result.observable = PerfectSensorCells(tracer, poses, scene.sensor.geometry,
+                                         scene.sensor.acoustics, map, report("observable"));
+  result.timings.ground_truth_s = clock.Lap();
+
+  result.metrics = ScoreMap(map, result.truth, result.observable, meshes, report("score"));
+  result.verdict = Evaluate(scene.criteria, result.metrics);
+  result.timings.score_s = clock.Lap();
+  return result;
+}
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,216 @@
+#include "sonarbench/sim/eval/score.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+#include <vector>
+
+#include "sonarbench/sim/eval/ground_truth.hpp"
+#include "sonarbench/sim/world/ray_tracer.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+double Ratio(std::size_t numerator, std::size_t denominator) {
+  return denominator == 0 ? 0.0 : static_cast<double>(numerator) / static_cast<double>(denominator);
+}
+
+DistanceStats Summarise(std::vector<double> d) {
+  DistanceStats s;
+  s.count = d.size();
+  if (d.empty()) return s;
+  std::sort(d.begin(), d.end());
+  double sum = 0.0;
+  for (const double v : d) sum += v;
+  s.mean_m = sum / static_cast<double>(d.size());
+  s.p95_m = d[std::min(d.size() - 1, static_cast<std::size_t>(std::ceil(0.95 * d.size())) - 1)];
+  s.max_m = d.back();
+  return s;
+}
+
+using Key = octomap::OcTreeKey;
+
+// Visits the cells at Chebyshev distance exactly `ring` from `centre`.
+template <typename F>
+void ForEachInRing(const Key& centre, int ring, F&& f) {
+  for (int dx = -ring; dx <= ring; ++dx) {
+    for (int dy = -ring; dy <= ring; ++dy) {
+      for (int dz = -ring; dz <= ring; ++dz) {
+        if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != ring) continue;
+        const int x = centre[0] + dx, y = centre[1] + dy, z = centre[2] + dz;
+        if (x < 0 || y < 0 || z < 0 || x > 65535 || y > 65535 || z > 65535) continue;
+        f(Key(static_cast<octomap::key_type>(x), static_cast<octomap::key_type>(y),
+              static_cast<octomap::key_type>(z)));
+      }
+    }
+  }
+}
+
+// Searches rings outwards from `from`'s cell; `visit(cell)` returns the distance to what that
+// cell holds, or a negative number. A cell `ring` rings out is at least (ring - 1) cells away,
+// so the search stops once that exceeds the best distance found, or at `max_ring`.
+template <typename Visit>
+double NearestByRings(const Key& from, double resolution, int max_ring, Visit&& visit) {
+  double best = -1.0;
+  for (int ring = 0; ring <= max_ring; ++ring) {
+    if (best >= 0.0 && (ring - 1) * resolution > best) break;
+    ForEachInRing(from, ring, [&](const Key& cell) {
+      const double d = visit(cell);
+      if (d >= 0.0 && (best < 0.0 || d < best)) best = d;
+    });
+  }
+  return best;
+}
+
+Eigen::Vector3d Centre(const octomap::OcTree& map, const Key& key) {
+  const octomap::point3d c = map.keyToCoord(key);
+  return {c.x(), c.y(), c.z()};
+}
+
+}  // namespace
+
+MapCells CollectMapCells(const octomap::OcTree& map) {
+  MapCells cells;
+  const unsigned max_depth = map.getTreeDepth();
+  for (auto it = map.begin_leafs(), end = map.end_leafs(); it != end; ++it) {
+    mapping::KeySet& target = map.isNodeOccupied(*it) ? cells.occupied : cells.free;
+    const octomap::OcTreeKey key = it.getIndexKey();
+    const int span = 1 << (max_depth - it.getDepth());
+    for (int x = 0; x < span; ++x) {
+      for (int y = 0; y < span; ++y) {
+        for (int z = 0; z < span; ++z) {
+          target.insert(octomap::OcTreeKey(static_cast<octomap::key_type>(key[0] + x),
+                                           static_cast<octomap::key_type>(key[1] + y),
+                                           static_cast<octomap::key_type>(key[2] + z)));
+        }
+      }
+    }
+  }
+  return cells;
+}
+
+namespace {
+
+// The cell counts and the ratios made of them.
+void CountCells(const MapCells& cells, const mapping::KeySet& truth,
+                const mapping::KeySet& observable, MapMetrics& m) {
+  m.truth_cells = truth.size();
+  m.occupied_cells = cells.occupied.size();
+  m.free_cells = cells.free.size();
+  for (const auto& key : cells.occupied) m.true_positive_cells += truth.contains(key) ? 1 : 0;
+  for (const auto& key : observable) {
+    if (!truth.contains(key)) continue;
+    ++m.observable_cells;
+    if (cells.occupied.contains(key)) {
+      ++m.observed_occupied_cells;
+      ++m.known_observable_cells;
+    } else if (cells.free.contains(key)) {
+      ++m.known_observable_cells;
+    }
+  }
+  m.occupied_precision = Ratio(m.true_positive_cells, m.occupied_cells);
+  m.occupied_recall = Ratio(m.observed_occupied_cells, m.observable_cells);
+  const double sum = m.occupied_precision + m.occupied_recall;
+  m.occupied_f1 = sum > 0.0 ? 2.0 * m.occupied_precision * m.occupied_recall / sum : 0.0;
+  m.coverage = Ratio(m.known_observable_cells, m.observable_cells);
+  std::size_t known_truth = 0;
+  for (const auto& key : truth) {
+    known_truth += (cells.occupied.contains(key) || cells.free.contains(key)) ? 1 : 0;
+  }
+  m.coverage_absolute = Ratio(known_truth, truth.size());
+  for (const auto& key : cells.free) m.free_on_surface_cells += truth.contains(key) ? 1 : 0;
+  m.free_accuracy = cells.free.empty() ? 0.0 : 1.0 - Ratio(m.free_on_surface_cells, m.free_cells);
+}
+
+// Recall of one mesh's own observable cells.
+MapMetrics::MeshRecall MeshRecallOf(const TriangleMesh& mesh, const octomap::OcTree& map,
+                                    const MapCells& cells, const mapping::KeySet& observable) {
+  MapMetrics::MeshRecall r;
+  r.name = mesh.name;
+  for (const auto& key : VoxelizeMeshes(std::span(&mesh, 1), map)) {
+    if (!observable.contains(key)) continue;
+    ++r.observable_cells;
+    r.observed_occupied_cells += cells.occupied.contains(key) ? 1 : 0;
+  }
+  r.recall = Ratio(r.observed_occupied_cells, r.observable_cells);
+  return r;
+}
+
+// Distances from occupied cell centres to the nearest truth surface.
+DistanceStats MapToMesh(const std::vector<TriangleMesh>& truth_meshes, const octomap::OcTree& map,
+                        const MapCells& cells) {
+  const RayTracer tracer(truth_meshes);
+  std::vector<double> d;
+  d.reserve(cells.occupied.size());
+  for (const auto& key : cells.occupied) {
+    if (const auto best = tracer.NearestSurfaceDistance(Centre(map, key), 1e3)) d.push_back(*best);
+  }
+  return Summarise(std::move(d));
+}
+
+// Distances from observable surface cells to the nearest occupied cell.
+DistanceStats MeshToMap(const octomap::OcTree& map, const MapCells& cells,
+                        const mapping::KeySet& truth, const mapping::KeySet& observable) {
+  const double res = map.getResolution();
+  // Occupied cells bucketed in blocks of 8³ cells: rings of blocks around a query skip empty
+  // space 8 cells at a time. A block `ring` blocks out is at least (ring - 1) blocks away.
+  constexpr int kBlock = 8;
+  std::unordered_map<Key, std::vector<Key>, Key::KeyHash> blocks;
+  for (const auto& key : cells.occupied) {
+    blocks[Key(static_cast<octomap::key_type>(key[0] / kBlock),
+               static_cast<octomap::key_type>(key[1] / kBlock),
+               static_cast<octomap::key_type>(key[2] / kBlock))]
+        .push_back(key);
+  }
+  std::vector<double> d;
+  for (const auto& key : observable) {
+    if (!truth.contains(key)) continue;
+    const Eigen::Vector3d p = Centre(map, key);
+    const Key block(static_cast<octomap::key_type>(key[0] / kBlock),
+                    static_cast<octomap::key_type>(key[1] / kBlock),
+                    static_cast<octomap::key_type>(key[2] / kBlock));
+    const double best = NearestByRings(block, kBlock * res, 65536 / kBlock, [&](const Key& b) {
+      const auto it = blocks.find(b);
+      if (it == blocks.end()) return -1.0;
+      double nearest = -1.0;
+      for (const auto& cell : it->second) {
+        const double dist = (Centre(map, cell) - p).norm();
+        if (nearest < 0.0 || dist < nearest) nearest = dist;
+      }
+      return nearest;
+    });
+    if (best >= 0.0) d.push_back(best);
+  }
+  return Summarise(std::move(d));
+}
+
+}  // namespace
+
+MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
+                    const mapping::KeySet& observable, std::span<const TriangleMesh> meshes,
+                    const StageProgress& progress) {
+  const MapCells cells = CollectMapCells(map);
+  MapMetrics m;
+  CountCells(cells, truth, observable, m);
+  std::vector<TriangleMesh> truth_meshes;
+  for (const TriangleMesh& mesh : meshes) {
+    if (mesh.truth) truth_meshes.push_back(mesh);
+  }
+  std::size_t passes = 0;
+  const std::size_t total = truth_meshes.size() + 3;
+  const auto pass_done = [&] {
+    if (progress) progress(++passes, total);
+  };
+  pass_done();
+  for (const TriangleMesh& mesh : truth_meshes) {
+    m.per_mesh.push_back(MeshRecallOf(mesh, map, cells, observable));
+    pass_done();
+  }
+  if (!truth_meshes.empty()) m.map_to_mesh = MapToMesh(truth_meshes, map, cells);
+  pass_done();
+  if (!cells.occupied.empty()) m.mesh_to_map = MeshToMap(map, cells, truth, observable);
+  pass_done();
+  return m;
+}
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,46 @@
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "sonarbench/mapping/beam.hpp"
+#include "sonarbench/mapping/sensor_geometry.hpp"
+#include "sonarbench/sim/eval/fidelity.hpp"
+
+namespace sonarbench::sim {
+
+/// Writes fidelity.json, profile.csv, wall_range.csv, wall_profile.csv,
+/// direct_wall_profile.csv, second_trip_profile.csv, histogram.csv, by_head_angle.csv (the
+/// self-reflection's and the near range's mean per head angle: where a vehicle's parts echo),
+/// profile.png (the two mean profiles), and polar and fan images of each run's first sweep side
+/// by side (sim left, real right) into `out_dir`.
+/// The files WriteFidelityOutputs writes, relative to its `out_dir`.
+inline const std::vector<std::string> kFidelityOutputFiles = {"fidelity.json",
+                                                              "profile.csv",
+                                                              "profile.png",
+                                                              "wall_range.csv",
+                                                              "wall_profile.csv",
+                                                              "direct_wall_profile.csv",
+                                                              "second_trip_profile.csv",
+                                                              "histogram.csv",
+                                                              "by_head_angle.csv",
+                                                              "polar.png",
+                                                              "fan.png"};
+
+/// fidelity.json's content: the report's header, the scene and log, and every statistic.
+[[nodiscard]] nlohmann::json FidelityJson(const FidelityReport& report,
+                                          const std::string& scene_file,
+                                          const std::string& log_file);
+
+/// That content as text, a line per statistic ("key: value"), for the terminal.
+[[nodiscard]] std::string FidelitySummary(const nlohmann::json& report);
+
+void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& report,
+                          std::span<const mapping::Beam> sim_sweep,
+                          std::span<const mapping::Beam> real_sweep,
+                          const mapping::SensorGeometry& sensor, const std::string& scene_file,
+                          const std::string& log_file);
+
+}  // namespace sonarbench::sim

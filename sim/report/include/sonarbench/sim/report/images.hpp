@@ -1,0 +1,69 @@
+#pragma once
+
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "sonarbench/mapping/beam.hpp"
+#include "sonarbench/sim/eval/score.hpp"
+
+namespace sonarbench::sim {
+
+/// `image` as PNG file bytes.
+[[nodiscard]] std::vector<unsigned char> EncodePng(const cv::Mat& image);
+/// Writes `image` as a PNG file, atomically.
+void WritePng(const std::string& path, const cv::Mat& image);
+
+/// Renders one sweep as a polar image: one row per beam (in time order), one column per range
+/// bin (range grows to the right), intensity on a perceptual colour map.
+[[nodiscard]] cv::Mat RenderPolarImage(std::span<const mapping::Beam> sweep);
+/// RenderPolarImage, written as a PNG file atomically.
+void WritePolarImage(const std::string& path, std::span<const mapping::Beam> sweep);
+
+/// Renders one sweep as a top-down Cartesian fan: the sonar at the centre, x to the right, y up,
+/// `pixel_m` per pixel; each pixel shows the bin at its range on the beam nearest its bearing.
+[[nodiscard]] cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m);
+/// RenderFanImage, written as a PNG file atomically.
+void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep, double pixel_m);
+
+/// Which cells a map image shows: every column seen from above (x right, y up), or a slab of
+/// cells around one y key seen from the side (x right, z up).
+struct MapView {
+  enum class Kind { kTop, kSide };
+  Kind kind = Kind::kTop;
+  /// kSide: the slab holds the cells whose y key is within slab_half_cells of slab_key.
+  std::uint16_t slab_key = 0;
+  int slab_half_cells = 1;
+};
+
+/// Renders the map against the truth, one pixel per cell (scaled up to about 400 pixels): green
+/// where a pixel's cells hold a true positive, red where only false positives, blue where
+/// observable truth the map missed, grey where only free cells. With an empty `truth` (a real
+/// log), occupied cells are white.
+[[nodiscard]] cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
+                                    const mapping::KeySet& observable, const MapView& view);
+
+/// One line of a plot: its legend name, colour (BGR) and points.
+struct PlotSeries {
+  std::string name;
+  cv::Scalar colour;
+  std::vector<double> x;
+  std::vector<double> y;
+};
+/// Renders a line plot with axes, ticks at the x values of the series (log2 scale when
+/// `log2_x`; over 16 x values on a linear scale, about ten round ticks), a marker at each point
+/// of a series of up to 64, five y ticks from `y_min` to the data's maximum (or `y_max` when it is
+/// set), a title, axis labels and a legend.
+[[nodiscard]] cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
+                                     const std::string& y_label,
+                                     const std::vector<PlotSeries>& series, bool log2_x,
+                                     double y_min, std::optional<double> y_max = std::nullopt);
+
+/// The top-down RenderMapView, written as a PNG file atomically.
+void WriteTopDownImage(const std::string& path, const MapCells& map, const mapping::KeySet& truth,
+                       const mapping::KeySet& observable);
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,474 @@
+#include "sonarbench/sim/report/output_directory.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <stdexcept>
+
+#include "sonarbench/io/dataset.hpp"
+#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/error.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// A file descriptor closed when it goes out of scope.
+class Fd {
+ public:
+  explicit Fd(int fd) : fd_(fd) {}
+  ~Fd() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  Fd(const Fd&) = delete;
+  Fd& operator=(const Fd&) = delete;
+  [[nodiscard]] int get() const { return fd_; }
+
+ private:
+  int fd_;
+};
+
+// A path a marker may list: relative, '/'-separated, without "." or ".." parts.
+bool SafeRelative(const std::string& path) {
+  if (path.empty() || path.front() == '/' || path.size() > 4096) return false;
+  for (const auto& part : fs::path(path)) {
+    if (part.empty() || part == "." || part == "..") return false;
+  }
+  return true;
+}
+
+std::optional<json> ReadJson(const fs::path& file) {
+  std::error_code error;
+  if (!fs::is_regular_file(file, error)) return std::nullopt;
+  try {
+    return json::parse(ReadFileBytes(file.string()));
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+// "a, b and 3 more".
+std::string Listed(const std::vector<std::string>& names) {
+  std::string text;
+  const std::size_t shown = std::min<std::size_t>(names.size(), 5);
+  for (std::size_t i = 0; i < shown; ++i) text += (i ? ", " : "") + names[i];
+  if (names.size() > shown) text += " and " + std::to_string(names.size() - shown) + " more";
+  return text;
+}
+
+bool Exists(const fs::path& path) {
+  std::error_code error;
+  return fs::exists(fs::symlink_status(path, error));
+}
+
+// The first folder on `relative`'s way down from `root` that is a symlink, or "".
+std::string SymlinkedFolder(const fs::path& root, const std::string& relative) {
+  fs::path folder;
+  for (const auto& part : fs::path(relative).parent_path()) {
+    folder /= part;
+    std::error_code error;
+    if (fs::is_symlink(fs::symlink_status(root / folder, error))) return folder.generic_string();
+  }
+  return {};
+}
+
+// Refuses `relative` when a folder on its way down from `root` (the directory named `name`) is a
+// symlink: nothing is written or removed through one.
+void RefuseSymlinkedFolder(const std::string& name, const fs::path& root,
+                           const std::string& relative) {
+  if (const std::string link = SymlinkedFolder(root, relative); !link.empty()) {
+    throw InputError(name + "/" + link + " is a symlink: sonarbench writes and removes nothing " +
+                     "through one (make it a folder or choose another --out)");
+  }
+}
+
+// The first folder on `relative`'s way down from `root` that something else stands in, or "".
+std::string BlockedFolder(const fs::path& root, const std::string& relative) {
+  fs::path folder;
+  for (const auto& part : fs::path(relative).parent_path()) {
+    folder /= part;
+    std::error_code error;
+    const fs::file_status status = fs::symlink_status(root / folder, error);
+    if (fs::exists(status) && !fs::is_directory(status)) return folder.generic_string();
+  }
+  return {};
+}
+
+std::vector<std::string> SortedUnion(std::vector<std::string> a,
+                                     const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  std::sort(a.begin(), a.end());
+  a.erase(std::unique(a.begin(), a.end()), a.end());
+  return a;
+}
+
+// Removes the empty folders on `relative`'s way up to `root` (never `root`).
+void RemoveEmptyParents(const fs::path& root, const std::string& relative) {
+  for (fs::path dir = fs::path(relative).parent_path(); !dir.empty(); dir = dir.parent_path()) {
+    if (::rmdir((root / dir).c_str()) != 0) return;  // not empty, or not there
+  }
+}
+
+}  // namespace
+
+std::optional<Ownership> ReadOwnership(const fs::path& dir) {
+  const auto names = [](const json& list, const char* key) {
+    std::vector<std::string> files;
+    for (const json& entry : list) {
+      const json name = key ? (entry.is_object() ? entry.value(key, json()) : json()) : entry;
+      if (name.is_string() && SafeRelative(name.get<std::string>())) files.push_back(name);
+    }
+    return SortedUnion(files, {});
+  };
+  Ownership owned;
+  if (const auto marker = ReadJson(dir / OutputDirectory::kMarkerFile);
+      marker && marker->is_object() && marker->value("tool", "") == "sonarbench" &&
+      marker->contains("outputs") && (*marker)["outputs"].is_object()) {
+    for (const auto& [command, claimed] : (*marker)["outputs"].items()) {
+      if (!claimed.is_object() || !claimed.contains("files") || !claimed["files"].is_array()) {
+        continue;
+      }
+      owned[command] = {claimed.value("config_sha256", ""), names(claimed["files"], nullptr)};
+    }
+    return owned;
+  }
+  // A report written before markers existed: report.json and the outputs it names.
+  if (const auto report = ReadJson(dir / "report.json");
+      report && report->is_object() && report->contains("tool") && (*report)["tool"].is_object() &&
+      (*report)["tool"].value("name", "") == "sonarbench" && report->contains("outputs") &&
+      (*report)["outputs"].is_object()) {
+    json files = json::array({"report.json"});
+    for (const auto& [what, file] : (*report)["outputs"].items()) files.push_back(file);
+    owned["report"] = {"", names(files, nullptr)};
+    return owned;
+  }
+  // A dataset written before markers existed: its manifest lists its files.
+  if (const auto manifest = ReadJson(dir / "manifest.json");
+      manifest && manifest->is_object() &&
+      manifest->value("format", "") == mapping::kDatasetFormat && manifest->contains("files") &&
+      (*manifest)["files"].is_array()) {
+    owned[manifest->value("source", "simulate")] = {
+        manifest->value("config_sha256", ""),
+        SortedUnion(names((*manifest)["files"], "path"), {"manifest.json"})};
+    return owned;
+  }
+  return std::nullopt;
+}
+
+std::optional<std::vector<std::string>> OwnedFiles(const fs::path& dir) {
+  const auto owned = ReadOwnership(dir);
+  if (!owned) return std::nullopt;
+  std::vector<std::string> files;
+  for (const auto& [command, claimed] : *owned) files = SortedUnion(files, claimed.files);
+  if (Exists(dir / OutputDirectory::kMarkerFile)) {
+    files = SortedUnion(files, {OutputDirectory::kMarkerFile, OutputDirectory::kLockFile});
+  }
+  return files;
+}
+
+OutputDirectory::OutputDirectory(const std::string& dir, OutputClaim claim)
+    : name_(dir), claim_(std::move(claim)) {
+  for (const std::string& file : claim_.files) {
+    if (!SafeRelative(file)) throw std::logic_error("output file '" + file + "' is not relative");
+  }
+  try {
+    Open();
+  } catch (...) {
+    Release();
+    throw;
+  }
+}
+
+void OutputDirectory::Open() {
+  if (name_.empty()) throw InputError("--out '': expected the path of an output directory");
+  std::error_code error;
+  const fs::path path(name_);
+  if (Exists(path)) {
+    root_ = fs::canonical(path, error);
+    if (error) {
+      throw EnvironmentError(name_ + ": cannot be used as the output directory (" +
+                             error.message() + ")");
+    }
+    if (!fs::is_directory(root_, error)) {
+      throw InputError(name_ + ": exists and is not a directory (expected an output directory)");
+    }
+  } else {
+    CreateOutputDirectory(name_);
+    created_ = true;
+    root_ = fs::canonical(path);
+  }
+  // The directory's own lock serialises the set-up; the lock file's lock is held for the run:
+  // exclusive by a one-shot writer, shared by the shards of one configuration.
+  const Fd dir_fd(::open(root_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (dir_fd.get() < 0 || ::flock(dir_fd.get(), LOCK_EX) != 0) {
+    throw EnvironmentError(name_ + ": cannot be opened (" + std::strerror(errno) + ")");
+  }
+  lock_created_ = !Exists(root_ / kLockFile);
+  lock_fd_ = ::open((root_ / kLockFile).c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd_ < 0) {
+    throw EnvironmentError(name_ + ": cannot write in it (" + std::strerror(errno) + ")");
+  }
+  if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+    const auto owned = ReadOwnership(root_);
+    const bool same = claim_.mode == OutputMode::kResume && !claim_.force && owned &&
+                      owned->contains(claim_.command) &&
+                      owned->at(claim_.command).config_sha256 == claim_.config_sha256;
+    if (!same || ::flock(lock_fd_, LOCK_SH) != 0) {
+      throw InputError(name_ + ": another sonarbench is writing here (" + Holder() +
+                       "); wait for it to finish or choose another --out" +
+                       (claim_.force ? " (--force never removes a running writer's files)" : ""));
+    }
+    write_root_ = root_;  // a shard of the same run: the marker lists its files already
+    lock_created_ = false;
+    return;
+  }
+  Ownership owned = ReadOwnership(root_).value_or(Ownership{});
+  CheckInputsAndCollisions(OwnedFiles(root_).value_or(std::vector<std::string>{}));
+  Claimed& mine = owned[claim_.command];
+  std::vector<std::string> outputs;
+  for (const std::string& file : mine.files) {
+    if (Exists(root_ / file)) outputs.push_back(file);
+  }
+  if (claim_.mode == OutputMode::kResume) {
+    if (claim_.force) {
+      RemoveFiles(outputs);
+      mine.files.clear();
+    } else if (mine.config_sha256 != claim_.config_sha256 && !outputs.empty()) {
+      throw InputError(name_ + ": holds sonarbench " + claim_.command +
+                       " outputs of another configuration (config_sha256 " + mine.config_sha256 +
+                       "); pass --force to replace them (only the files " + claim_.command +
+                       " listed in " + kMarkerFile + " are removed)");
+    }
+  }
+  // A file this claim writes is this command's now, whichever wrote it before.
+  for (auto& [command, claimed] : owned) {
+    if (command == claim_.command) continue;
+    std::erase_if(claimed.files, [&](const std::string& file) {
+      return std::find(claim_.files.begin(), claim_.files.end(), file) != claim_.files.end();
+    });
+  }
+  mine = {claim_.config_sha256, SortedUnion(mine.files, claim_.files)};
+  WriteMarker(owned);
+  lock_created_ = false;  // listed in the marker now
+  WriteHolder();
+  // Temporary files of a killed writer are never whole.
+  RemoveTemporaries({});
+  write_root_ = root_;
+  if (claim_.mode == OutputMode::kResume) {
+    // Converted under the directory's lock, so no other writer can take it in between.
+    ::flock(lock_fd_, LOCK_SH);
+  } else {
+    write_root_ = root_ / kStageDir;
+    std::vector<std::string> staged;
+    for (const std::string& file : claim_.files) staged.push_back(kStageDir + ("/" + file));
+    RemoveFiles(staged);
+    fs::create_directories(write_root_, error);
+    if (error) throw EnvironmentError(name_ + ": cannot write in it (" + error.message() + ")");
+  }
+}
+
+void OutputDirectory::CheckInputsAndCollisions(const std::vector<std::string>& owned) const {
+  std::vector<std::string> foreign;
+  const std::set<std::string> mine(owned.begin(), owned.end());
+  if (Exists(root_ / kMarkerFile) && !OwnedFiles(root_)) foreign.push_back(kMarkerFile);
+  for (const std::string& file : claim_.files) {
+    RefuseSymlinkedFolder(name_, root_, file);
+    if (const std::string blocked = BlockedFolder(root_, file); !blocked.empty()) {
+      foreign.push_back(blocked + " (where a folder goes)");
+    } else if (!mine.contains(file) && Exists(root_ / file)) {
+      foreign.push_back(file);
+    }
+  }
+  std::sort(foreign.begin(), foreign.end());
+  foreign.erase(std::unique(foreign.begin(), foreign.end()), foreign.end());
+  if (!foreign.empty()) {
+    throw InputError(name_ + ": holds files sonarbench did not write: " + Listed(foreign) +
+                     "; sonarbench never replaces them (move them or choose another --out)");
+  }
+  std::error_code error;
+  for (const std::string& input : claim_.inputs) {
+    const fs::path in = fs::weakly_canonical(input, error);
+    for (const auto* list : {&claim_.files, &owned}) {
+      for (const std::string& file : *list) {
+        if (fs::weakly_canonical(root_ / file, error) == in) {
+          throw InputError(name_ + "/" + file + " is the input " + input +
+                           ": sonarbench never overwrites or removes its inputs (choose another "
+                           "--out)");
+        }
+      }
+    }
+  }
+}
+
+void OutputDirectory::RemoveFiles(const std::vector<std::string>& files) const {
+  for (const std::string& file : files) {
+    RefuseSymlinkedFolder(name_, root_, file);
+    std::error_code error;
+    fs::remove(root_ / file, error);
+    if (error) {
+      throw EnvironmentError(name_ + "/" + file + ": cannot be removed (" + error.message() + ")");
+    }
+  }
+  RemoveTemporaries(files);
+  for (const std::string& file : files) RemoveEmptyParents(root_, file);
+}
+
+void OutputDirectory::RemoveTemporaries(const std::vector<std::string>& files) const {
+  // "NAME.tmp.PID" beside a listed or given NAME: WriteFileAtomically's, of a writer that died.
+  const auto listed = OwnedFiles(root_).value_or(std::vector<std::string>{});
+  const std::set<std::string> names(listed.begin(), listed.end());
+  std::set<fs::path> folders;
+  for (const std::string& file : SortedUnion(files, listed)) {
+    folders.insert(fs::path(file).parent_path());
+  }
+  for (const fs::path& folder : folders) {
+    std::error_code error;
+    for (fs::directory_iterator it(root_ / folder, error), end; !error && it != end;
+         it.increment(error)) {
+      const std::string name = it->path().filename().string();
+      const auto at = name.rfind(".tmp.");
+      if (at == std::string::npos || !names.contains((folder / name.substr(0, at)).string()) ||
+          name.find_first_not_of("0123456789", at + 5) != std::string::npos) {
+        continue;
+      }
+      std::error_code ignored;
+      fs::remove(it->path(), ignored);
+    }
+  }
+}
+
+void OutputDirectory::WriteMarker(const Ownership& owned) const {
+  json outputs = json::object();
+  for (const auto& [command, claimed] : owned) {
+    if (claimed.files.empty()) continue;
+    outputs[command] = {{"config_sha256", claimed.config_sha256}, {"files", claimed.files}};
+  }
+  const json marker = {{"tool", "sonarbench"},
+                       {"about",
+                        "sonarbench wrote the files listed here, command by command, and may "
+                        "replace or remove them; it touches nothing else in this directory"},
+                       {"outputs", outputs}};
+  WriteFileAtomically((root_ / kMarkerFile).string(),
+                      [&](std::ostream& out) { out << marker.dump(2) << "\n"; });
+}
+
+void OutputDirectory::WriteHolder() const {
+  char host[256] = "?";
+  ::gethostname(host, sizeof host - 1);
+  const std::string text = "sonarbench " + claim_.command + ", pid " + std::to_string(::getpid()) +
+                           " on " + host + ", config " + claim_.config_sha256.substr(0, 12) + "\n";
+  if (::ftruncate(lock_fd_, 0) != 0 ||
+      ::pwrite(lock_fd_, text.data(), text.size(), 0) != static_cast<ssize_t>(text.size())) {
+    throw EnvironmentError(name_ + "/" + kLockFile + ": cannot be written (" +
+                           std::strerror(errno) + ")");
+  }
+}
+
+std::string OutputDirectory::Holder() const {
+  char text[512] = {};
+  const ssize_t n = ::pread(lock_fd_, text, sizeof text - 1, 0);
+  std::string holder = n > 0 ? std::string(text, static_cast<std::size_t>(n)) : "";
+  while (!holder.empty() && holder.back() == '\n') holder.pop_back();
+  return holder.empty() ? "holder unknown" : Quoted(holder, 200);
+}
+
+void OutputDirectory::Commit() {
+  if (claim_.mode != OutputMode::kReplace) return;
+  std::vector<std::string> staged;
+  for (const auto& entry : fs::recursive_directory_iterator(write_root_)) {
+    if (entry.is_directory()) continue;
+    staged.push_back(fs::relative(entry.path(), write_root_).generic_string());
+  }
+  for (const std::string& file : staged) {
+    if (std::find(claim_.files.begin(), claim_.files.end(), file) == claim_.files.end()) {
+      throw std::logic_error(name_ + ": staged " + file + ", which " + claim_.command +
+                             " does not claim");
+    }
+  }
+  // The record goes first, so no reader trusts a mix of two runs' files.
+  std::vector<std::string> stale;
+  for (const std::string& file : claim_.files) {
+    if (file == claim_.record || std::find(staged.begin(), staged.end(), file) == staged.end()) {
+      stale.push_back(file);
+    }
+  }
+  std::stable_partition(stale.begin(), stale.end(),
+                        [&](const std::string& file) { return file == claim_.record; });
+  for (const std::string& file : stale) {
+    std::error_code error;
+    fs::remove(root_ / file, error);
+    if (error) {
+      throw EnvironmentError(name_ + "/" + file + ": cannot be removed (" + error.message() + ")");
+    }
+    RemoveEmptyParents(root_, file);
+  }
+  std::stable_partition(staged.begin(), staged.end(),
+                        [&](const std::string& file) { return file != claim_.record; });
+  for (const std::string& file : staged) {
+    std::error_code error;
+    fs::create_directories((root_ / file).parent_path(), error);
+    if (!error) fs::rename(write_root_ / file, root_ / file, error);
+    if (error) {
+      throw EnvironmentError(name_ + "/" + file + ": cannot be written (" + error.message() + ")");
+    }
+    RemoveEmptyParents(write_root_, file);
+  }
+  const Fd dir_fd(::open(root_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
+  if (dir_fd.get() >= 0) ::fsync(dir_fd.get());
+  ::rmdir(write_root_.c_str());
+  committed_ = true;
+}
+
+OutputDirectory::~OutputDirectory() { Release(); }
+
+void OutputDirectory::Release() noexcept {
+  if (lock_fd_ < 0) {
+    if (created_) ::rmdir(root_.c_str());
+    return;
+  }
+  try {
+    // A lock file made by an open that was refused goes again (no marker lists it).
+    if (lock_created_) ::unlink((root_ / kLockFile).c_str());
+    if (claim_.mode == OutputMode::kReplace && !committed_ && write_root_ != root_) {
+      for (const std::string& file : claim_.files) {
+        std::error_code ignored;
+        fs::remove(write_root_ / file, ignored);
+        RemoveEmptyParents(write_root_, file);
+      }
+      ::rmdir(write_root_.c_str());
+    }
+    // The last writer out leaves the lock file empty: the same inputs, the same bytes.
+    const bool last = ::flock(lock_fd_, LOCK_EX | LOCK_NB) == 0;
+    if (last && !lock_created_ && ::ftruncate(lock_fd_, 0) != 0) {
+      // Only the holder's name is left in it.
+    }
+    // A directory made for nothing goes again, unless another writer has joined.
+    if (created_ && !committed_ && last) {
+      std::error_code error;
+      std::size_t others = 0;
+      for (fs::directory_iterator it(root_, error), end; !error && it != end; it.increment(error)) {
+        const std::string name = it->path().filename().string();
+        others += name != kMarkerFile && name != kLockFile;
+      }
+      if (!error && others == 0) {
+        fs::remove(root_ / kMarkerFile, error);
+        fs::remove(root_ / kLockFile, error);
+        ::rmdir(root_.c_str());
+      }
+    }
+  } catch (...) {
+    // A destructor must not throw; what is left is listed in the marker.
+  }
+  ::close(lock_fd_);
+  lock_fd_ = -1;
+}
+
+}  // namespace sonarbench::sim

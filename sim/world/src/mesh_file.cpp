@@ -1,0 +1,441 @@
+#include "sonarbench/sim/world/mesh_file.hpp"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <assimp/Importer.hpp>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string_view>
+#include <vector>
+
+#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/error.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+// A PLY value as the file would write it: 99, -5, 2.5.
+std::string Number(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+// A PLY scalar type.
+struct PlyType {
+  int bytes = 0;  // 0: not a PLY type
+  bool is_signed = false;
+  bool is_float = false;
+};
+
+PlyType PlyTypeNamed(const std::string& name) {
+  static const std::map<std::string, PlyType> kTypes = {
+      {"char", {1, true, false}},    {"int8", {1, true, false}},    {"uchar", {1, false, false}},
+      {"uint8", {1, false, false}},  {"short", {2, true, false}},   {"int16", {2, true, false}},
+      {"ushort", {2, false, false}}, {"uint16", {2, false, false}}, {"int", {4, true, false}},
+      {"int32", {4, true, false}},   {"uint", {4, false, false}},   {"uint32", {4, false, false}},
+      {"float", {4, true, true}},    {"float32", {4, true, true}},  {"double", {8, true, true}},
+      {"float64", {8, true, true}}};
+  const auto found = kTypes.find(name);
+  return found == kTypes.end() ? PlyType{} : found->second;
+}
+
+// One property of a PLY element: a scalar, or a list (a count, then that many items).
+struct PlyProperty {
+  std::string name;
+  bool list = false;
+  PlyType count;  // the list's
+  PlyType item;   // the scalar, or each item of the list
+};
+
+struct PlyElement {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+struct PlyHeader {
+  std::string format;  // ascii, binary_little_endian or binary_big_endian
+  std::vector<PlyElement> elements;
+  std::size_t body = 0;  // where the body starts
+  int lines = 0;         // the header's, end_header's included
+};
+
+PlyHeader ReadPlyHeader(const std::string& bytes,
+                        const std::function<InputError(std::string)>& fail) {
+  PlyHeader header;
+  std::size_t at = 0;
+  for (int line_number = 1;; ++line_number) {
+    const std::size_t end = bytes.find('\n', at);
+    if (end == std::string::npos) throw fail("the header has no 'end_header' line");
+    std::string line = bytes.substr(at, end - at);
+    at = end + 1;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    const auto bad_line = [&](const std::string& expected) {
+      return fail("header line " + std::to_string(line_number) + ": expected " + expected +
+                  ", got " + Quoted(line));
+    };
+    if (line_number == 1) {
+      if (keyword != "ply" || words >> keyword) throw bad_line("'ply'");
+    } else if (keyword == "end_header") {
+      header.lines = line_number;
+      break;
+    } else if (keyword == "comment" || keyword == "obj_info" || keyword.empty()) {
+      continue;
+    } else if (keyword == "format") {
+      words >> header.format;
+      if (header.format != "ascii" && header.format != "binary_little_endian" &&
+          header.format != "binary_big_endian") {
+        throw bad_line("format ascii, binary_little_endian or binary_big_endian");
+      }
+    } else if (keyword == "element") {
+      PlyElement element;
+      if (!(words >> element.name >> element.count)) throw bad_line("element NAME COUNT");
+      header.elements.push_back(element);
+    } else if (keyword == "property") {
+      if (header.elements.empty()) throw bad_line("an element before its properties");
+      PlyProperty property;
+      std::string type;
+      words >> type;
+      if (type == "list") {
+        std::string count_type, item_type;
+        words >> count_type >> item_type >> property.name;
+        property.list = true;
+        property.count = PlyTypeNamed(count_type);
+        property.item = PlyTypeNamed(item_type);
+        if (property.count.bytes == 0 || property.count.is_float || property.item.bytes == 0) {
+          throw bad_line("property list COUNT_TYPE ITEM_TYPE NAME, COUNT_TYPE an integer type");
+        }
+      } else {
+        words >> property.name;
+        property.item = PlyTypeNamed(type);
+        if (property.item.bytes == 0) throw bad_line("property TYPE NAME, TYPE a PLY type");
+      }
+      header.elements.back().properties.push_back(property);
+    } else {
+      throw bad_line("a PLY header keyword");
+    }
+  }
+  if (header.format.empty()) throw fail("the header has no 'format' line");
+  header.body = at;
+  return header;
+}
+
+// The values of a PLY body one by one: binary of either order, or ASCII numbers, one element per
+// line, separated by spaces or tabs.
+class PlyValues {
+ public:
+  PlyValues(const std::string& bytes, const PlyHeader& header,
+            std::function<InputError(std::string)> fail)
+      : bytes_(bytes),
+        at_(header.body),
+        line_number_(header.lines),
+        ascii_(header.format == "ascii"),
+        little_endian_(header.format == "binary_little_endian"),
+        fail_(std::move(fail)) {}
+
+  [[nodiscard]] bool ascii() const { return ascii_; }
+  // The file's line that the element being read is on (ASCII).
+  [[nodiscard]] int line_number() const { return line_number_; }
+
+  // Starts an element: in ASCII its line, the next one not blank; false if there is none.
+  bool BeginElement() {
+    if (!ascii_) return true;
+    for (;;) {
+      if (at_ >= bytes_.size()) return false;
+      line_end_ = std::min(bytes_.find('\n', at_), bytes_.size());
+      ++line_number_;
+      // Assimp ends a line at a form feed or a NUL as well: such a byte would split an element.
+      for (std::size_t i = at_; i < line_end_; ++i) {
+        const auto c = static_cast<unsigned char>(bytes_[i]);
+        if ((c < 0x20 && c != '\t' && !(c == '\r' && i + 1 == line_end_)) || c == 0x7f) {
+          throw fail_("line " + std::to_string(line_number_) + " holds the control character " +
+                      Quoted(std::string_view(bytes_.data() + i, 1)));
+        }
+      }
+      SkipBlanks();
+      if (at_ < line_end_) return true;
+      at_ = line_end_ + 1;
+    }
+  }
+
+  // The next value, read as `type`; nullopt at the body's end, or in ASCII at the line's.
+  std::optional<double> Next(const PlyType& type) {
+    if (ascii_) {
+      SkipBlanks();
+      if (at_ >= line_end_) return std::nullopt;
+      std::size_t end = at_;
+      while (end < line_end_ && !IsBlank(bytes_[end])) ++end;
+      double value = 0.0;
+      const auto [stop, error] = std::from_chars(bytes_.data() + at_, bytes_.data() + end, value);
+      if (error != std::errc() || stop != bytes_.data() + end) {
+        throw fail_("line " + std::to_string(line_number_) + " holds " +
+                    Quoted(bytes_.substr(at_, end - at_)) + " where a number belongs");
+      }
+      at_ = end;
+      return value;
+    }
+    if (bytes_.size() - at_ < static_cast<std::size_t>(type.bytes)) return std::nullopt;
+    std::uint64_t bits = 0;
+    for (int b = 0; b < type.bytes; ++b) {
+      const int shift = little_endian_ ? 8 * b : 8 * (type.bytes - 1 - b);
+      bits |= static_cast<std::uint64_t>(static_cast<unsigned char>(bytes_[at_ + b])) << shift;
+    }
+    at_ += type.bytes;
+    if (type.is_float && type.bytes == 4) {
+      float value = 0.0f;
+      const auto narrow = static_cast<std::uint32_t>(bits);
+      std::memcpy(&value, &narrow, sizeof value);
+      return value;
+    }
+    if (type.is_float) {
+      double value = 0.0;
+      std::memcpy(&value, &bits, sizeof value);
+      return value;
+    }
+    if (type.is_signed && (bits >> (8 * type.bytes - 1)) != 0) {
+      return static_cast<double>(bits) - std::ldexp(1.0, 8 * type.bytes);
+    }
+    return static_cast<double>(bits);
+  }
+
+  // Ends an element: in ASCII its line holds nothing more.
+  void EndElement(const std::string& element) {
+    if (!ascii_) return;
+    SkipBlanks();
+    if (at_ < line_end_) {
+      throw fail_("line " + std::to_string(line_number_) + " holds more values than " + element +
+                  " has properties");
+    }
+    at_ = line_end_ + 1;
+  }
+
+ private:
+  static bool IsBlank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+  void SkipBlanks() {
+    while (at_ < line_end_ && IsBlank(bytes_[at_])) ++at_;
+  }
+
+  const std::string& bytes_;
+  std::size_t at_;
+  std::size_t line_end_ = 0;
+  int line_number_;
+  bool ascii_;
+  bool little_endian_;
+  std::function<InputError(std::string)> fail_;
+};
+
+// Assimp 5.2's PLY reader loops for ever on a header without `end_header`, aborts (an assertion
+// in its triangulation) on a body shorter than its header declares or on a face of no vertices,
+// and reads out of bounds through a face's vertex index past the vertices. So a PLY file is
+// checked first: its header whole, every element the header counts present in the body (in ASCII
+// on a line of its own, as Assimp reads it), and every face a list of at least one whole index to
+// one of the vertices.
+void CheckPly(const std::string& path, const std::string& bytes) {
+  const auto fail = [&](std::string what) {
+    return InputError(path + ": not a readable PLY file: " + what);
+  };
+  const PlyHeader header = ReadPlyHeader(bytes, fail);
+  std::uint64_t vertices = 0;
+  for (const PlyElement& element : header.elements) {
+    if (element.name == "vertex") vertices = element.count;
+  }
+  PlyValues values(bytes, header, fail);
+  for (const PlyElement& element : header.elements) {
+    for (std::uint64_t i = 0; i < element.count && !element.properties.empty(); ++i) {
+      const auto where = [&] { return "element '" + element.name + "' " + std::to_string(i); };
+      const auto ends = [&] {
+        return fail("the body ends in " + where() + " of the " + std::to_string(element.count) +
+                    " its header declares");
+      };
+      if (!values.BeginElement()) throw ends();
+      const auto next = [&](const PlyType& type) {
+        const std::optional<double> value = values.Next(type);
+        if (value) return *value;
+        if (!values.ascii()) throw ends();
+        throw fail("line " + std::to_string(values.line_number()) + " holds fewer values than " +
+                   where() + " has properties");
+      };
+      for (const PlyProperty& p : element.properties) {
+        if (!p.list) {
+          (void)next(p.item);
+          continue;
+        }
+        const double count = next(p.count);
+        if (count < 0.0 || count != std::floor(count)) {
+          throw fail(where() + ": a list's count of " + Number(count));
+        }
+        const bool indices =
+            element.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
+        if (indices && count == 0.0) throw fail(where() + ": a face of no vertices");
+        for (double k = 0; k < count; ++k) {
+          const double index = next(p.item);
+          if (indices && (index < 0.0 || index >= static_cast<double>(vertices) ||
+                          index != std::floor(index))) {
+            throw fail(where() + ": vertex index " + Number(index) +
+                       ", expected a whole index from 0 of the " + std::to_string(vertices) +
+                       " vertices");
+          }
+        }
+      }
+      values.EndElement(where());
+    }
+  }
+}
+
+// An element of an XML text, found by its tag: where it starts, its attributes' text and its
+// text up to the next tag.
+struct XmlElement {
+  std::size_t at = 0;
+  std::string attributes;
+  std::string content;
+};
+
+// Calls `each` on every element `tag` of `bytes` that is not empty (<p/>). A plain scan, not a
+// parser: what it cannot find, Assimp's own parser reports.
+void ForEachXmlElement(const std::string& bytes, const std::string& tag,
+                       const std::function<void(const XmlElement&)>& each) {
+  for (std::size_t at = bytes.find("<" + tag); at != std::string::npos;
+       at = bytes.find("<" + tag, at + 1)) {
+    const std::size_t name_end = at + 1 + tag.size();
+    if (name_end >= bytes.size()) break;
+    // Another element whose name starts so (<param>, <vertices>).
+    if (bytes[name_end] != '>' && !std::isspace(static_cast<unsigned char>(bytes[name_end]))) {
+      continue;
+    }
+    const std::size_t content = bytes.find('>', name_end);
+    if (content == std::string::npos || bytes[content - 1] == '/') continue;
+    const std::size_t content_end = std::min(bytes.find('<', content), bytes.size());
+    each({.at = at,
+          .attributes = bytes.substr(name_end, content - name_end),
+          .content = bytes.substr(content + 1, content_end - content - 1)});
+  }
+}
+
+// The value of the attribute `name` in an element's attributes' text; nullopt if it has none.
+std::optional<std::string> XmlAttribute(const std::string& attributes, const std::string& name) {
+  for (std::size_t at = attributes.find(name); at != std::string::npos;
+       at = attributes.find(name, at + 1)) {
+    if (at == 0 || !std::isspace(static_cast<unsigned char>(attributes[at - 1]))) continue;
+    std::size_t i = at + name.size();
+    while (i < attributes.size() && std::isspace(static_cast<unsigned char>(attributes[i]))) ++i;
+    if (i == attributes.size() || attributes[i] != '=') continue;
+    ++i;
+    while (i < attributes.size() && std::isspace(static_cast<unsigned char>(attributes[i]))) ++i;
+    if (i == attributes.size() || (attributes[i] != '"' && attributes[i] != '\'')) continue;
+    const std::size_t end = attributes.find(attributes[i], i + 1);
+    if (end == std::string::npos) return std::nullopt;
+    return attributes.substr(i + 1, end - i - 1);
+  }
+  return std::nullopt;
+}
+
+// A whole number as COLLADA's unsigned types write it (a '+' allowed); nullopt if it is not one.
+std::optional<std::uint64_t> WholeNumber(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  const char* const first = text.data() + (text[0] == '+' ? 1 : 0);
+  const char* const end = text.data() + text.size();
+  std::uint64_t value = 0;
+  const auto [stop, error] = std::from_chars(first, end, value);
+  if (error != std::errc() || stop != end) return std::nullopt;
+  return value;
+}
+
+// Assimp 5.2's COLLADA reader loops for ever on an index list (<p>, <vcount>, <v> or <h>)
+// holding anything but whole numbers, takes an index of 2^31 or more for a valid one (4e9 in a
+// 12-triangle file read as whole), segfaults on an array (<float_array>, ...) without a whole
+// `count`, and reads only `count` of its items when there are more. So index lists and arrays
+// are checked first.
+void CheckCollada(const std::string& path, const std::string& bytes) {
+  const auto fail = [&](std::size_t at, const std::string& what) {
+    const auto line = std::count(bytes.begin(), bytes.begin() + static_cast<long>(at), '\n');
+    return InputError(path + ":" + std::to_string(line + 1) +
+                      ": not a readable COLLADA file: " + what);
+  };
+  for (const std::string tag : {"p", "vcount", "v", "h"}) {
+    ForEachXmlElement(bytes, tag, [&](const XmlElement& element) {
+      std::istringstream items(element.content);
+      for (std::string item; items >> item;) {
+        if (const auto index = WholeNumber(item); !index || *index > 0x7fffffff) {
+          throw fail(element.at, "<" + tag + "> holds " + Quoted(item) +
+                                     " where an index (a whole number from 0 to 2^31 - 1) "
+                                     "belongs");
+        }
+      }
+    });
+  }
+  for (const std::string tag :
+       {"float_array", "int_array", "bool_array", "Name_array", "IDREF_array"}) {
+    ForEachXmlElement(bytes, tag, [&](const XmlElement& element) {
+      std::istringstream items(element.content);
+      std::uint64_t count = 0;
+      for (std::string item; items >> item;) ++count;
+      const std::optional<std::string> said = XmlAttribute(element.attributes, "count");
+      if (!said || WholeNumber(*said) != count) {
+        throw fail(element.at, "<" + tag + "> holds " + std::to_string(count) +
+                                   " items, expected its count attribute to say so, as count=\"" +
+                                   std::to_string(count) + "\"");
+      }
+    });
+  }
+}
+
+}  // namespace
+
+MeshFileData LoadMeshFile(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": no such mesh file");
+  // What Assimp cannot read safely is checked first, in the formats it reads by their content.
+  std::string start(4096, '\0');
+  start.resize(static_cast<std::size_t>(
+      std::ifstream(path, std::ios::binary).read(start.data(), 4096).gcount()));
+  if (start.starts_with("ply") && start.size() > 3 &&
+      std::isspace(static_cast<unsigned char>(start[3]))) {
+    CheckPly(path, ReadFileBytes(path));
+  } else if (start.find("<COLLADA") != std::string::npos) {
+    CheckCollada(path, ReadFileBytes(path));
+  }
+  Assimp::Importer importer;
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
+  // Points and lines have no surface to echo from.
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  const aiScene* scene =
+      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices |
+                                  aiProcess_SortByPType | aiProcess_JoinIdenticalVertices);
+  if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0) {
+    throw InputError(path + ": not a readable mesh file (OBJ, STL, PLY or DAE expected): " +
+                     Quoted(importer.GetErrorString(), 300));
+  }
+  MeshFileData data;
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* mesh = scene->mMeshes[m];
+    const auto base = static_cast<std::uint32_t>(data.vertices.size());
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+      const aiVector3D& p = mesh->mVertices[v];
+      data.vertices.emplace_back(p.x, p.y, p.z);
+    }
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      data.triangles.push_back(
+          {base + face.mIndices[0], base + face.mIndices[1], base + face.mIndices[2]});
+    }
+  }
+  if (data.triangles.empty()) throw InputError(path + ": the mesh file holds no triangle");
+  return data;
+}
+
+}  // namespace sonarbench::sim

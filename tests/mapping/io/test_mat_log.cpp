@@ -1,0 +1,163 @@
+#include <gtest/gtest.h>
+#include <matio.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <numbers>
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "sonarbench/io/mat_log.hpp"
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/app/dataset_writer.hpp"
+#include "sonarbench/sim/app/map_log.hpp"
+#include "sonarbench/sim/app/scenario.hpp"
+#include "sonarbench/sim/eval/score.hpp"
+#include "sonarbench/sim/report/fidelity_report.hpp"
+#include "sonarbench/sim/report/scenario_report.hpp"
+#include "sonarbench/sim/sonar/simulation.hpp"
+#include "sonarbench/sim/world/mesh.hpp"
+#include "sonarbench/sim/world/scene.hpp"
+#include "test_util.hpp"
+
+namespace sonarbench {
+namespace {
+
+using test::RealLogPath;
+
+using mapping::kDegToRad;
+
+// Writes the real log's bytes, changed by `change`, to `path`.
+void WriteChangedRealLog(const std::string& path,
+                         const std::function<void(std::vector<char>&)>& change) {
+  std::ifstream in(RealLogPath(), std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  change(bytes);
+  std::ofstream(path, std::ios::binary)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+TEST(MatLog, CorruptOrMissingFilesAreClearErrors) {
+  test::TempDir dir;
+  const std::string garbage = (dir.path() / "garbage.mat").string();
+  std::ofstream(garbage) << "MATLAB 5.0 MAT-file, but not really";
+  for (const std::string& path : {garbage, (dir.path() / "absent.mat").string()}) {
+    try {
+      (void)mapping::ReadMatLog(path);
+      ADD_FAILURE() << "no error for " << path;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(MatLog, TruncatedCopyOfTheRealLogIsAClearError) {
+  REQUIRE_REAL_LOG();
+  test::TempDir dir;
+  const std::string cut = (dir.path() / "cut.mat").string();
+  WriteChangedRealLog(cut, [](std::vector<char>& bytes) { bytes.resize(bytes.size() / 2); });
+  EXPECT_THROW((void)mapping::ReadMatLog(cut), InputError);
+}
+
+// One byte changed inside the compressed log, found by flipping bytes: at offset 299 libmatio sized
+// parsedData's table of fields at 571 GB, left it unallocated and then read through a null pointer
+// (segfault); at 620834 it allocated 13 GB over 35 s before it refused the file. Both break the
+// compressed stream's checksum, which libmatio checks only at the end: refused at once now.
+TEST(MatLog, CorruptCopiesOfTheRealLogAreClearErrors) {
+  REQUIRE_REAL_LOG();
+  test::TempDir dir;
+  for (const auto& change : {std::tuple{299, 140, 165}, std::tuple{620834, 151, 252}}) {
+    const int at = std::get<0>(change), before = std::get<1>(change), after = std::get<2>(change);
+    const std::string bad = (dir.path() / ("bad" + std::to_string(at) + ".mat")).string();
+    WriteChangedRealLog(bad, [&](std::vector<char>& bytes) {
+      ASSERT_EQ(static_cast<unsigned char>(bytes.at(at)), before);
+      bytes[at] = static_cast<char>(after);
+    });
+    EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(bad); }),
+              bad + ": a corrupt MAT file (a compressed element does not inflate whole)");
+  }
+}
+
+// The check before libmatio reads what libmatio writes: a char array (whose stated size counts
+// padding it leaves out of the compressed stream), an uncompressed array and the struct array of
+// beams, compressed and not.
+TEST(MatLog, WhatLibmatioWritesIsRead) {
+  test::TempDir dir;
+  for (const matio_compression compression : {MAT_COMPRESSION_ZLIB, MAT_COMPRESSION_NONE}) {
+    const std::string path = (dir.path() / "written.mat").string();
+    mat_t* mat = Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT5);
+    ASSERT_NE(mat, nullptr);
+    std::size_t note_dims[2] = {1, 7};
+    char note[] = "odd one";
+    matvar_t* var = Mat_VarCreate("note", MAT_C_CHAR, MAT_T_UINT8, 2, note_dims, note, 0);
+    Mat_VarWrite(mat, var, MAT_COMPRESSION_ZLIB);
+    Mat_VarFree(var);
+    std::size_t plain_dims[2] = {1, 3};
+    double plain[3] = {1, 2, 3};
+    var = Mat_VarCreate("plain", MAT_C_DOUBLE, MAT_T_DOUBLE, 2, plain_dims, plain, 0);
+    Mat_VarWrite(mat, var, MAT_COMPRESSION_NONE);
+    Mat_VarFree(var);
+    const char* fields[4] = {"time", "angle", "step_dist", "intensities"};
+    std::size_t beams[2] = {1, 2};
+    matvar_t* data = Mat_VarCreateStruct("parsedData", 2, beams, fields, 4);
+    for (std::size_t i = 0; i < 2; ++i) {
+      std::size_t one[2] = {1, 1};
+      std::size_t bins[2] = {1, 5};
+      double time = 0.1 * static_cast<double>(i), angle = 1.8 * static_cast<double>(i);
+      double step = 0.0125;
+      double intensities[5] = {0, 10, 20, 30, 255};
+      const auto set = [&](const char* field, std::size_t* dims, double* values) {
+        Mat_VarSetStructFieldByName(
+            data, field, i, Mat_VarCreate(nullptr, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, values, 0));
+      };
+      set("time", one, &time);
+      set("angle", one, &angle);
+      set("step_dist", one, &step);
+      set("intensities", bins, intensities);
+    }
+    Mat_VarWrite(mat, data, compression);
+    Mat_VarFree(data);
+    Mat_Close(mat);
+    const mapping::MatLog log = mapping::ReadMatLog(path);
+    ASSERT_EQ(log.beams.size(), 2u);
+    EXPECT_EQ(log.beams[1].intensities, (std::vector<std::uint8_t>{0, 10, 20, 30, 255}));
+    EXPECT_DOUBLE_EQ(log.beams[1].head_angle_rad, 1.8 * std::numbers::pi / 180.0);
+  }
+}
+
+// A MAT v5 file whose array states more elements than it holds values is refused before libmatio
+// reads it (it would allocate what the dimensions say: 16 GB here).
+TEST(MatLog, AnArrayLargerThanItsBytesIsRefused) {
+  test::TempDir dir;
+  std::string mat(116, ' ');
+  mat.replace(0, 10, "MATLAB 5.0");
+  mat += std::string(8, '\0') + std::string("\x00\x01IM", 4);
+  const auto u32 = [&](std::uint32_t value) {
+    mat.append(reinterpret_cast<const char*>(&value), 4);  // little-endian, as "IM" says
+  };
+  u32(14), u32(72);                         // miMATRIX of 72 bytes
+  u32(6), u32(8), u32(6), u32(0);           // its flags: a double array
+  u32(5), u32(8), u32(1), u32(2000000000);  // 1 x 2e9
+  u32(1), u32(10), mat += std::string("parsedData\0\0\0\0\0\0", 16);
+  u32(9), u32(8), mat += std::string("\0\0\0\0\0\0\xf0\x3f", 8);  // one double, 1.0
+  const std::string path = test::WriteFile(dir, "huge.mat", mat);
+  EXPECT_EQ(
+      test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+      path + ": a corrupt MAT file (an array of 2000000000 elements holds 8 bytes of values)");
+  // The same file stating the one element it holds is read as far as its layout: not a struct.
+  mat.replace(128 + 8 + 16 + 8 + 4, 4, std::string("\x01\0\0\0", 4));
+  test::WriteFile(dir, "huge.mat", mat);
+  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+            path + ": 'parsedData' is not a struct array");
+}
+
+}  // namespace
+}  // namespace sonarbench

@@ -1,0 +1,134 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "sonarbench/io/mapping_yaml.hpp"
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/mapping/mapper_config.hpp"
+#include "sonarbench/sim/app/dataset_writer.hpp"
+#include "sonarbench/sim/world/scene.hpp"
+#include "sonarbench/sim/world/sensor_model.hpp"
+#include "test_util.hpp"
+
+namespace sonarbench {
+namespace {
+
+using test::ThrowsInputErrorWith;
+
+mapping::MapperConfig ReadMapping(const std::string& text) {
+  YamlReader reader = YamlReader::FromString(text, "scene.yaml");
+  mapping::MapperConfig config = mapping::ReadMapperConfig(reader);
+  reader.ThrowIfErrors();
+  return config;
+}
+
+TEST(YamlReader, DefaultsComeFromTheStruct) {
+  const mapping::MapperConfig config = ReadMapping("resolution_m: 0.1\n");
+  EXPECT_DOUBLE_EQ(config.resolution_m, 0.1);
+  EXPECT_EQ(config.rays_horizontal, mapping::MapperConfig{}.rays_horizontal);
+  EXPECT_EQ(config.rays_vertical, mapping::MapperConfig{}.rays_vertical);
+}
+
+TEST(YamlReader, UnknownKeyNamesFileLineAndKey) {
+  EXPECT_TRUE(
+      ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nray_horizontal: 3\n"); },
+                           {"scene.yaml:2:1", "'ray_horizontal'", "unknown key"}));
+}
+
+TEST(YamlReader, OutOfRangeValueNamesKeyAndExpectation) {
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [] { (void)ReadMapping("rays_vertical: 0\n"); },
+      {"scene.yaml:1:16", "'rays_vertical'", "an integer in [1, 4096]", "got '0'"}));
+}
+
+TEST(YamlReader, WrongTypeAndNestedKeyPath) {
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [] { (void)ReadMapping("detection:\n  threshold: high\n"); },
+      {"scene.yaml:2:14", "'detection.threshold'", "expected an integer", "got 'high'"}));
+}
+
+TEST(YamlReader, DuplicateKeyIsAnError) {
+  EXPECT_TRUE(
+      ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nresolution_m: 0.2\n"); },
+                           {"scene.yaml:2:1", "'resolution_m'", "duplicate key"}));
+  // A mapping of many duplicates (two list items run together) is one message.
+  EXPECT_EQ(test::InputErrorOf([] {
+              (void)ReadMapping(
+                  "resolution_m: 0.1\nrays_vertical: 8\nresolution_m: 0.2\nrays_vertical: 9\n"
+                  "rays_horizontal: 4\nrays_horizontal: 4\n");
+            }),
+            "scene.yaml:3:1: key 'resolution_m': duplicate key (each key may appear once; so are "
+            "'rays_vertical', 'rays_horizontal')");
+}
+
+TEST(YamlReader, ReportsEveryBadFieldAtOnce) {
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [] { (void)ReadMapping("resolution_m: -1\nrays_vertical: 0\nbogus: 1\n"); },
+      {"'resolution_m'", "'rays_vertical'", "'bogus'"}));
+}
+
+TEST(YamlReader, NonFiniteNumbersAreRejected) {
+  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: .nan\n"); },
+                                   {"'resolution_m'", "a finite number"}));
+}
+
+// A failure recorded at a key names that key's line and leaves the mapping as it was: the keys
+// after it still read (yaml-cpp assigns through a Node that shares another, so pointing at the
+// key's value must rebind, not assign).
+TEST(YamlReader, FailAtAKeyLeavesTheMappingIntact) {
+  YamlReader reader = YamlReader::FromString("a: 1\nb: 2\nc: 3\n", "scene.yaml");
+  reader.Fail("b", "something else");
+  int a = 0;
+  int c = 0;
+  reader.Required("a", a);
+  reader.Required("c", c);
+  EXPECT_EQ(a, 1);
+  EXPECT_EQ(c, 3);
+  EXPECT_EQ(reader.Keys(), (std::vector<std::string>{"a", "b", "c"}));
+  const std::string message = test::InputErrorOf([&] { reader.ThrowIfErrors(); });
+  EXPECT_NE(message.find("scene.yaml:2:"), std::string::npos) << message;
+  EXPECT_NE(message.find("key 'b': something else"), std::string::npos) << message;
+  EXPECT_EQ(message.find("'a'"), std::string::npos) << message;
+  EXPECT_EQ(message.find("'c'"), std::string::npos) << message;
+}
+
+// A value that should be a mapping and is not, or is missing, is one mistake, reported once:
+// the keys then read from it, its checks and its unknown keys add nothing.
+TEST(YamlReader, AValueThatIsNotAMappingIsReportedOnce) {
+  YamlReader reader = YamlReader::FromString("a: 5\nb: x\n", "scene.yaml");
+  int c = 0;
+  for (const char* key : {"a", "d"}) {
+    YamlReader child = reader.Child(key);
+    child.Required("c", c);
+    child.Fail("", "a bound");
+    child.RejectUnknownKeys();
+  }
+  int b = 0;
+  reader.Required("b", b);  // a mistake of its own: still reported
+  reader.RejectUnknownKeys();
+  const std::string message = test::InputErrorOf([&] { reader.ThrowIfErrors(); });
+  EXPECT_EQ(message,
+            "scene.yaml:1:4: key 'a': expected a mapping, got '5'\n"
+            "scene.yaml:1:1: key 'd': missing (expected a mapping)\n"
+            "scene.yaml:2:4: key 'b': expected an integer, got 'x'");
+}
+
+TEST(YamlReader, SyntaxErrorNamesFileAndLine) {
+  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("a: [1, 2\nb: 3\n"); },
+                                   {"scene.yaml:", "invalid YAML"}));
+}
+
+// A directory opens as a stream and would read as an empty document: it is refused as what it is.
+TEST(YamlReader, ADirectoryIsNotAFile) {
+  test::TempDir dir;
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)YamlReader::FromFile(dir.path().string()); },
+                                   {dir.path().string(), "is a directory"}));
+}
+
+}  // namespace
+}  // namespace sonarbench

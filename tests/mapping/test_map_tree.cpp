@@ -1,0 +1,62 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <random>
+#include <sstream>
+#include <string>
+#include <unordered_set>
+#include <vector>
+
+#include "sonarbench/mapping/detail/beam_raster.hpp"
+#include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/detail/integrate.hpp"
+#include "sonarbench/mapping/detail/map_tree.hpp"
+#include "sonarbench/mapping/detail/ray_keys.hpp"
+#include "sonarbench/mapping/mapper.hpp"
+
+namespace sonarbench::mapping {
+namespace {
+
+using Reference = std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHash>;
+
+// Updating leaves in octree order along shared paths builds the tree OctoMap's updateNode builds,
+// byte for byte, including clamping at the thresholds (keys updated many times over batches).
+TEST(MapTree, UpdateLeavesInOrderBuildsUpdateNodesTree) {
+  MapTree ours(0.05);
+  octomap::OcTree octomaps(0.05);
+  std::mt19937_64 rng(8);
+  // Few keys (25^3) across the root's octants, so most are updated again and many reach a clamp.
+  std::uniform_int_distribution<int> near(32768 - 12, 32768 + 12);
+  std::bernoulli_distribution hit(0.3);
+  for (int batch = 0; batch < 30; ++batch) {
+    std::vector<std::pair<std::uint64_t, octomap::OcTreeKey>> updates;
+    std::vector<std::uint64_t> seen;
+    for (int i = 0; i < 3000; ++i) {
+      const octomap::OcTreeKey key(static_cast<octomap::key_type>(near(rng)),
+                                   static_cast<octomap::key_type>(near(rng)),
+                                   static_cast<octomap::key_type>(near(rng)));
+      if (std::find(seen.begin(), seen.end(), PackKey(key)) != seen.end()) continue;
+      seen.push_back(PackKey(key));
+      updates.emplace_back((MortonCode(key) << 1) | (hit(rng) ? 1 : 0), key);
+    }
+    for (const auto& [code, key] : updates) octomaps.updateNode(key, (code & 1) != 0, true);
+    std::sort(updates.begin(), updates.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    const float log_odds[2] = {ours.getProbMissLog(), ours.getProbHitLog()};
+    ours.UpdateLeavesInOrder(
+        updates.size(), [&](std::size_t i) { return updates[i].second; },
+        [&](std::size_t i) { return log_odds[updates[i].first & 1]; });
+  }
+  FinishUpdates(ours);
+  octomaps.updateInnerOccupancy();
+  std::ostringstream a;
+  std::ostringstream b;
+  WriteOctomapBinary(ours, a);
+  WriteOctomapBinary(octomaps, b);
+  EXPECT_EQ(ours.size(), octomaps.size());
+  EXPECT_TRUE(a.str() == b.str());
+}
+
+}  // namespace
+}  // namespace sonarbench::mapping

@@ -1,0 +1,134 @@
+#include <gtest/gtest.h>
+
+#include "sim_fixtures.hpp"
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/eval/ground_truth.hpp"
+#include "sonarbench/sim/eval/score.hpp"
+#include "sonarbench/sim/world/mesh.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+using Eigen::Vector3d;
+
+octomap::OcTree MapWith(const mapping::KeySet& occupied, const mapping::KeySet& free) {
+  octomap::OcTree tree(0.05);
+  for (const auto& k : occupied) tree.updateNode(k, true);
+  for (const auto& k : free) tree.updateNode(k, false);
+  return tree;
+}
+
+mapping::KeySet Row(int from, int to) {
+  mapping::KeySet cells;
+  for (int x = from; x < to; ++x)
+    cells.insert(octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + x), 32768, 32768));
+  return cells;
+}
+
+TEST(ScoreMap, IdenticalMapAndTruthScoreOne) {
+  const mapping::KeySet truth = Row(0, 10);
+  const MapMetrics m = ScoreMap(MapWith(truth, {}), truth, truth);
+  EXPECT_EQ(m.occupied_precision, 1.0);
+  EXPECT_EQ(m.occupied_recall, 1.0);
+  EXPECT_EQ(m.occupied_f1, 1.0);
+  EXPECT_EQ(m.coverage, 1.0);
+}
+
+TEST(ScoreMap, SwappingMapAndTruthSwapsPrecisionAndRecall) {
+  const mapping::KeySet a = Row(0, 10);
+  const mapping::KeySet b = Row(4, 20);
+  const MapMetrics ab = ScoreMap(MapWith(a, {}), b, b);
+  const MapMetrics ba = ScoreMap(MapWith(b, {}), a, a);
+  EXPECT_DOUBLE_EQ(ab.occupied_precision, 6.0 / 10.0);
+  EXPECT_DOUBLE_EQ(ab.occupied_recall, 6.0 / 16.0);
+  EXPECT_DOUBLE_EQ(ab.occupied_precision, ba.occupied_recall);
+  EXPECT_DOUBLE_EQ(ab.occupied_recall, ba.occupied_precision);
+}
+
+TEST(ScoreMap, FreeCellsCountForCoverageNotRecall) {
+  const mapping::KeySet truth = Row(0, 10);
+  const MapMetrics m = ScoreMap(MapWith(Row(0, 2), Row(2, 6)), truth, truth);
+  EXPECT_DOUBLE_EQ(m.occupied_recall, 0.2);
+  EXPECT_DOUBLE_EQ(m.coverage, 0.6);
+  EXPECT_EQ(m.free_cells, 4u);
+}
+
+TEST(ScoreMap, EmptyInputsGiveZerosNotNaN) {
+  const MapMetrics m = ScoreMap(octomap::OcTree(0.05), {}, {});
+  EXPECT_EQ(m.occupied_precision, 0.0);
+  EXPECT_EQ(m.occupied_recall, 0.0);
+  EXPECT_EQ(m.occupied_f1, 0.0);
+  EXPECT_EQ(m.coverage, 0.0);
+}
+
+TEST(CollectMapCells, PrunedNodesExpandToTheirLeafCells) {
+  octomap::OcTree tree(0.05);
+  // Eight sibling cells with equal values are pruned into one parent node.
+  for (int x = 0; x < 2; ++x)
+    for (int y = 0; y < 2; ++y)
+      for (int z = 0; z < 2; ++z)
+        tree.updateNode(octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + x),
+                                           static_cast<octomap::key_type>(32768 + y),
+                                           static_cast<octomap::key_type>(32768 + z)),
+                        true);
+  tree.prune();
+  ASSERT_EQ(tree.getNumLeafNodes(), 1u);
+  EXPECT_EQ(CollectMapCells(tree).occupied.size(), 8u);
+}
+
+// A plane at z = 0.012 m and occupied cells in the layers k = 0, 1, 3 above it (centres at
+// 0.025 + 0.05 k): each cell's distance to the mesh is its centre's height above the plane,
+// exactly; the surface cells' distance back to the nearest occupied cell is 0 where the map
+// holds them.
+TEST(ScoreMap, SurfaceDistancesOfKnownOffsets) {
+  const std::vector<TriangleMesh> meshes{SmallPlane()};
+  const octomap::OcTree key_space(0.05);
+  const mapping::KeySet truth = VoxelizeMeshes(meshes, key_space);
+  mapping::KeySet occupied;
+  const octomap::key_type z0 = key_space.coordToKey(0.012);
+  for (const int layer : {0, 1, 3}) {
+    occupied.insert(octomap::OcTreeKey(32768, 32768, static_cast<octomap::key_type>(z0 + layer)));
+  }
+  const MapMetrics m = ScoreMap(MapWith(occupied, {}), truth, truth, meshes);
+  ASSERT_EQ(m.map_to_mesh.count, 3u);
+  EXPECT_NEAR(m.map_to_mesh.max_m, 0.025 + 0.15 - 0.012, 1e-6);
+  EXPECT_NEAR(m.map_to_mesh.mean_m, (0.013 + 0.063 + 0.163) / 3.0, 1e-6);
+  ASSERT_EQ(m.mesh_to_map.count, truth.size());
+  // The farthest surface cell is a corner of the 20 × 20 layer, 10 and 9 or 10 cells away in x
+  // and y from the one occupied column (at keys 32768 = cells [0, 0.05)).
+  EXPECT_NEAR(m.mesh_to_map.max_m, 0.05 * std::hypot(10.0, 10.0), 1e-6);
+}
+
+// A mesh that is not truth (a water surface) adds no cells, no per-mesh recall, and is not a
+// surface that occupied cells are measured to: the test above, with a second plane right on the
+// occupied cells, gives the same distances.
+TEST(ScoreMap, MeshesThatAreNotTruthAreLeftOut) {
+  TriangleMesh surface = SmallPlane();
+  for (Eigen::Vector3f& v : surface.vertices) v.z() += 0.15f;
+  surface.truth = false;
+  const std::vector<TriangleMesh> meshes{SmallPlane(), surface};
+  const octomap::OcTree key_space(0.05);
+  const mapping::KeySet truth = VoxelizeMeshes(meshes, key_space);
+  EXPECT_EQ(truth.size(), 400u);
+  mapping::KeySet occupied;
+  const octomap::key_type z0 = key_space.coordToKey(0.012);
+  for (const int layer : {0, 1, 3}) {
+    occupied.insert(octomap::OcTreeKey(32768, 32768, static_cast<octomap::key_type>(z0 + layer)));
+  }
+  const MapMetrics m = ScoreMap(MapWith(occupied, {}), truth, truth, meshes);
+  ASSERT_EQ(m.per_mesh.size(), 1u);
+  ASSERT_EQ(m.map_to_mesh.count, 3u);
+  EXPECT_NEAR(m.map_to_mesh.max_m, 0.025 + 0.15 - 0.012, 1e-6);
+}
+
+TEST(ScoreMap, FreeCellsOnTheSurfaceLowerFreeAccuracy) {
+  const mapping::KeySet truth = Row(0, 10);
+  const MapMetrics m = ScoreMap(MapWith({}, Row(5, 25)), truth, truth);
+  EXPECT_EQ(m.free_on_surface_cells, 5u);
+  EXPECT_DOUBLE_EQ(m.free_accuracy, 1.0 - 5.0 / 20.0);
+  EXPECT_DOUBLE_EQ(m.coverage_absolute, 0.5);
+  EXPECT_EQ(m.mesh_to_map.count, 0u);  // no occupied cell: no distance, and no NaN
+}
+
+}  // namespace
+}  // namespace sonarbench::sim
