@@ -60,6 +60,44 @@ TEST(DetectThreshold, ShortSpikesAreNotObstacles) {
   EXPECT_TRUE(DetectThreshold(beam, sensor, config).empty());
 }
 
+// A run is an obstacle when it holds at least min_run_bins bins above the threshold: exactly
+// that many is one, one fewer is none (unsmoothed, so a run's length is the bins filled).
+TEST(DetectThreshold, ARunOfExactlyTheMinimumLengthIsAnObstacle) {
+  const SensorGeometry sensor;
+  for (int min_run : {1, 2, 3, 5}) {
+    DetectionConfig config;
+    config.smoothing_bins = 1;
+    config.min_run_bins = min_run;
+    Beam exact = MakeBeam(sensor);
+    Fill(exact, 100, 100 + min_run, 200);
+    EXPECT_EQ(DetectThreshold(exact, sensor, config),
+              std::vector<double>{exact.BinCentreRange(100)})
+        << "min_run_bins " << min_run;
+    Beam shorter = MakeBeam(sensor);
+    Fill(shorter, 100, 100 + min_run - 1, 200);
+    EXPECT_TRUE(DetectThreshold(shorter, sensor, config).empty()) << "min_run_bins " << min_run;
+  }
+}
+
+// The first usable bin is the first that begins at or past the self-reflection range: a bin that
+// begins inside it is ignored even when the range ends inside the bin (rounded up, not down),
+// and a range that ends exactly on a bin's edge leaves that bin usable.
+TEST(DetectThreshold, TheSelfReflectionRangeIsRoundedUpToWholeBins) {
+  SensorGeometry sensor;
+  sensor.self_reflection_range_m = 0.35;  // 27.93 bins of 0.012531 m
+  EXPECT_EQ(sensor.FirstUsableBin(), 28);
+  DetectionConfig config;
+  config.smoothing_bins = 1;
+  config.min_run_bins = 1;
+  Beam beam = MakeBeam(sensor);
+  Fill(beam, 27, 28, 255);  // begins at 0.338 m, inside the range
+  EXPECT_TRUE(DetectThreshold(beam, sensor, config).empty());
+  Fill(beam, 28, 29, 255);  // begins at 0.351 m, past it
+  EXPECT_EQ(DetectThreshold(beam, sensor, config), std::vector<double>{beam.BinCentreRange(28)});
+  sensor.self_reflection_range_m = 10 * sensor.bin_size_m;  // on bin 10's edge
+  EXPECT_EQ(sensor.FirstUsableBin(), 10);
+}
+
 TEST(DetectThreshold, FirstThenStrongestRuns) {
   const SensorGeometry sensor;
   Beam beam = MakeBeam(sensor);

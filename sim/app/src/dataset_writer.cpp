@@ -276,6 +276,56 @@ std::optional<Shard> ShardFromSlurm() {
   return Shard{(task - first) / step, tasks};
 }
 
+namespace {
+
+// The dataset's poses (reported, true, the vehicle's) and its truth occupancy.
+void WritePosesAndTruth(const fs::path& root, const Scene& scene, std::uint64_t seed,
+                        std::size_t beam_count, const std::vector<TriangleMesh>& meshes) {
+  std::string sonar;
+  std::string sonar_true;
+  std::string vehicle;
+  for (std::size_t b = 0; b < beam_count; ++b) {
+    const ScheduledBeam scheduled = ScheduleBeam(scene, b);
+    sonar +=
+        mapping::TumLine(scheduled.time_s, ReportedSonarPose(scene, b, scheduled.time_s, seed));
+    sonar_true += mapping::TumLine(scheduled.time_s, scheduled.pose.T_world_sonar);
+    vehicle +=
+        mapping::TumLine(scheduled.time_s, scene.trajectory.T_world_vehicle(scheduled.time_s));
+  }
+  WriteText(root / "poses/sonar.tum", sonar);
+  WriteText(root / "poses/sonar_true.tum", sonar_true);
+  WriteText(root / "poses/vehicle.tum", vehicle);
+  WriteTruthOccupancy(root / "truth/occupancy.bt", meshes, scene.mapping.resolution_m);
+}
+
+// A simulated dataset's manifest.json.
+json SimulatedManifest(const Scene& scene, const DatasetSummary& summary, std::uint64_t seed,
+                       std::size_t beam_count) {
+  json manifest =
+      ManifestBase(scene.sensor.geometry, summary.sweeps_total, beam_count, summary.config_sha256);
+  manifest["source"] = "simulate";
+  manifest["scene"] = {{"name", scene.name}, {"file", scene.file}};
+  manifest["seed"] = seed;
+  manifest["navigation_error"] = {
+      {"drift_m_per_s", scene.navigation.drift_m_per_s},
+      {"heading_drift_deg_per_s", scene.navigation.heading_drift_rad_per_s / mapping::kDegToRad},
+      {"position_noise_m", scene.navigation.position_noise_m},
+      {"heading_noise_deg", scene.navigation.heading_noise_rad / mapping::kDegToRad}};
+  manifest["truth"] = {
+      {"per_beam",
+       "truth/sweep_NNNN.csv: beam, time_s, head_angle_rad, first_hit_range_m "
+       "(nearest surface any ray of the beam's main lobe hit), first_hit_mesh, "
+       "axis_hit_range_m; empty when nothing within range"},
+      {"occupancy", "truth/occupancy.bt: every cell a mesh surface crosses, at resolution_m"},
+      {"resolution_m", scene.mapping.resolution_m}};
+  json mesh_names = json::array();
+  for (const MeshSpec& mesh : scene.meshes) mesh_names.push_back(mesh.name);
+  manifest["meshes"] = mesh_names;
+  return manifest;
+}
+
+}  // namespace
+
 DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
                                const DatasetOptions& options) {
   const std::uint64_t seed = options.seed.value_or(scene.seed);
@@ -324,42 +374,8 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   for (std::size_t s = 0; s < summary.sweeps_total; ++s) {
     if (!SweepComplete(root, s, true)) return summary;  // other shards' sweeps are still due
   }
-  std::string sonar;
-  std::string sonar_true;
-  std::string vehicle;
-  for (std::size_t b = 0; b < beam_count; ++b) {
-    const ScheduledBeam scheduled = ScheduleBeam(scene, b);
-    sonar +=
-        mapping::TumLine(scheduled.time_s, ReportedSonarPose(scene, b, scheduled.time_s, seed));
-    sonar_true += mapping::TumLine(scheduled.time_s, scheduled.pose.T_world_sonar);
-    vehicle +=
-        mapping::TumLine(scheduled.time_s, scene.trajectory.T_world_vehicle(scheduled.time_s));
-  }
-  WriteText(root / "poses/sonar.tum", sonar);
-  WriteText(root / "poses/sonar_true.tum", sonar_true);
-  WriteText(root / "poses/vehicle.tum", vehicle);
-  WriteTruthOccupancy(root / "truth/occupancy.bt", meshes, scene.mapping.resolution_m);
-
-  json manifest =
-      ManifestBase(scene.sensor.geometry, summary.sweeps_total, beam_count, summary.config_sha256);
-  manifest["source"] = "simulate";
-  manifest["scene"] = {{"name", scene.name}, {"file", scene.file}};
-  manifest["seed"] = seed;
-  manifest["navigation_error"] = {
-      {"drift_m_per_s", scene.navigation.drift_m_per_s},
-      {"heading_drift_deg_per_s", scene.navigation.heading_drift_rad_per_s / mapping::kDegToRad},
-      {"position_noise_m", scene.navigation.position_noise_m},
-      {"heading_noise_deg", scene.navigation.heading_noise_rad / mapping::kDegToRad}};
-  manifest["truth"] = {
-      {"per_beam",
-       "truth/sweep_NNNN.csv: beam, time_s, head_angle_rad, first_hit_range_m "
-       "(nearest surface any ray of the beam's main lobe hit), first_hit_mesh, "
-       "axis_hit_range_m; empty when nothing within range"},
-      {"occupancy", "truth/occupancy.bt: every cell a mesh surface crosses, at resolution_m"},
-      {"resolution_m", scene.mapping.resolution_m}};
-  json mesh_names = json::array();
-  for (const MeshSpec& mesh : scene.meshes) mesh_names.push_back(mesh.name);
-  manifest["meshes"] = mesh_names;
+  WritePosesAndTruth(root, scene, seed, beam_count, meshes);
+  const json manifest = SimulatedManifest(scene, summary, seed, beam_count);
   Finalize(out, claim.files, manifest);
   summary.complete = true;
   return summary;

@@ -199,6 +199,42 @@ std::vector<StudyItem> DivisionsStudyItems() {
   return items;
 }
 
+namespace {
+
+// The study's claim on its output folder: its files, each item's, study.json last.
+OutputClaim StudyClaim(const Scene& scene, const std::string& config, std::size_t item_count,
+                       bool force) {
+  OutputClaim claim;
+  claim.command = "sweep";
+  claim.config_sha256 = config;
+  claim.mode = OutputMode::kResume;
+  claim.files = {"divisions.csv", "coverage_vs_divisions.png", "time_vs_divisions.png",
+                 "study.json"};
+  for (std::size_t i = 0; i < item_count; ++i) claim.files.push_back(ItemFile(i));
+  claim.record = "study.json";
+  claim.inputs = SceneInputFiles(scene);
+  claim.force = force;
+  return claim;
+}
+
+// Every item's result, once all shards wrote theirs; none while some are still due.
+std::optional<std::vector<json>> CollectItems(const fs::path& root, std::size_t item_count,
+                                              const std::string& config) {
+  std::vector<json> results;
+  for (std::size_t i = 0; i < item_count; ++i) {
+    const auto item = ReadItem(root / ItemFile(i));
+    if (!item) return std::nullopt;  // other shards' items are still due
+    if (item->value("config_sha256", "") != config) {
+      throw InputError((root / ItemFile(i)).string() +
+                       ": from a study of another configuration; pass --force to start over");
+    }
+    results.push_back(*item);
+  }
+  return results;
+}
+
+}  // namespace
+
 StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
                                const StudyOptions& options) {
   Scene scene = original;
@@ -213,16 +249,7 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const std::vector<StudyItem> items =
       options.items.empty() ? DivisionsStudyItems() : options.items;
-  OutputClaim claim;
-  claim.command = "sweep";
-  claim.config_sha256 = config;
-  claim.mode = OutputMode::kResume;
-  claim.files = {"divisions.csv", "coverage_vs_divisions.png", "time_vs_divisions.png",
-                 "study.json"};
-  for (std::size_t i = 0; i < items.size(); ++i) claim.files.push_back(ItemFile(i));
-  claim.record = "study.json";
-  claim.inputs = SceneInputFiles(scene);
-  claim.force = options.force;
+  const OutputClaim claim = StudyClaim(scene, config, items.size(), options.force);
   const OutputDirectory out(dir, claim);
   const fs::path& root = out.root();
   fs::create_directories(root / "items");
@@ -257,16 +284,8 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
     if (options.progress) options.progress(++done, mine.size());
   }
 
-  std::vector<json> results;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    const auto item = ReadItem(root / ItemFile(i));
-    if (!item) return summary;  // other shards' items are still due
-    if (item->value("config_sha256", "") != config) {
-      throw InputError((root / ItemFile(i)).string() +
-                       ": from a study of another configuration; pass --force to start over");
-    }
-    results.push_back(*item);
-  }
+  const std::optional<std::vector<json>> results = CollectItems(root, items.size(), config);
+  if (!results) return summary;
   json header = ReportHeader();
   header.update({{"scene", {{"name", scene.name}, {"file", scene.file}}},
                  {"seed", seed},
@@ -275,7 +294,7 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
                  {"coverage_beams", options.coverage_beams},
                  {"config_sha256", config},
                  {"threads", options.threads}});
-  WriteOutputs(root, results, header);
+  WriteOutputs(root, *results, header);
   summary.complete = true;
   return summary;
 }

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <optional>
+#include <utility>
 
 namespace sonarbench::sim {
 namespace {
@@ -55,25 +56,21 @@ std::optional<double> MinNorm(const std::array<HalfSpace, 10>& c) {
   return best;
 }
 
-}  // namespace
+// The wedge's side planes through the sonar, as world-frame normals n with n·p <= 0 inside:
+// its azimuth edges, and the fan's elevation edges on the axis (inner) and at the azimuth edges
+// (outer, the wider).
+struct WedgePlanes {
+  Vector3d left;
+  Vector3d right;
+  std::array<Vector3d, 2> inner;
+  std::array<Vector3d, 2> outer;
+};
 
-WedgeCells ExactWedgeCells(const mapping::Beam& beam, const mapping::SensorGeometry& sensor,
-                           double range_m, const octomap::OcTree& key_space) {
-  const Eigen::Matrix3d R_world_beam =
-      beam.T_world_sonar.linear() *
-      Eigen::AngleAxisd(beam.head_angle_rad, Vector3d::UnitZ()).toRotationMatrix();
-  const Vector3d origin = beam.T_world_sonar.translation();
-  const double a = 0.5 * sensor.beam_width_horizontal_rad;
-  const double t = std::tan(0.5 * sensor.beam_width_vertical_rad);
-  // Cone planes through the sonar, in the beam frame, as normals n with n·p <= 0; then in the
-  // world frame.
-  auto world = [&](const Vector3d& n) { return Vector3d(R_world_beam * n); };
-  const Vector3d left = world({-std::sin(a), std::cos(a), 0.0});    // azimuth <= a
-  const Vector3d right = world({-std::sin(a), -std::cos(a), 0.0});  // azimuth >= -a
-  const std::array<Vector3d, 2> inner = {world({-t, 0, 1}), world({-t, 0, -1})};
-  const double t_out = t / std::cos(a);
-  const std::array<Vector3d, 2> outer = {world({-t_out, 0, 1}), world({-t_out, 0, -1})};
-
+// The keys of the corners of a box holding the wedge (its corners at full range, the far cap's
+// bulges and the apex), one cell wider each way.
+std::pair<octomap::OcTreeKey, octomap::OcTreeKey> WedgeKeyBounds(
+    const Eigen::Matrix3d& R_world_beam, const Vector3d& origin, double a, double t_out,
+    double range_m, const octomap::OcTree& key_space) {
   // Candidates: the cells of the wedge's bounding box (its corners at full range, and the apex).
   Vector3d lo = origin;
   Vector3d hi = origin;
@@ -97,11 +94,55 @@ WedgeCells ExactWedgeCells(const mapping::Beam& beam, const mapping::SensorGeome
   const double res = key_space.getResolution();
   lo -= Vector3d::Constant(res);
   hi += Vector3d::Constant(res);
-  const octomap::OcTreeKey k_lo = key_space.coordToKey(lo.x(), lo.y(), lo.z());
-  const octomap::OcTreeKey k_hi = key_space.coordToKey(hi.x(), hi.y(), hi.z());
+  return {key_space.coordToKey(lo.x(), lo.y(), lo.z()),
+          key_space.coordToKey(hi.x(), hi.y(), hi.z())};
+}
 
+enum class CellInWedge { kOutside, kInside, kUndecided };
+
+// Whether the cell box centred at `centre` (relative to the sonar), `half` wide each way, meets
+// the wedge within `range_m`: inside if it meets the inner (narrower) wedge, undecided if only
+// the outer one.
+CellInWedge Classify(const Vector3d& centre, double half, double range_m, const WedgePlanes& w) {
+  std::array<HalfSpace, 10> c;
+  for (int i = 0; i < 3; ++i) {
+    Vector3d e = Vector3d::Zero();
+    e[i] = 1.0;
+    c[2 * i] = {e, centre[i] + half};
+    c[2 * i + 1] = {-e, -(centre[i] - half)};
+  }
+  c[6] = {w.left, 0.0};
+  c[7] = {w.right, 0.0};
+  c[8] = {w.outer[0], 0.0};
+  c[9] = {w.outer[1], 0.0};
+  const auto outer_distance = MinNorm(c);
+  if (!outer_distance || *outer_distance > range_m) return CellInWedge::kOutside;
+  c[8] = {w.inner[0], 0.0};
+  c[9] = {w.inner[1], 0.0};
+  const auto inner_distance = MinNorm(c);
+  return inner_distance && *inner_distance <= range_m ? CellInWedge::kInside
+                                                      : CellInWedge::kUndecided;
+}
+
+}  // namespace
+
+WedgeCells ExactWedgeCells(const mapping::Beam& beam, const mapping::SensorGeometry& sensor,
+                           double range_m, const octomap::OcTree& key_space) {
+  const Eigen::Matrix3d R_world_beam =
+      beam.T_world_sonar.linear() *
+      Eigen::AngleAxisd(beam.head_angle_rad, Vector3d::UnitZ()).toRotationMatrix();
+  const Vector3d origin = beam.T_world_sonar.translation();
+  const double a = 0.5 * sensor.beam_width_horizontal_rad;
+  const double t = std::tan(0.5 * sensor.beam_width_vertical_rad);
+  const double t_out = t / std::cos(a);
+  auto world = [&](const Vector3d& n) { return Vector3d(R_world_beam * n); };
+  const WedgePlanes planes{world({-std::sin(a), std::cos(a), 0.0}),   // azimuth <= a
+                           world({-std::sin(a), -std::cos(a), 0.0}),  // azimuth >= -a
+                           {world({-t, 0, 1}), world({-t, 0, -1})},
+                           {world({-t_out, 0, 1}), world({-t_out, 0, -1})}};
+  const auto [k_lo, k_hi] = WedgeKeyBounds(R_world_beam, origin, a, t_out, range_m, key_space);
   WedgeCells out;
-  const double half = 0.5 * res;
+  const double half = 0.5 * key_space.getResolution();
   for (int x = k_lo[0]; x <= k_hi[0]; ++x) {
     for (int y = k_lo[1]; y <= k_hi[1]; ++y) {
       for (int z = k_lo[2]; z <= k_hi[2]; ++z) {
@@ -114,27 +155,9 @@ WedgeCells ExactWedgeCells(const mapping::Beam& beam, const mapping::SensorGeome
         // Quick rejection: the box's nearest point is beyond range.
         const Vector3d nearest = centre.cwiseAbs() - Vector3d::Constant(half);
         if (nearest.cwiseMax(0.0).norm() > range_m) continue;
-        std::array<HalfSpace, 10> c;
-        for (int i = 0; i < 3; ++i) {
-          Vector3d e = Vector3d::Zero();
-          e[i] = 1.0;
-          c[2 * i] = {e, centre[i] + half};
-          c[2 * i + 1] = {-e, -(centre[i] - half)};
-        }
-        c[6] = {left, 0.0};
-        c[7] = {right, 0.0};
-        c[8] = {outer[0], 0.0};
-        c[9] = {outer[1], 0.0};
-        const auto outer_distance = MinNorm(c);
-        if (!outer_distance || *outer_distance > range_m) continue;
-        c[8] = {inner[0], 0.0};
-        c[9] = {inner[1], 0.0};
-        const auto inner_distance = MinNorm(c);
-        if (inner_distance && *inner_distance <= range_m) {
-          out.inside.insert(key);
-        } else {
-          out.undecided.insert(key);
-        }
+        const CellInWedge in = Classify(centre, half, range_m, planes);
+        if (in == CellInWedge::kInside) out.inside.insert(key);
+        if (in == CellInWedge::kUndecided) out.undecided.insert(key);
       }
     }
   }

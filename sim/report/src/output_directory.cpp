@@ -189,6 +189,14 @@ OutputDirectory::OutputDirectory(const std::string& dir, OutputClaim claim)
 
 void OutputDirectory::Open() {
   if (name_.empty()) throw InputError("--out '': expected the path of an output directory");
+  ResolveRoot();
+  const Fd dir_fd(LockDirectory());
+  if (!TakeRunLock()) return;  // joined the shards of the same run
+  ClaimFiles();
+  PrepareWriteRoot();
+}
+
+void OutputDirectory::ResolveRoot() {
   std::error_code error;
   const fs::path path(name_);
   if (Exists(path)) {
@@ -205,12 +213,20 @@ void OutputDirectory::Open() {
     created_ = true;
     root_ = fs::canonical(path);
   }
-  // The directory's own lock serialises the set-up; the lock file's lock is held for the run:
-  // exclusive by a one-shot writer, shared by the shards of one configuration.
-  const Fd dir_fd(::open(root_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC));
-  if (dir_fd.get() < 0 || ::flock(dir_fd.get(), LOCK_EX) != 0) {
-    throw EnvironmentError(name_ + ": cannot be opened (" + std::strerror(errno) + ")");
-  }
+}
+
+// The directory opened and locked, its lock serialising the set-up: the caller closes it.
+int OutputDirectory::LockDirectory() const {
+  const int fd = ::open(root_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd >= 0 && ::flock(fd, LOCK_EX) == 0) return fd;
+  const std::string reason = std::strerror(errno);
+  if (fd >= 0) ::close(fd);
+  throw EnvironmentError(name_ + ": cannot be opened (" + reason + ")");
+}
+
+bool OutputDirectory::TakeRunLock() {
+  // The lock file's lock is held for the run: exclusive by a one-shot writer, shared by the
+  // shards of one configuration.
   lock_created_ = !Exists(root_ / kLockFile);
   lock_fd_ = ::open((root_ / kLockFile).c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (lock_fd_ < 0) {
@@ -228,8 +244,12 @@ void OutputDirectory::Open() {
     }
     write_root_ = root_;  // a shard of the same run: the marker lists its files already
     lock_created_ = false;
-    return;
+    return false;
   }
+  return true;
+}
+
+void OutputDirectory::ClaimFiles() {
   Ownership owned = ReadOwnership(root_).value_or(Ownership{});
   CheckInputsAndCollisions(OwnedFiles(root_).value_or(std::vector<std::string>{}));
   Claimed& mine = owned[claim_.command];
@@ -261,6 +281,10 @@ void OutputDirectory::Open() {
   WriteHolder();
   // Temporary files of a killed writer are never whole.
   RemoveTemporaries({});
+}
+
+void OutputDirectory::PrepareWriteRoot() {
+  std::error_code error;
   write_root_ = root_;
   if (claim_.mode == OutputMode::kResume) {
     // Converted under the directory's lock, so no other writer can take it in between.

@@ -96,6 +96,67 @@ struct BatchWorkspace {
   }
 };
 
+namespace integrate_detail {
+
+// The threads' cells are merged without a lock: split by the root's eight octants (disjoint
+// subtrees), then one thread per octant sorts its cells in Morton order, keeps one copy per cell
+// (occupied winning) and applies the updates (docs/mapper.md). An update is a cell's Morton code
+// << 1 | occupied.
+// Each thread's cells split by the root's octant, as updates.
+template <typename Set>
+void SplitByOctant(BatchWorkspace<Set>& workspace, int threads) {
+  auto& per_thread = workspace.per_thread;
+  auto& split = workspace.split;
+#pragma omp parallel for num_threads(threads) schedule(static, 1)
+  for (int t = 0; t < threads; ++t) {
+    auto& octants = split[static_cast<std::size_t>(t)];
+    const auto& cells = per_thread[static_cast<std::size_t>(t)];
+    for (auto& part : octants) part.clear();
+    using Cells = BasicBeamCells<Set>;
+    for (const std::uint64_t occupied : {0u, 1u}) {
+      Cells::ForEach(occupied != 0 ? cells.occupied : cells.free,
+                     [&octants, occupied](std::uint64_t packed) {
+                       const std::uint64_t code = MortonCode(UnpackKey(packed));
+                       octants[code >> 45].push_back((code << 1) | occupied);
+                     });
+    }
+  }
+}
+
+// Octant o's updates from all threads, sorted, a cell's copies merged (occupied winning), applied
+// to `tree`. Returns {free cells, occupied cells, nodes created}.
+template <typename Set>
+std::array<std::size_t, 3> UpdateOctant(MapTree& tree, BatchWorkspace<Set>& workspace, int o,
+                                        const float (&log_odds)[2]) {
+  const auto& split = workspace.split;
+  std::array<std::size_t, 3> counts{};
+  auto& updates = workspace.updates[static_cast<std::size_t>(o)];
+  updates.clear();
+  for (const auto& octants : split) {
+    const auto& part = octants[static_cast<std::size_t>(o)];
+    updates.insert(updates.end(), part.begin(), part.end());
+  }
+  RadixSort(updates, workspace.scratch[static_cast<std::size_t>(o)]);
+  // A cell's copies are adjacent, free (0) before occupied (1): the last one is kept.
+  std::size_t kept = 0;
+  for (const std::uint64_t u : updates) {
+    if (kept > 0 && (updates[kept - 1] >> 1) == (u >> 1)) {
+      updates[kept - 1] = u;
+    } else {
+      updates[kept++] = u;
+    }
+  }
+  updates.resize(kept);
+  for (const std::uint64_t u : updates) counts[u & 1] += 1;
+  // Octant o's subtree hangs below the root's child o, made above: threads share no node.
+  counts[2] = tree.UpdateLeavesUncounted(
+      updates.size(), [&updates](std::size_t i) { return KeyFromMortonCode(updates[i] >> 1); },
+      [&updates, &log_odds](std::size_t i) { return log_odds[updates[i] & 1]; });
+  return counts;
+}
+
+}  // namespace integrate_detail
+
 /// Casts the rays of a batch of beams on `threads` threads, each into its own key sets of type
 /// `Set`, merges the threads' cells (no lock per key), lets occupied win over free, and applies
 /// one log-odds update per cell. The result does not depend on `threads` or on `Set`: a set's
@@ -117,82 +178,34 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
              per_thread[static_cast<std::size_t>(omp_get_thread_num())]);
   }
   const double cast_done = omp_get_wtime();
-  // The threads' cells are merged without a lock per key: each thread splits its own into the
-  // root's eight octants (the top bit of each key coordinate), whose subtrees are disjoint; then
-  // one thread per octant sorts that octant's cells from all threads in octree (Morton) order,
-  // where a cell's copies meet, keeps one (occupied winning over free), and applies the updates,
-  // walking only the part of each key's path that differs from the previous key's. The root
-  // and each octant's path to one of its keys are created first, serially, so no two threads
-  // create the same node. Neither the order nor the threads change the result: each cell is
-  // updated once. OctoMap's node count and the inner nodes are left for FinishUpdates.
-  // An update is the cell's Morton code << 1 | occupied.
-  auto& split = workspace.split;
-#pragma omp parallel for num_threads(threads) schedule(static, 1)
-  for (int t = 0; t < threads; ++t) {
-    auto& octants = split[static_cast<std::size_t>(t)];
-    const auto& cells = per_thread[static_cast<std::size_t>(t)];
-    for (auto& part : octants) part.clear();
-    using Cells = BasicBeamCells<Set>;
-    for (const std::uint64_t occupied : {0u, 1u}) {
-      Cells::ForEach(occupied != 0 ? cells.occupied : cells.free,
-                     [&octants, occupied](std::uint64_t packed) {
-                       const std::uint64_t code = MortonCode(UnpackKey(packed));
-                       octants[code >> 45].push_back((code << 1) | occupied);
-                     });
-    }
-  }
+  integrate_detail::SplitByOctant(workspace, threads);
   const double split_done = omp_get_wtime();
   for (unsigned o = 0; o < 8; ++o) {
-    for (const auto& octants : split) {
+    for (const auto& octants : workspace.split) {
       if (octants[o].empty()) continue;
       tree.CreatePath(KeyFromMortonCode(octants[o].front() >> 1));
       break;
     }
   }
   const float log_odds[2] = {tree.getProbMissLog(), tree.getProbHitLog()};
-  std::array<std::size_t, 8> free_cells{};
-  std::array<std::size_t, 8> occupied_cells{};
-  std::array<std::size_t, 8> created_nodes{};
+  std::array<std::array<std::size_t, 3>, 8> counts{};
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
   for (int o = 0; o < 8; ++o) {
-    auto& updates = workspace.updates[static_cast<std::size_t>(o)];
-    updates.clear();
-    for (const auto& octants : split) {
-      const auto& part = octants[static_cast<std::size_t>(o)];
-      updates.insert(updates.end(), part.begin(), part.end());
-    }
-    RadixSort(updates, workspace.scratch[static_cast<std::size_t>(o)]);
-    // A cell's copies are adjacent, free (0) before occupied (1): the last one is kept.
-    std::size_t kept = 0;
-    for (const std::uint64_t u : updates) {
-      if (kept > 0 && (updates[kept - 1] >> 1) == (u >> 1)) {
-        updates[kept - 1] = u;
-      } else {
-        updates[kept++] = u;
-      }
-    }
-    updates.resize(kept);
-    for (const std::uint64_t u : updates) {
-      (u & 1 ? occupied_cells : free_cells)[static_cast<std::size_t>(o)] += 1;
-    }
-    // Octant o's subtree hangs below the root's child o, made above: threads share no node.
-    created_nodes[static_cast<std::size_t>(o)] = tree.UpdateLeavesUncounted(
-        updates.size(), [&updates](std::size_t i) { return KeyFromMortonCode(updates[i] >> 1); },
-        [&updates, &log_odds](std::size_t i) { return log_odds[updates[i] & 1]; });
+    counts[static_cast<std::size_t>(o)] =
+        integrate_detail::UpdateOctant(tree, workspace, o, log_odds);
   }
-  for (const std::size_t created : created_nodes) tree.AddNodes(created);
-
   BatchStats stats;
+  for (const auto& c : counts) {
+    stats.free_cells += c[0];
+    stats.occupied_cells += c[1];
+    tree.AddNodes(c[2]);
+  }
   stats.beams = beams.size();
   for (const auto& o : obstacles) stats.beams_with_obstacle += o.empty() ? 0 : 1;
   stats.ray_casts = beams.size() * directions.size();
   for (const auto& cells : per_thread) {
     stats.cell_visits += cells.visits;
     stats.beam_free_cells += cells.beam_free_cells;
-  }
-  for (unsigned o = 0; o < 8; ++o) {
-    stats.free_cells += free_cells[o];
-    stats.occupied_cells += occupied_cells[o];
   }
   stats.cast_s = cast_done - start;
   stats.split_s = split_done - cast_done;

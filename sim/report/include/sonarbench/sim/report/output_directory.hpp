@@ -79,6 +79,14 @@ class OutputDirectory {
 
  private:
   void Open();
+  // Open's steps: the root made or found; the directory's lock for the set-up; the run's lock
+  // (false: joined the shards of the same run, nothing more to do); this claim's files listed in
+  // the marker; the staging folder.
+  void ResolveRoot();
+  [[nodiscard]] int LockDirectory() const;
+  [[nodiscard]] bool TakeRunLock();
+  void ClaimFiles();
+  void PrepareWriteRoot();
   void Release() noexcept;
   void CheckInputsAndCollisions(const std::vector<std::string>& owned) const;
   void RemoveFiles(const std::vector<std::string>& files) const;
