@@ -186,6 +186,55 @@ nlohmann::json SensorGeometryJson(const SensorGeometry& g) {
           {"self_reflection_range_m", g.self_reflection_range_m}};
 }
 
+namespace {
+
+// Checks that every file the manifest lists lies inside `root`, exists and has its sha256.
+void CheckListedFiles(const std::filesystem::path& root, const std::string& dir,
+                      const std::string& manifest_path, const nlohmann::json& manifest) {
+  namespace fs = std::filesystem;
+  const auto& files = manifest.at("files");
+  if (!files.is_array()) throw InputError(manifest_path + ": key 'files': expected a list");
+  for (const auto& entry : files) {
+    if (!entry.is_object() || !entry.contains("path") || !entry.contains("sha256") ||
+        !entry["path"].is_string() || !entry["sha256"].is_string()) {
+      throw InputError(manifest_path + ": key 'files': expected entries {path, sha256, bytes}");
+    }
+    const std::string relative = entry["path"];
+    if (relative.find("..") != std::string::npos || fs::path(relative).is_absolute()) {
+      throw InputError(manifest_path + ": file '" + relative + "': expected a path inside " + dir);
+    }
+    const std::string path = (root / relative).string();
+    if (!fs::is_regular_file(path)) throw InputError(path + ": listed in the manifest, missing");
+    if (Sha256OfFile(path) != entry["sha256"].get<std::string>()) {
+      throw InputError(path +
+                       ": its sha256 differs from the manifest's: the file changed or is "
+                       "damaged");
+    }
+  }
+}
+
+// Sets each beam's pose from poses/sonar.tum, one per beam, stamped as the beam is.
+void ReadPoses(const std::filesystem::path& root, std::vector<Beam>& beams) {
+  const std::string poses_path = (root / "poses/sonar.tum").string();
+  const std::vector<StampedPose> poses = ReadTum(poses_path);
+  if (poses.size() != beams.size()) {
+    throw InputError(poses_path + ": " + std::to_string(poses.size()) +
+                     " poses, expected one per "
+                     "beam (" +
+                     std::to_string(beams.size()) + ")");
+  }
+  for (std::size_t b = 0; b < poses.size(); ++b) {
+    if (std::abs(poses[b].time_s - beams[b].time_s) > 1e-6) {
+      throw InputError(poses_path + ": pose " + std::to_string(b) + " is stamped " +
+                       std::to_string(poses[b].time_s) + " s, its beam " +
+                       std::to_string(beams[b].time_s) + " s");
+    }
+    beams[b].T_world_sonar = poses[b].pose;
+  }
+}
+
+}  // namespace
+
 Dataset ReadDataset(const std::string& dir) {
   namespace fs = std::filesystem;
   const fs::path root(dir);
@@ -214,25 +263,7 @@ Dataset ReadDataset(const std::string& dir) {
   reader.ThrowIfErrors();
   dataset.sweeps = static_cast<std::size_t>(sweeps);
 
-  const auto& files = dataset.manifest.at("files");
-  if (!files.is_array()) throw InputError(manifest_path + ": key 'files': expected a list");
-  for (const auto& entry : files) {
-    if (!entry.is_object() || !entry.contains("path") || !entry.contains("sha256") ||
-        !entry["path"].is_string() || !entry["sha256"].is_string()) {
-      throw InputError(manifest_path + ": key 'files': expected entries {path, sha256, bytes}");
-    }
-    const std::string relative = entry["path"];
-    if (relative.find("..") != std::string::npos || fs::path(relative).is_absolute()) {
-      throw InputError(manifest_path + ": file '" + relative + "': expected a path inside " + dir);
-    }
-    const std::string path = (root / relative).string();
-    if (!fs::is_regular_file(path)) throw InputError(path + ": listed in the manifest, missing");
-    if (Sha256OfFile(path) != entry["sha256"].get<std::string>()) {
-      throw InputError(path +
-                       ": its sha256 differs from the manifest's: the file changed or is "
-                       "damaged");
-    }
-  }
+  CheckListedFiles(root, dir, manifest_path, dataset.manifest);
 
   for (std::size_t s = 0; s < dataset.sweeps; ++s) {
     const std::string path = (root / SweepFile("beams", s, "bin")).string();
@@ -242,22 +273,7 @@ Dataset ReadDataset(const std::string& dir) {
                        " sweeps)");
     for (Beam& beam : ReadBeamFile(in, path)) dataset.beams.push_back(std::move(beam));
   }
-  const std::string poses_path = (root / "poses/sonar.tum").string();
-  const std::vector<StampedPose> poses = ReadTum(poses_path);
-  if (poses.size() != dataset.beams.size()) {
-    throw InputError(poses_path + ": " + std::to_string(poses.size()) +
-                     " poses, expected one per "
-                     "beam (" +
-                     std::to_string(dataset.beams.size()) + ")");
-  }
-  for (std::size_t b = 0; b < poses.size(); ++b) {
-    if (std::abs(poses[b].time_s - dataset.beams[b].time_s) > 1e-6) {
-      throw InputError(poses_path + ": pose " + std::to_string(b) + " is stamped " +
-                       std::to_string(poses[b].time_s) + " s, its beam " +
-                       std::to_string(dataset.beams[b].time_s) + " s");
-    }
-    dataset.beams[b].T_world_sonar = poses[b].pose;
-  }
+  ReadPoses(root, dataset.beams);
   return dataset;
 }
 

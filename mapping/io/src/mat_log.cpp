@@ -243,6 +243,39 @@ class MatV5Check {
   std::function<InputError(const std::string&)> fail_;
 };
 
+// Throws unless the struct array's table of fields reads back whole. A corrupt file can leave it
+// unread or the wrong size, and libmatio's field lookup reads that table unchecked: checked
+// before asking for a field (the MAT v5 check finds such files first; a v7.3 file it does not
+// read).
+void CheckFieldTable(const std::string& path, matvar_t* data, std::size_t count) {
+  const unsigned fields = Mat_VarGetNumberOfFields(data);
+  char* const* names = Mat_VarGetStructFieldnames(data);
+  if (data->data == nullptr || fields == 0 || names == nullptr ||
+      data->nbytes != count * fields * sizeof(matvar_t*) ||
+      std::any_of(names, names + fields, [](const char* name) { return name == nullptr; })) {
+    throw InputError(path + ": 'parsedData' is corrupt: its table of " + std::to_string(count) +
+                     " beams' fields does not read back whole");
+  }
+}
+
+// Beam i's intensities, each an integer in 0..255.
+std::vector<std::uint8_t> ReadIntensities(const std::string& path, matvar_t* data, std::size_t i) {
+  const matvar_t* bins = Mat_VarGetStructFieldByName(data, "intensities", i);
+  const std::string where = path + ": beam " + std::to_string(i) + ", field 'intensities'";
+  if (bins == nullptr) throw InputError(where + ": missing");
+  const std::size_t n = ElementCount(bins);
+  if (n == 0) throw InputError(where + ": empty");
+  std::vector<std::uint8_t> intensities(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto value = NumericAt(bins, k);
+    if (!value || *value < 0.0 || *value > 255.0 || *value != std::floor(*value)) {
+      throw InputError(where + ", bin " + std::to_string(k) + ": expected an integer in 0..255");
+    }
+    intensities[k] = static_cast<std::uint8_t>(*value);
+  }
+  return intensities;
+}
+
 }  // namespace
 
 MatLog ReadMatLog(const std::string& path) {
@@ -259,17 +292,7 @@ MatLog ReadMatLog(const std::string& path) {
   if (data->class_type != MAT_C_STRUCT) throw fail("'parsedData' is not a struct array");
   const std::size_t count = ElementCount(data.get());
   if (count == 0) throw fail("'parsedData' holds no beams");
-  // A corrupt file can leave the struct's table of fields unread or the wrong size, and
-  // libmatio's field lookup reads that table unchecked: check it before asking for a field (the
-  // MAT v5 check above finds such files first; a v7.3 file it does not read).
-  const unsigned fields = Mat_VarGetNumberOfFields(data.get());
-  char* const* names = Mat_VarGetStructFieldnames(data.get());
-  if (data->data == nullptr || fields == 0 || names == nullptr ||
-      data->nbytes != count * fields * sizeof(matvar_t*) ||
-      std::any_of(names, names + fields, [](const char* name) { return name == nullptr; })) {
-    throw fail("'parsedData' is corrupt: its table of " + std::to_string(count) +
-               " beams' fields does not read back whole");
-  }
+  CheckFieldTable(path, data.get(), count);
 
   MatLog log;
   log.beams.reserve(count);
@@ -291,19 +314,8 @@ MatLog ReadMatLog(const std::string& path) {
     if (beam.bin_size_m <= 0.0) {
       throw fail("beam " + std::to_string(i) + ", field 'step_dist': expected a range > 0 m");
     }
-    const matvar_t* bins = Mat_VarGetStructFieldByName(data.get(), "intensities", i);
-    const std::string where = "beam " + std::to_string(i) + ", field 'intensities'";
-    if (bins == nullptr) throw fail(where + ": missing");
-    const std::size_t n = ElementCount(bins);
-    if (n == 0) throw fail(where + ": empty");
-    beam.intensities.resize(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      const auto value = NumericAt(bins, k);
-      if (!value || *value < 0.0 || *value > 255.0 || *value != std::floor(*value)) {
-        throw fail(where + ", bin " + std::to_string(k) + ": expected an integer in 0..255");
-      }
-      beam.intensities[k] = static_cast<std::uint8_t>(*value);
-    }
+    beam.intensities = ReadIntensities(path, data.get(), i);
+    const std::size_t n = beam.intensities.size();
     ++bin_counts[n];
     log.beams.push_back(std::move(beam));
   }

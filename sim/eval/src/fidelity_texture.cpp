@@ -49,6 +49,50 @@ CellSums SumCells(std::span<const mapping::Beam> beams, const mapping::SensorGeo
   return out;
 }
 
+// Bin k's cells' means across the head steps seen twice or more, around the turn: their spread
+// and correlations at 1 and kRingingFarStep steps added to `out`; false if under two were seen.
+bool AddBinAcrossAngles(const CellSums& cells, std::size_t steps, std::size_t k,
+                        FidelityReport::HeadAngleCells& out) {
+  const std::vector<double>& n = cells.n;
+  const std::vector<double>& sum = cells.sum;
+  const std::size_t width = cells.width;
+  std::vector<double> means(steps, 0.0);
+  std::vector<bool> seen(steps, false);
+  for (std::size_t j = 0; j < steps; ++j) {
+    const std::size_t c = j * width + k;
+    if (n[c] < 2.0) continue;
+    means[j] = sum[c] / n[c];
+    seen[j] = true;
+  }
+  std::vector<double> a;
+  std::vector<double> b_near;
+  std::vector<double> a_far;
+  std::vector<double> b_far;
+  std::vector<double> all;
+  for (std::size_t j = 0; j < steps; ++j) {
+    if (!seen[j]) continue;
+    all.push_back(means[j]);
+    if (const std::size_t next = (j + 1) % steps; seen[next]) {
+      a.push_back(means[j]);
+      b_near.push_back(means[next]);
+    }
+    const std::size_t far = (j + FidelityReport::kRingingFarStep) % steps;
+    if (seen[far]) {
+      a_far.push_back(means[j]);
+      b_far.push_back(means[far]);
+    }
+  }
+  if (all.size() < 2) return false;
+  const double mean =
+      std::accumulate(all.begin(), all.end(), 0.0) / static_cast<double>(all.size());
+  double squares = 0.0;
+  for (const double m : all) squares += (m - mean) * (m - mean);
+  out.angle_spread += std::sqrt(squares / static_cast<double>(all.size() - 1));
+  out.angle_correlation[0] += PearsonCorrelation(a, b_near);
+  out.angle_correlation[1] += PearsonCorrelation(a_far, b_far);
+  return true;
+}
+
 }  // namespace
 
 // Each beam's bins [first, bins) (fewer for a short beam), less the beam's mean over them.
@@ -212,45 +256,9 @@ FidelityReport::HeadAngleCells HeadAngleStats(std::span<const mapping::Beam> bea
           std::accumulate(sum.begin() + row, sum.begin() + row + width, 0.0) / seen;
     }
   }
-  // Per bin, the cells' means over the head steps seen twice or more, around the turn.
   double bins_counted = 0.0;
-  for (std::size_t k = 0; k < width; ++k) {
-    std::vector<double> means(steps, 0.0);
-    std::vector<bool> seen(steps, false);
-    for (std::size_t j = 0; j < steps; ++j) {
-      const std::size_t c = j * width + k;
-      if (n[c] < 2.0) continue;
-      means[j] = sum[c] / n[c];
-      seen[j] = true;
-    }
-    std::vector<double> a;
-    std::vector<double> b_near;
-    std::vector<double> a_far;
-    std::vector<double> b_far;
-    std::vector<double> all;
-    for (std::size_t j = 0; j < steps; ++j) {
-      if (!seen[j]) continue;
-      all.push_back(means[j]);
-      if (const std::size_t next = (j + 1) % steps; seen[next]) {
-        a.push_back(means[j]);
-        b_near.push_back(means[next]);
-      }
-      const std::size_t far = (j + FidelityReport::kRingingFarStep) % steps;
-      if (seen[far]) {
-        a_far.push_back(means[j]);
-        b_far.push_back(means[far]);
-      }
-    }
-    if (all.size() < 2) continue;
-    const double mean =
-        std::accumulate(all.begin(), all.end(), 0.0) / static_cast<double>(all.size());
-    double squares = 0.0;
-    for (const double m : all) squares += (m - mean) * (m - mean);
-    out.angle_spread += std::sqrt(squares / static_cast<double>(all.size() - 1));
-    out.angle_correlation[0] += PearsonCorrelation(a, b_near);
-    out.angle_correlation[1] += PearsonCorrelation(a_far, b_far);
-    bins_counted += 1.0;
-  }
+  for (std::size_t k = 0; k < width; ++k)
+    bins_counted += AddBinAcrossAngles(cells, steps, k, out) ? 1.0 : 0.0;
   if (bins_counted > 0.0) {
     out.angle_spread /= bins_counted;
     for (double& c : out.angle_correlation) c /= bins_counted;

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "sonarbench/sim/eval/ground_truth.hpp"
@@ -90,6 +92,69 @@ MapCells CollectMapCells(const octomap::OcTree& map) {
 }
 
 namespace {
+
+// Whether `cells` holds a cell within `k` cells (Chebyshev) of `key`.
+bool AnyWithin(const mapping::KeySet& cells, const Key& key, int k) {
+  for (int dx = -k; dx <= k; ++dx) {
+    for (int dy = -k; dy <= k; ++dy) {
+      for (int dz = -k; dz <= k; ++dz) {
+        const Key near(static_cast<octomap::key_type>(key[0] + dx),
+                       static_cast<octomap::key_type>(key[1] + dy),
+                       static_cast<octomap::key_type>(key[2] + dz));
+        if (cells.contains(near)) return true;
+      }
+    }
+  }
+  return false;
+}
+
+double F1(double precision, double recall) {
+  const double sum = precision + recall;
+  return sum > 0.0 ? 2.0 * precision * recall / sum : 0.0;
+}
+
+// Precision, recall and F1 within 0, 1 and 2 cells, and the ghosts' share.
+void CountWithinTolerance(const MapCells& cells, const mapping::KeySet& truth,
+                          const mapping::KeySet& observable, MapMetrics& m) {
+  for (int k = 0; k < 3; ++k) {
+    std::size_t near_truth = 0;
+    for (const auto& key : cells.occupied) near_truth += AnyWithin(truth, key, k) ? 1 : 0;
+    std::size_t seen = 0;
+    std::size_t observable_truth = 0;
+    for (const auto& key : observable) {
+      if (!truth.contains(key)) continue;
+      ++observable_truth;
+      seen += AnyWithin(cells.occupied, key, k) ? 1 : 0;
+    }
+    const auto index = static_cast<std::size_t>(k);
+    m.precision_within[index] = Ratio(near_truth, cells.occupied.size());
+    m.recall_within[index] = Ratio(seen, observable_truth);
+    m.f1_within[index] = F1(m.precision_within[index], m.recall_within[index]);
+  }
+  m.ghost_share = cells.occupied.empty() ? 0.0 : 1.0 - m.precision_within[2];
+}
+
+// Column precision and recall: the cells' (x, y) columns, top down.
+void CountColumns(const MapCells& cells, const mapping::KeySet& truth,
+                  const mapping::KeySet& observable, MapMetrics& m) {
+  const auto column = [](const Key& key) {
+    return (static_cast<std::uint32_t>(key[0]) << 16) | key[1];
+  };
+  std::unordered_set<std::uint32_t> occupied;
+  std::unordered_set<std::uint32_t> truth_columns;
+  std::unordered_set<std::uint32_t> observable_columns;
+  for (const auto& key : cells.occupied) occupied.insert(column(key));
+  for (const auto& key : truth) truth_columns.insert(column(key));
+  for (const auto& key : observable) {
+    if (truth.contains(key)) observable_columns.insert(column(key));
+  }
+  std::size_t true_columns = 0;
+  for (const std::uint32_t c : occupied) true_columns += truth_columns.contains(c) ? 1 : 0;
+  std::size_t seen_columns = 0;
+  for (const std::uint32_t c : observable_columns) seen_columns += occupied.contains(c) ? 1 : 0;
+  m.column_precision = Ratio(true_columns, occupied.size());
+  m.column_recall = Ratio(seen_columns, observable_columns.size());
+}
 
 // The cell counts and the ratios made of them.
 void CountCells(const MapCells& cells, const mapping::KeySet& truth,
@@ -192,6 +257,8 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
   const MapCells cells = CollectMapCells(map);
   MapMetrics m;
   CountCells(cells, truth, observable, m);
+  CountWithinTolerance(cells, truth, observable, m);
+  CountColumns(cells, truth, observable, m);
   std::vector<TriangleMesh> truth_meshes;
   for (const TriangleMesh& mesh : meshes) {
     if (mesh.truth) truth_meshes.push_back(mesh);

@@ -49,6 +49,15 @@ double MetricValue(const MapMetrics& metrics, const std::string& name) {
   if (name == "occupied_precision") return metrics.occupied_precision;
   if (name == "occupied_recall") return metrics.occupied_recall;
   if (name == "occupied_f1") return metrics.occupied_f1;
+  if (name == "occupied_precision_within_1") return metrics.precision_within[1];
+  if (name == "occupied_precision_within_2") return metrics.precision_within[2];
+  if (name == "occupied_recall_within_1") return metrics.recall_within[1];
+  if (name == "occupied_recall_within_2") return metrics.recall_within[2];
+  if (name == "occupied_f1_within_1") return metrics.f1_within[1];
+  if (name == "occupied_f1_within_2") return metrics.f1_within[2];
+  if (name == "ghost_share") return metrics.ghost_share;
+  if (name == "column_precision") return metrics.column_precision;
+  if (name == "column_recall") return metrics.column_recall;
   if (name == "coverage") return metrics.coverage;
   if (name == "coverage_absolute") return metrics.coverage_absolute;
   if (name == "free_accuracy") return metrics.free_accuracy;

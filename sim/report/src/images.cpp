@@ -156,6 +156,29 @@ cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
   return colour;
 }
 
+namespace {
+
+// Ticks at the series' x values `xs` (sorted, distinct), or for long series (a profile) at about
+// ten round steps.
+std::vector<double> XTicks(const std::vector<double>& xs, bool log2_x,
+                           std::size_t max_value_ticks) {
+  std::vector<double> ticks = xs;
+  if (!log2_x && xs.size() > max_value_ticks) {
+    const double raw = (xs.back() - xs.front()) / 10.0;
+    const double decade = std::pow(10.0, std::floor(std::log10(raw)));
+    const double step = raw / decade < 2.0   ? 2.0 * decade
+                        : raw / decade < 5.0 ? 5.0 * decade
+                                             : 10.0 * decade;
+    ticks.clear();
+    for (double t = std::ceil(xs.front() / step) * step; t <= xs.back(); t += step) {
+      ticks.push_back(t);
+    }
+  }
+  return ticks;
+}
+
+}  // namespace
+
 cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
                        const std::string& y_label, const std::vector<PlotSeries>& series,
                        bool log2_x, double y_min, std::optional<double> y_max) {
@@ -188,19 +211,7 @@ cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
   };
   const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
   const int font = cv::FONT_HERSHEY_SIMPLEX;
-  // Ticks at the series' x values, or for long series (a profile) at about ten round steps.
-  std::vector<double> ticks = xs;
-  if (!log2_x && xs.size() > kMaxValueTicks) {
-    const double raw = (xs.back() - xs.front()) / 10.0;
-    const double decade = std::pow(10.0, std::floor(std::log10(raw)));
-    const double step = raw / decade < 2.0   ? 2.0 * decade
-                        : raw / decade < 5.0 ? 5.0 * decade
-                                             : 10.0 * decade;
-    ticks.clear();
-    for (double t = std::ceil(xs.front() / step) * step; t <= xs.back(); t += step) {
-      ticks.push_back(t);
-    }
-  }
+  const std::vector<double> ticks = XTicks(xs, log2_x, kMaxValueTicks);
   for (double x : ticks) {
     const int u = px(x).x;
     cv::line(img, {u, kTop}, {u, kHeight - kBottom}, grey, 1);

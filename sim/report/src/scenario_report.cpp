@@ -199,6 +199,50 @@ std::vector<Image> RenderImages(const ScenarioResult& result) {
 
 std::string HtmlEscape(std::string_view text) { return XmlEscape(text); }
 
+// report.html's criteria section: each criterion's actual, expected, margin and status.
+std::string CriteriaHtml(const Verdict& v) {
+  std::ostringstream html;
+  html << "<h2>Criteria</h2>\n";
+  if (v.results.empty()) {
+    html << "<p>The scene sets no criteria: the scenario passes when it runs.</p>\n";
+  } else {
+    html << "<table><tr><th>metric</th><th>actual</th><th>expected</th><th>margin</th>"
+            "<th>status</th><th>optional</th></tr>\n";
+    for (const CriterionResult& r : v.results) {
+      html << "<tr class=\"" << StatusName(r.status) << "\"><td>" << HtmlEscape(r.criterion.metric)
+           << "</td><td class=\"n\">" << FormatMetricValue(r.actual) << "</td><td>"
+           << HtmlEscape(r.expected) << "</td><td class=\"n\">" << FormatMetricValue(r.margin)
+           << "</td><td>" << StatusName(r.status) << "</td><td>"
+           << (r.criterion.optional ? "yes" : "no") << "</td></tr>\n";
+    }
+    html << "</table>\n";
+  }
+  return html.str();
+}
+
+// report.html's metrics section: every known metric with its definition, each mesh's recall, the
+// counts.
+std::string MetricsHtml(const MapMetrics& m) {
+  std::ostringstream html;
+  html << "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>value</th><th>definition</th></tr>\n";
+  for (const MetricInfo& info : KnownMetrics()) {
+    html << "<tr><td>" << info.name << "</td><td class=\"n\">"
+         << FormatMetricValue(MetricValue(m, info.name)) << "</td><td>"
+         << HtmlEscape(info.definition) << "</td></tr>\n";
+  }
+  for (const auto& r : m.per_mesh) {
+    html << "<tr><td>" << kMeshRecallPrefix << HtmlEscape(r.name) << "</td><td class=\"n\">"
+         << FormatMetricValue(r.recall) << "</td><td>" << r.observed_occupied_cells << " of "
+         << r.observable_cells << " observable cells of this mesh mapped occupied</td></tr>\n";
+  }
+  html << "</table>\n<p>Counts: " << m.truth_cells << " surface cells, " << m.observable_cells
+       << " observable, " << m.occupied_cells << " occupied (" << m.true_positive_cells
+       << " on a surface), " << m.free_cells
+       << " free. Unknown cells are neither occupied nor "
+          "free: they lower coverage and recall, never precision.</p>\n";
+  return html.str();
+}
+
 std::string ScenarioHtml(const Scene& scene, const ScenarioResult& result,
                          const std::vector<Image>& images) {
   const Verdict& v = result.verdict;
@@ -228,38 +272,8 @@ std::string ScenarioHtml(const Scene& scene, const ScenarioResult& result,
        << result.beams << " beams in " << scene.sweeps << " sweeps, " << result.threads
        << " threads, " << Seconds(TotalSeconds(result.timings)) << " s.</p>\n";
 
-  html << "<h2>Criteria</h2>\n";
-  if (v.results.empty()) {
-    html << "<p>The scene sets no criteria: the scenario passes when it runs.</p>\n";
-  } else {
-    html << "<table><tr><th>metric</th><th>actual</th><th>expected</th><th>margin</th>"
-            "<th>status</th><th>optional</th></tr>\n";
-    for (const CriterionResult& r : v.results) {
-      html << "<tr class=\"" << StatusName(r.status) << "\"><td>" << HtmlEscape(r.criterion.metric)
-           << "</td><td class=\"n\">" << FormatMetricValue(r.actual) << "</td><td>"
-           << HtmlEscape(r.expected) << "</td><td class=\"n\">" << FormatMetricValue(r.margin)
-           << "</td><td>" << StatusName(r.status) << "</td><td>"
-           << (r.criterion.optional ? "yes" : "no") << "</td></tr>\n";
-    }
-    html << "</table>\n";
-  }
-
-  html << "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>value</th><th>definition</th></tr>\n";
-  for (const MetricInfo& info : KnownMetrics()) {
-    html << "<tr><td>" << info.name << "</td><td class=\"n\">"
-         << FormatMetricValue(MetricValue(m, info.name)) << "</td><td>"
-         << HtmlEscape(info.definition) << "</td></tr>\n";
-  }
-  for (const auto& r : m.per_mesh) {
-    html << "<tr><td>" << kMeshRecallPrefix << HtmlEscape(r.name) << "</td><td class=\"n\">"
-         << FormatMetricValue(r.recall) << "</td><td>" << r.observed_occupied_cells << " of "
-         << r.observable_cells << " observable cells of this mesh mapped occupied</td></tr>\n";
-  }
-  html << "</table>\n<p>Counts: " << m.truth_cells << " surface cells, " << m.observable_cells
-       << " observable, " << m.occupied_cells << " occupied (" << m.true_positive_cells
-       << " on a surface), " << m.free_cells
-       << " free. Unknown cells are neither occupied nor "
-          "free: they lower coverage and recall, never precision.</p>\n";
+  html << CriteriaHtml(v);
+  html << MetricsHtml(m);
 
   const StageTimings& t = result.timings;
   html << "<h2>Timing</h2>\n<table><tr><th>stage</th><th>seconds</th></tr>\n";
@@ -289,6 +303,14 @@ nlohmann::json MetricsJson(const MapMetrics& m) {
   return {{"occupied_precision", m.occupied_precision},
           {"occupied_recall", m.occupied_recall},
           {"occupied_f1", m.occupied_f1},
+          {"within_cells",
+           {{"cells", {0, 1, 2}},
+            {"precision", m.precision_within},
+            {"recall", m.recall_within},
+            {"f1", m.f1_within}}},
+          {"ghost_share", m.ghost_share},
+          {"column_precision", m.column_precision},
+          {"column_recall", m.column_recall},
           {"coverage", m.coverage},
           {"coverage_absolute", m.coverage_absolute},
           {"free_accuracy", m.free_accuracy},

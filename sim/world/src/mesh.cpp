@@ -19,6 +19,40 @@ void AddQuad(TriangleMesh& mesh, const Eigen::Vector3d& a, const Eigen::Vector3d
   mesh.triangles.push_back({base, base + 2, base + 3});
 }
 
+// A height field's vertices and triangles: sand waves of `amplitude_m` and `wavelength_m` plus
+// seeded roughness, on a grid of `cell_m` over the spec's size, placed by the spec's pose.
+void AddHeightField(TriangleMesh& mesh, const MeshSpec& spec, std::uint64_t seed) {
+  const Eigen::Isometry3d& T = spec.T_world_mesh;
+  const double hx = 0.5 * spec.size_m[0];
+  const double hy = 0.5 * spec.size_m[1];
+  // CheckBudgets refuses far fewer cells; this keeps the int conversions defined.
+  if (!(spec.size_m[0] / spec.cell_m < 1e7 && spec.size_m[1] / spec.cell_m < 1e7)) {
+    throw InputError("mesh '" + spec.name + "': 'cell_m' " + std::to_string(spec.cell_m) +
+                     " makes over 1e7 cells a side (expected a coarser grid)");
+  }
+  const int nx = std::max(1, static_cast<int>(std::lround(spec.size_m[0] / spec.cell_m)));
+  const int ny = std::max(1, static_cast<int>(std::lround(spec.size_m[1] / spec.cell_m)));
+  const double k = 2.0 * std::numbers::pi / spec.wavelength_m;
+  for (int j = 0; j <= ny; ++j) {
+    for (int i = 0; i <= nx; ++i) {
+      const double x = -hx + spec.size_m[0] * i / nx;
+      const double y = -hy + spec.size_m[1] * j / ny;
+      Rng rng(DeriveSeed(seed, static_cast<std::uint64_t>(j) * (nx + 1) + i));
+      const double z =
+          spec.amplitude_m * std::sin(k * x) * std::cos(k * y) + spec.roughness_m * rng.Normal();
+      mesh.vertices.push_back((T * Eigen::Vector3d(x, y, z)).cast<float>());
+    }
+  }
+  const auto row = static_cast<std::uint32_t>(nx + 1);
+  for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(ny); ++j) {
+    for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(nx); ++i) {
+      const std::uint32_t v = j * row + i;
+      mesh.triangles.push_back({v, v + 1, v + row + 1});
+      mesh.triangles.push_back({v, v + row + 1, v + row});
+    }
+  }
+}
+
 }  // namespace
 
 TriangleMesh BuildMesh(const MeshSpec& spec, std::uint64_t seed) {
@@ -53,32 +87,7 @@ TriangleMesh BuildMesh(const MeshSpec& spec, std::uint64_t seed) {
       break;
     }
     case MeshSpec::Type::kHeightField: {
-      // CheckBudgets refuses far fewer cells; this keeps the int conversions defined.
-      if (!(spec.size_m[0] / spec.cell_m < 1e7 && spec.size_m[1] / spec.cell_m < 1e7)) {
-        throw InputError("mesh '" + spec.name + "': 'cell_m' " + std::to_string(spec.cell_m) +
-                         " makes over 1e7 cells a side (expected a coarser grid)");
-      }
-      const int nx = std::max(1, static_cast<int>(std::lround(spec.size_m[0] / spec.cell_m)));
-      const int ny = std::max(1, static_cast<int>(std::lround(spec.size_m[1] / spec.cell_m)));
-      const double k = 2.0 * std::numbers::pi / spec.wavelength_m;
-      for (int j = 0; j <= ny; ++j) {
-        for (int i = 0; i <= nx; ++i) {
-          const double x = -hx + spec.size_m[0] * i / nx;
-          const double y = -hy + spec.size_m[1] * j / ny;
-          Rng rng(DeriveSeed(seed, static_cast<std::uint64_t>(j) * (nx + 1) + i));
-          const double z = spec.amplitude_m * std::sin(k * x) * std::cos(k * y) +
-                           spec.roughness_m * rng.Normal();
-          mesh.vertices.push_back(p(x, y, z).cast<float>());
-        }
-      }
-      const auto row = static_cast<std::uint32_t>(nx + 1);
-      for (std::uint32_t j = 0; j < static_cast<std::uint32_t>(ny); ++j) {
-        for (std::uint32_t i = 0; i < static_cast<std::uint32_t>(nx); ++i) {
-          const std::uint32_t v = j * row + i;
-          mesh.triangles.push_back({v, v + 1, v + row + 1});
-          mesh.triangles.push_back({v, v + row + 1, v + row});
-        }
-      }
+      AddHeightField(mesh, spec, seed);
       break;
     }
     case MeshSpec::Type::kFile:

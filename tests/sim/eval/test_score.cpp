@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <random>
+#include <utility>
+
 #include "sim_fixtures.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
@@ -59,6 +62,86 @@ TEST(ScoreMap, EmptyInputsGiveZerosNotNaN) {
   EXPECT_EQ(m.occupied_recall, 0.0);
   EXPECT_EQ(m.occupied_f1, 0.0);
   EXPECT_EQ(m.coverage, 0.0);
+}
+
+// `cells` moved by (dx, dy, dz) cells.
+mapping::KeySet Shifted(const mapping::KeySet& cells, int dx, int dy, int dz) {
+  mapping::KeySet out;
+  for (const auto& k : cells) {
+    out.insert(octomap::OcTreeKey(static_cast<octomap::key_type>(k[0] + dx),
+                                  static_cast<octomap::key_type>(k[1] + dy),
+                                  static_cast<octomap::key_type>(k[2] + dz)));
+  }
+  return out;
+}
+
+// A wall mapped one cell off its surface misses at no tolerance and hits at one cell or more;
+// three cells off, it is all ghosts.
+TEST(ScoreMap, ToleranceCountsCellsWithinKCellsOfTheSurface) {
+  const mapping::KeySet truth = Row(0, 10);
+  for (const auto& [dy, dz] : {std::pair{1, 0}, std::pair{1, 1}, std::pair{0, -1}}) {
+    const MapMetrics m = ScoreMap(MapWith(Shifted(truth, 0, dy, dz), {}), truth, truth);
+    EXPECT_EQ(m.precision_within[0], 0.0);
+    EXPECT_EQ(m.precision_within[1], 1.0);
+    EXPECT_EQ(m.recall_within[0], 0.0);
+    EXPECT_EQ(m.recall_within[1], 1.0);
+    EXPECT_EQ(m.f1_within[2], 1.0);
+    EXPECT_EQ(m.ghost_share, 0.0);
+  }
+  const MapMetrics two = ScoreMap(MapWith(Shifted(truth, 0, 2, 0), {}), truth, truth);
+  EXPECT_EQ(two.precision_within[1], 0.0);
+  EXPECT_EQ(two.precision_within[2], 1.0);
+  const MapMetrics far = ScoreMap(MapWith(Shifted(truth, 0, 0, 3), {}), truth, truth);
+  EXPECT_EQ(far.precision_within[2], 0.0);
+  EXPECT_EQ(far.ghost_share, 1.0);
+  // Half the map on the wall, half three cells off: half are ghosts, and the wall's cells 5 and 6
+  // are within 1 and 2 cells of its cell 4.
+  mapping::KeySet half = Row(0, 5);
+  for (const auto& k : Shifted(Row(5, 10), 0, 0, 3)) half.insert(k);
+  const MapMetrics mixed = ScoreMap(MapWith(half, {}), truth, truth);
+  EXPECT_EQ(mixed.ghost_share, 0.5);
+  EXPECT_EQ(mixed.recall_within[0], 0.5);
+  EXPECT_EQ(mixed.recall_within[1], 0.6);
+  EXPECT_EQ(mixed.recall_within[2], 0.7);
+}
+
+// On random maps the tolerant figures never fall as the tolerance grows, index 0 is the exact
+// figure, and the ghosts' share is what the 2-cell precision leaves.
+TEST(ScoreMap, ToleranceFiguresGrowWithTheToleranceOnRandomMaps) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> offset(-6, 6);
+  for (int trial = 0; trial < 20; ++trial) {
+    mapping::KeySet truth, map;
+    const auto key = [&] {
+      return octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + offset(rng)),
+                                static_cast<octomap::key_type>(32768 + offset(rng)),
+                                static_cast<octomap::key_type>(32768 + offset(rng)));
+    };
+    for (int i = 0; i < 40; ++i) truth.insert(key());
+    for (int i = 0; i < 40; ++i) map.insert(key());
+    const MapMetrics m = ScoreMap(MapWith(map, {}), truth, truth);
+    EXPECT_EQ(m.precision_within[0], m.occupied_precision);
+    EXPECT_EQ(m.recall_within[0], m.occupied_recall);
+    for (int k = 1; k < 3; ++k) {
+      EXPECT_GE(m.precision_within[k], m.precision_within[k - 1]);
+      EXPECT_GE(m.recall_within[k], m.recall_within[k - 1]);
+    }
+    EXPECT_DOUBLE_EQ(m.ghost_share, 1.0 - m.precision_within[2]);
+  }
+}
+
+// Top down, a wall's arc mapped five cells above its true cells is right column by column.
+TEST(ScoreMap, ColumnsJudgeTheMapTopDown) {
+  const mapping::KeySet truth = Row(0, 10);
+  const MapMetrics m = ScoreMap(MapWith(Shifted(Row(0, 5), 0, 0, 5), {}), truth, truth);
+  EXPECT_EQ(m.occupied_precision, 0.0);
+  EXPECT_EQ(m.ghost_share, 1.0);
+  EXPECT_EQ(m.column_precision, 1.0);
+  EXPECT_EQ(m.column_recall, 0.5);
+  // A cell beside the wall's columns is wrong top down too.
+  const MapMetrics beside = ScoreMap(MapWith(Shifted(Row(0, 5), 0, 1, 5), {}), truth, truth);
+  EXPECT_EQ(beside.column_precision, 0.0);
+  EXPECT_EQ(beside.column_recall, 0.0);
 }
 
 TEST(CollectMapCells, PrunedNodesExpandToTheirLeafCells) {

@@ -69,15 +69,18 @@ TEST(Verdict, OptionalFailuresWarnAndExpectFailInverts) {
 
 TEST(Verdict, EveryKnownMetricReadsItsOwnField) {
   MapMetrics m;
-  double* fields[] = {&m.occupied_precision, &m.occupied_recall,   &m.occupied_f1,
-                      &m.coverage,           &m.coverage_absolute, &m.free_accuracy,
-                      &m.map_to_mesh.mean_m, &m.map_to_mesh.p95_m, &m.map_to_mesh.max_m,
-                      &m.mesh_to_map.mean_m, &m.mesh_to_map.p95_m, &m.mesh_to_map.max_m};
+  double* fields[] = {
+      &m.occupied_precision,  &m.occupied_recall,     &m.occupied_f1,        &m.coverage,
+      &m.coverage_absolute,   &m.free_accuracy,       &m.map_to_mesh.mean_m, &m.map_to_mesh.p95_m,
+      &m.map_to_mesh.max_m,   &m.mesh_to_map.mean_m,  &m.mesh_to_map.p95_m,  &m.mesh_to_map.max_m,
+      &m.precision_within[1], &m.precision_within[2], &m.recall_within[1],   &m.recall_within[2],
+      &m.f1_within[1],        &m.f1_within[2],        &m.ghost_share,        &m.column_precision,
+      &m.column_recall};
   double next = 1.0;
   for (double* field : fields) *field = next++;
-  m.occupied_cells = 13;
-  m.true_positive_cells = 14;
-  m.free_on_surface_cells = 15;
+  m.occupied_cells = 100;
+  m.true_positive_cells = 101;
+  m.free_on_surface_cells = 102;
   std::set<double> values;
   for (const MetricInfo& info : KnownMetrics()) {
     const double value = MetricValue(m, info.name);
@@ -86,7 +89,8 @@ TEST(Verdict, EveryKnownMetricReadsItsOwnField) {
   }
   EXPECT_EQ(values.size(), KnownMetrics().size());  // no two metrics read one field
   EXPECT_EQ(MetricValue(m, "map_to_mesh_p95_m"), 8.0);
-  EXPECT_EQ(MetricValue(m, "occupied_cells"), 13.0);
+  EXPECT_EQ(MetricValue(m, "occupied_cells"), 100.0);
+  EXPECT_EQ(MetricValue(m, "ghost_share"), 19.0);
   EXPECT_TRUE(std::isnan(MetricValue(m, "no_such_metric")));
 }
 

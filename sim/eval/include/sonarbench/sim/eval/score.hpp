@@ -2,6 +2,7 @@
 
 #include <octomap/OcTree.h>
 
+#include <array>
 #include <cstddef>
 #include <span>
 #include <string>
@@ -40,6 +41,21 @@ struct MapMetrics {
   double occupied_recall = 0.0;
   /// Harmonic mean of precision and recall (0 when both are 0).
   double occupied_f1 = 0.0;
+  /// The same with a tolerance of k cells (k = 0, 1, 2; index k): an occupied cell counts when a
+  /// truth cell lies within k cells of it (Chebyshev distance, the (2k + 1)³ block around it),
+  /// an observable cell when an occupied one does. Index 0 is occupied_precision/recall/f1.
+  std::array<double, 3> precision_within{};
+  std::array<double, 3> recall_within{};
+  std::array<double, 3> f1_within{};
+  /// Occupied cells more than 2 cells from every truth cell / occupied: the ghosts' share,
+  /// 1 - precision_within[2] (0 for an empty map).
+  double ghost_share = 0.0;
+  /// Top down, over (x, y) columns of cells: columns holding an occupied cell that hold a truth
+  /// cell / columns holding an occupied cell; columns of observable cells that hold an occupied
+  /// cell / columns of observable cells. Fair to a static sonar, whose echo's elevation on its
+  /// arc is unknown.
+  double column_precision = 0.0;
+  double column_recall = 0.0;
   /// known ∩ observable / observable: the share of visible surface the map has any belief about.
   double coverage = 0.0;
   /// (occupied ∪ free) ∩ truth / truth: the same against every surface cell, seen or not.
