@@ -420,10 +420,10 @@ FidelityReport CompareWithLog(std::span<const mapping::Beam> sim,
   const std::size_t usable = std::min(static_cast<std::size_t>(sensor.FirstUsableBin()), bins);
   FidelitySettings settings;
   settings.wall_min_range_m = wall_min_range_m;
-  settings.reference_wall_m = WallRanges(sim, FindStrongestBins(sim, wall_min_range_m), sensor);
   settings.ringing_bins = RingingBins(MeanProfile(real, bins), usable);
   FidelityReport r;
-  r.sim = Measure(sim, sensor, settings);
+  r.sim = Measure(sim, sensor, settings);  // its own walls are the direct-wall reference
+  settings.reference_wall_m = r.sim.wall_m;
   r.real = Measure(real, sensor, settings);
   Compare(r, sensor);
   return r;

@@ -113,22 +113,23 @@ double F1(double precision, double recall) {
   return sum > 0.0 ? 2.0 * precision * recall / sum : 0.0;
 }
 
-// Precision, recall and F1 within 0, 1 and 2 cells, and the ghosts' share.
+// Precision, recall and F1 within 1 and 2 cells (index 0: CountCells' exact figures, which it
+// needs first), and the ghosts' share.
 void CountWithinTolerance(const MapCells& cells, const mapping::KeySet& truth,
                           const mapping::KeySet& observable, MapMetrics& m) {
-  for (int k = 0; k < 3; ++k) {
+  m.precision_within[0] = m.occupied_precision;
+  m.recall_within[0] = m.occupied_recall;
+  m.f1_within[0] = m.occupied_f1;
+  for (int k = 1; k < 3; ++k) {
     std::size_t near_truth = 0;
     for (const auto& key : cells.occupied) near_truth += AnyWithin(truth, key, k) ? 1 : 0;
     std::size_t seen = 0;
-    std::size_t observable_truth = 0;
     for (const auto& key : observable) {
-      if (!truth.contains(key)) continue;
-      ++observable_truth;
-      seen += AnyWithin(cells.occupied, key, k) ? 1 : 0;
+      if (truth.contains(key)) seen += AnyWithin(cells.occupied, key, k) ? 1 : 0;
     }
     const auto index = static_cast<std::size_t>(k);
-    m.precision_within[index] = Ratio(near_truth, cells.occupied.size());
-    m.recall_within[index] = Ratio(seen, observable_truth);
+    m.precision_within[index] = Ratio(near_truth, m.occupied_cells);
+    m.recall_within[index] = Ratio(seen, m.observable_cells);
     m.f1_within[index] = F1(m.precision_within[index], m.recall_within[index]);
   }
   m.ghost_share = cells.occupied.empty() ? 0.0 : 1.0 - m.precision_within[2];
@@ -175,8 +176,7 @@ void CountCells(const MapCells& cells, const mapping::KeySet& truth,
   }
   m.occupied_precision = Ratio(m.true_positive_cells, m.occupied_cells);
   m.occupied_recall = Ratio(m.observed_occupied_cells, m.observable_cells);
-  const double sum = m.occupied_precision + m.occupied_recall;
-  m.occupied_f1 = sum > 0.0 ? 2.0 * m.occupied_precision * m.occupied_recall / sum : 0.0;
+  m.occupied_f1 = F1(m.occupied_precision, m.occupied_recall);
   m.coverage = Ratio(m.known_observable_cells, m.observable_cells);
   std::size_t known_truth = 0;
   for (const auto& key : truth) {
