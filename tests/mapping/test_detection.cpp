@@ -27,6 +27,23 @@ TEST(DetectThreshold, UnsmoothedStepIsFoundAtItsFirstBin) {
   EXPECT_DOUBLE_EQ(ranges[0], beam.BinCentreRange(150));
 }
 
+// A bin is above the threshold when its (smoothed) intensity reaches it: equal counts, one less
+// does not.
+TEST(DetectThreshold, AnIntensityEqualToTheThresholdIsAbove) {
+  const SensorGeometry sensor;
+  DetectionConfig config;
+  config.smoothing_bins = 1;
+  config.min_run_bins = 1;
+  config.threshold = 90;
+  Beam beam = MakeBeam(sensor);
+  Fill(beam, 150, 153, 90);
+  const auto ranges = DetectThreshold(beam, sensor, config);
+  ASSERT_EQ(ranges.size(), 1u);
+  EXPECT_DOUBLE_EQ(ranges[0], beam.BinCentreRange(150));
+  Fill(beam, 150, 153, 89);
+  EXPECT_TRUE(DetectThreshold(beam, sensor, config).empty());
+}
+
 // A moving average of half-width h can pull a step's leading edge at most h bins nearer.
 TEST(DetectThreshold, SmoothingMovesTheEdgeAtMostHalfAWindow) {
   const SensorGeometry sensor;
@@ -48,6 +65,21 @@ TEST(DetectThreshold, SelfReflectionBinsAreIgnored) {
   Beam beam = MakeBeam(sensor);
   Fill(beam, 0, sensor.FirstUsableBin(), 255);
   EXPECT_TRUE(DetectThreshold(beam, sensor, DetectionConfig{}).empty());
+}
+
+// The smoothing window averages usable bins only: a bright self-reflection just before the first
+// usable bin never lifts it over the threshold, even for a run of one bin.
+TEST(DetectThreshold, TheWindowNeverReachesIntoTheSelfReflection) {
+  const SensorGeometry sensor;
+  const int first = sensor.FirstUsableBin();
+  Beam beam = MakeBeam(sensor);
+  Fill(beam, 0, first, 255);
+  DetectionConfig config;
+  config.min_run_bins = 1;
+  for (int window : {3, 5, 7}) {
+    config.smoothing_bins = window;
+    EXPECT_TRUE(DetectThreshold(beam, sensor, config).empty()) << window;
+  }
 }
 
 TEST(DetectThreshold, ShortSpikesAreNotObstacles) {
@@ -159,6 +191,26 @@ TEST(DetectCanny, FindsRisingEdgesWithinTheBlurRadius) {
       ASSERT_EQ(ranges[b].size(), 2u) << "beam " << b;
       EXPECT_NEAR(ranges[b][0], sweep[b].BinCentreRange(120), 2 * sensor.bin_size_m);
       EXPECT_NEAR(ranges[b][1], sweep[b].BinCentreRange(250), 2 * sensor.bin_size_m);
+    }
+  }
+}
+
+// An echo is a rise along the range: an edge between beams where each is flat along its range
+// (no gradient along range), or where the intensity falls with range, is none.
+TEST(DetectCanny, AnEdgeBetweenBeamsIsNoEcho) {
+  const SensorGeometry sensor;
+  std::vector<Beam> sweep(12, MakeBeam(sensor));
+  for (std::size_t b = 0; b < sweep.size(); ++b) {
+    Fill(sweep[b], 0, sensor.num_bins, 200);
+    if (b >= 6) Fill(sweep[b], 200, sensor.num_bins, 100);
+  }
+  for (const auto method : {DetectionConfig::Method::kCanny, DetectionConfig::Method::kAutoCanny}) {
+    DetectionConfig config;
+    config.method = method;
+    const auto ranges = DetectObstacles(sweep, sensor, config);
+    for (std::size_t b = 0; b < ranges.size(); ++b) {
+      EXPECT_TRUE(ranges[b].empty()) << "beam " << b << ": " << ranges[b].size() << " echoes, first at "
+                                     << (ranges[b].empty() ? 0.0 : ranges[b][0]) << " m";
     }
   }
 }

@@ -192,8 +192,10 @@ namespace {
 void CheckListedFiles(const std::filesystem::path& root, const std::string& dir,
                       const std::string& manifest_path, const nlohmann::json& manifest) {
   namespace fs = std::filesystem;
-  const auto& files = manifest.at("files");
-  if (!files.is_array()) throw InputError(manifest_path + ": key 'files': expected a list");
+  if (!manifest.is_object() || !manifest.contains("files") || !manifest["files"].is_array()) {
+    throw InputError(manifest_path + ": key 'files': expected a list of {path, sha256, bytes}");
+  }
+  const auto& files = manifest["files"];
   for (const auto& entry : files) {
     if (!entry.is_object() || !entry.contains("path") || !entry.contains("sha256") ||
         !entry["path"].is_string() || !entry["sha256"].is_string()) {
@@ -247,7 +249,7 @@ Dataset ReadDataset(const std::string& dir) {
   Dataset dataset;
   try {
     dataset.manifest = nlohmann::json::parse(ReadFileBytes(manifest_path));
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // a syntax error, or a number past a double
     throw InputError(manifest_path + ": not valid JSON: " + e.what());
   }
   // JSON is YAML: the strict reader checks the keys the mapper needs, with line and column.

@@ -182,6 +182,12 @@ class MatV5Check {
       elements *= static_cast<double>(static_cast<std::int32_t>(U32(bytes, dims.data + d)));
     }
     if (elements < 0.0) throw fail_("an array of negative dimensions");
+    // Cell, struct, char and numeric arrays; libmatio sizes a sparse or object array by counts
+    // this check does not follow, and a log holds none.
+    if (array_class == 0 || array_class == 3 || array_class == 5 || array_class > 15) {
+      throw fail_("an array of class " + std::to_string(array_class) +
+                  " (expected cell, struct, char or numeric arrays)");
+    }
     const Tag name = ReadTag(bytes, dims.end, end);
     if (name.type != kInt8) throw fail_("an array without its name");
     std::size_t at = name.end;
@@ -197,6 +203,13 @@ class MatV5Check {
                       std::to_string(values.bytes) + " bytes of values");
         }
         at = values.end;
+      }
+    } else if (array_class == 1) {  // cell: an array per element
+      for (double k = 0; k < elements; ++k) {
+        const Tag cell = ReadTag(bytes, at, end);
+        if (cell.type != kMatrix) throw fail_("a cell array's element is not an array");
+        Matrix(bytes, cell, depth + 1);
+        at = cell.end;
       }
     } else if (array_class == 2) {  // struct
       const Tag length = ReadTag(bytes, at, end);
@@ -276,14 +289,31 @@ std::vector<std::uint8_t> ReadIntensities(const std::string& path, matvar_t* dat
   return intensities;
 }
 
+// Only a little-endian v5 or v7.3 header reaches libmatio: a v4 file cannot hold the struct array
+// of pings, and libmatio sizes a v4 variable's name by whatever its first bytes say.
+void CheckMatHeader(const std::string& bytes,
+                    const std::function<InputError(const std::string&)>& fail) {
+  if (bytes.size() >= 128 && bytes.compare(126, 2, "MI") == 0) {
+    throw fail("a big-endian MAT file (expected a little-endian v5 or v7.3 .mat log)");
+  }
+  const bool v5_or_v73 = bytes.size() >= 128 && bytes.compare(126, 2, "IM") == 0 &&
+                         bytes[124] == '\0' && (bytes[125] == '\x01' || bytes[125] == '\x02');
+  if (!v5_or_v73) {
+    throw fail("not a MAT v5 or v7.3 file (no MAT header in its first 128 bytes; expected the "
+               ".mat log of pings)");
+  }
+}
+
 }  // namespace
 
 MatLog ReadMatLog(const std::string& path) {
   auto fail = [&](const std::string& what) { return InputError(path + ": " + what); };
   if (std::filesystem::is_regular_file(path)) {
+    const std::string bytes = ReadFileBytes(path);
+    CheckMatHeader(bytes, fail);
     MatV5Check([&](const std::string& what) {
       return fail("a corrupt MAT file (" + what + ")");
-    }).File(ReadFileBytes(path));
+    }).File(bytes);
   }
   std::unique_ptr<mat_t, MatCloser> mat(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
   if (!mat) throw fail("cannot open as a MATLAB .mat file (expected a v5 or v7.3 .mat log)");

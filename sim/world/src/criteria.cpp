@@ -1,13 +1,15 @@
 #include "sonarbench/sim/world/criteria.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace sonarbench::sim {
 
 std::string FormatMetricValue(double value) {
   char text[32];
-  std::snprintf(text, sizeof text, "%.4g", value);
+  const bool whole = std::isfinite(value) && value == std::floor(value) && std::abs(value) < 1e15;
+  std::snprintf(text, sizeof text, whole ? "%.0f" : "%.4g", value);
   return text;
 }
 

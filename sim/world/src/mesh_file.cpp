@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -14,6 +15,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string_view>
 #include <vector>
@@ -81,6 +83,13 @@ PlyHeader ReadPlyHeader(const std::string& bytes,
     std::string line = bytes.substr(at, end - at);
     at = end + 1;
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    // Assimp reads a header line up to a NUL or other control byte, and a count after it.
+    for (const char c : line) {
+      if ((static_cast<unsigned char>(c) < 0x20 && c != '\t') || c == 0x7f) {
+        throw fail("header line " + std::to_string(line_number) + " holds the control character " +
+                   Quoted(std::string_view(&c, 1)));
+      }
+    }
     std::istringstream words(line);
     std::string keyword;
     words >> keyword;
@@ -359,6 +368,44 @@ std::optional<std::uint64_t> WholeNumber(const std::string& text) {
 // 12-triangle file read as whole), segfaults on an array (<float_array>, ...) without a whole
 // `count`, and reads only `count` of its items when there are more. So index lists and arrays
 // are checked first.
+// The ids the file's elements carry (id="..."), for its references to resolve against.
+std::set<std::string> XmlIds(const std::string& bytes) {
+  std::set<std::string> ids;
+  for (std::size_t at = bytes.find("id="); at != std::string::npos; at = bytes.find("id=", at + 1)) {
+    if (at == 0 || !std::isspace(static_cast<unsigned char>(bytes[at - 1]))) continue;
+    const std::size_t open = at + 3;
+    if (open >= bytes.size() || (bytes[open] != '"' && bytes[open] != '\'')) continue;
+    const std::size_t close = bytes.find(bytes[open], open + 1);
+    if (close != std::string::npos) ids.insert(bytes.substr(open + 1, close - open - 1));
+  }
+  return ids;
+}
+
+// Every <instance_*> element must name an element of the file ("#id"), and one visual scene is
+// instantiated: Assimp 5.2 leaks what it built of the scene otherwise.
+void CheckColladaInstances(const std::string& bytes,
+                           const std::function<InputError(std::size_t, const std::string&)>& fail) {
+  const std::set<std::string> ids = XmlIds(bytes);
+  int visual_scenes = 0;
+  for (std::size_t at = bytes.find("<instance_"); at != std::string::npos;
+       at = bytes.find("<instance_", at + 1)) {
+    const std::size_t name_end = bytes.find_first_of(" \t\r\n/>", at);
+    const std::size_t end = bytes.find('>', at);
+    if (name_end == std::string::npos || end == std::string::npos) return;
+    const std::string tag = bytes.substr(at + 1, name_end - at - 1);
+    if (tag == "instance_visual_scene" && ++visual_scenes > 1) {
+      throw fail(at, "a second <instance_visual_scene>, expected one (COLLADA's <scene> holds one)");
+    }
+    const std::string key = tag == "instance_material" ? "target" : "url";
+    const std::optional<std::string> ref =
+        XmlAttribute(bytes.substr(name_end, end - name_end), key);
+    if (!ref || !ref->starts_with('#') || !ids.contains(ref->substr(1))) {
+      throw fail(at, "<" + tag + "> " + (ref ? "refers to " + Quoted(*ref) : "has no " + key) +
+                         ", expected " + key + "=\"#ID\" naming an element of this file");
+    }
+  }
+}
+
 void CheckCollada(const std::string& path, const std::string& bytes) {
   const auto fail = [&](std::size_t at, const std::string& what) {
     const auto line = std::count(bytes.begin(), bytes.begin() + static_cast<long>(at), '\n');
@@ -391,6 +438,7 @@ void CheckCollada(const std::string& path, const std::string& bytes) {
       }
     });
   }
+  CheckColladaInstances(bytes, fail);
 }
 
 }  // namespace
@@ -401,10 +449,16 @@ MeshFileData LoadMeshFile(const std::string& path) {
   std::string start(4096, '\0');
   start.resize(static_cast<std::size_t>(
       std::ifstream(path, std::ios::binary).read(start.data(), 4096).gcount()));
-  if (start.starts_with("ply") && start.size() > 3 &&
-      std::isspace(static_cast<unsigned char>(start[3]))) {
+  // Assimp picks a reader by the extension and then by the content: either sends a file here.
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::string lower = start;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (extension == ".ply" || lower.starts_with("ply")) {
     CheckPly(path, ReadFileBytes(path));
-  } else if (start.find("<COLLADA") != std::string::npos) {
+  } else if (extension == ".dae" || lower.find("<collada") != std::string::npos) {
     CheckCollada(path, ReadFileBytes(path));
   }
   Assimp::Importer importer;

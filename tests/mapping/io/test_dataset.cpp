@@ -55,6 +55,31 @@ TEST(BeamFile, RoundTripsAndRejectsDamage) {
       std::string::npos);
 }
 
+// A manifest without its list of files is bad input, named as such, like every other key.
+TEST(Dataset, AManifestWithoutItsListOfFilesIsRefused) {
+  test::TempDir dir;
+  nlohmann::json manifest = {{"format", mapping::kDatasetFormat},
+                             {"schema_version", mapping::kDatasetSchemaVersion},
+                             {"sweeps", 0},
+                             {"sensor", mapping::SensorGeometryJson(mapping::SensorGeometry{})}};
+  for (const nlohmann::json& files : {nlohmann::json(), nlohmann::json::object()}) {
+    if (!files.is_null()) manifest["files"] = files;
+    const std::string path = test::WriteFile(dir, "manifest.json", manifest.dump());
+    EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadDataset(dir.path().string()); }),
+              path + ": key 'files': expected a list of {path, sha256, bytes}");
+  }
+  // A number past a double's range is bad JSON as a syntax error is.
+  const std::string path = test::WriteFile(dir, "manifest.json", R"({"sweeps": 1e999})");
+  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadDataset(dir.path().string()); }),
+            path + ": not valid JSON: [json.exception.out_of_range.406] number overflow parsing "
+                   "'1e999'");
+  manifest["files"] = nlohmann::json::array();
+  test::WriteFile(dir, "manifest.json", manifest.dump());
+  fs::create_directories(dir.path() / "poses");
+  test::WriteFile(dir, "poses/sonar.tum", "");
+  EXPECT_TRUE(mapping::ReadDataset(dir.path().string()).beams.empty());
+}
+
 TEST(Tum, RoundTripsAPoseAndNamesTheBadLine) {
   test::TempDir dir;
   Eigen::Isometry3d pose = mapping::PoseFromXyzRpy({1, -2, 0.5}, {0.1, -0.2, 2.5});

@@ -133,6 +133,25 @@ TEST(MatLog, WhatLibmatioWritesIsRead) {
   }
 }
 
+// Only a little-endian v5 or v7.3 header reaches libmatio: it read a v4 variable's name length
+// from the first bytes of this file (the start of a v5 header moved 18 bytes) and asked for 1 GB.
+TEST(MatLog, AFileWithoutAV5OrV73HeaderNeverReachesLibmatio) {
+  test::TempDir dir;
+  std::string shifted(18, '\0');
+  shifted += "MATLAB 5.0 MAT-file";
+  shifted.resize(164, ' ');
+  const std::string path = test::WriteFile(dir, "shifted.mat", shifted);
+  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+            path + ": not a MAT v5 or v7.3 file (no MAT header in its first 128 bytes; expected "
+                   "the .mat log of pings)");
+  std::string big_endian(128, ' ');
+  big_endian.replace(0, 10, "MATLAB 5.0");
+  big_endian.replace(124, 4, std::string("\x01\0MI", 4));
+  test::WriteFile(dir, "shifted.mat", big_endian);
+  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+            path + ": a big-endian MAT file (expected a little-endian v5 or v7.3 .mat log)");
+}
+
 // A MAT v5 file whose array states more elements than it holds values is refused before libmatio
 // reads it (it would allocate what the dimensions say: 16 GB here).
 TEST(MatLog, AnArrayLargerThanItsBytesIsRefused) {
@@ -152,6 +171,13 @@ TEST(MatLog, AnArrayLargerThanItsBytesIsRefused) {
   EXPECT_EQ(
       test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
       path + ": a corrupt MAT file (an array of 2000000000 elements holds 8 bytes of values)");
+  // A sparse array is refused before libmatio sizes it by its nonzero count.
+  std::string sparse = mat;
+  sparse[128 + 8 + 8] = '\x05';
+  test::WriteFile(dir, "huge.mat", sparse);
+  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+            path + ": a corrupt MAT file (an array of class 5 (expected cell, struct, char or "
+                   "numeric arrays))");
   // The same file stating the one element it holds is read as far as its layout: not a struct.
   mat.replace(128 + 8 + 16 + 8 + 4, 4, std::string("\x01\0\0\0", 4));
   test::WriteFile(dir, "huge.mat", mat);

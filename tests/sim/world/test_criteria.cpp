@@ -72,5 +72,16 @@ TEST(Criteria, MeshRecallNamesAMeshOfTheScene) {
             std::string::npos);
 }
 
+// Counts print whole (42030, not 4.203e+04); fractions and the rest to four significant digits.
+TEST(Criteria, MetricValuesPrintCountsWholeAndTheRestToFourDigits) {
+  EXPECT_EQ(FormatMetricValue(42030.0), "42030");
+  EXPECT_EQ(FormatMetricValue(0.0), "0");
+  EXPECT_EQ(FormatMetricValue(-3.0), "-3");
+  EXPECT_EQ(FormatMetricValue(0.11573), "0.1157");
+  EXPECT_EQ(FormatMetricValue(2.5), "2.5");
+  EXPECT_EQ(FormatMetricValue(1e20), "1e+20");
+  EXPECT_EQ(FormatMetricValue(std::nan("")), "nan");
+}
+
 }  // namespace
 }  // namespace sonarbench::sim

@@ -50,7 +50,8 @@ inline constexpr const char* kMeshRecallPrefix = "mesh_recall.";
 [[nodiscard]] Criteria ReadCriteria(YamlReader& node, const std::vector<std::string>& mesh_names,
                                     const Criteria* base = nullptr);
 
-/// A metric value as reports print it: four significant digits ("%.4g").
+/// A metric value as reports print it: a whole number whole (a count), any other to four
+/// significant digits ("%.4g").
 [[nodiscard]] std::string FormatMetricValue(double value);
 
 }  // namespace sonarbench::sim

@@ -1,0 +1,103 @@
+#!/usr/bin/env python3
+"""Writes the harnesses' seed corpora and YAML dictionaries from the shipped files.
+
+Usage: fuzz/make_corpus.py [DATASET]   (run from anywhere; writes fuzz/corpus/ and fuzz/dict/)
+
+DATASET is a folder `sonarbench simulate` wrote; its manifest, first beams and poses seed the
+dataset harness, cut to a few beams. The .mat seeds (the real log's first beams) are written by
+libmatio and kept as they are. Files a harness found are kept in the corpus beside these.
+"""
+import hashlib
+import json
+import pathlib
+import re
+import struct
+import sys
+
+import yaml
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+CORPUS = ROOT / "fuzz" / "corpus"
+DICT = ROOT / "fuzz" / "dict"
+
+
+def write(path, data):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(data if isinstance(data, bytes) else data.encode())
+
+
+def yaml_keys(paths):
+    keys = set()
+    for path in paths:
+        for line in path.read_text().splitlines():
+            m = re.match(r"^\s*(?:-\s+)?([A-Za-z_][A-Za-z0-9_.]*):", line)
+            if m:
+                keys.add(m.group(1))
+    return sorted(keys)
+
+
+def scenes():
+    files = sorted((ROOT / "scenes").glob("*.yaml"))
+    for f in files:
+        write(CORPUS / "scene" / f.name, f.read_bytes())
+    for f in sorted((ROOT / "sensor-models").glob("*.yaml")):
+        write(CORPUS / "sensor_model" / f.name, f.read_bytes())
+    for f in files:
+        criteria = yaml.safe_load(f.read_text()).get("criteria")
+        if criteria:
+            write(CORPUS / "criteria" / f.name, yaml.safe_dump(criteria, sort_keys=False))
+    yamls = files + sorted((ROOT / "sensor-models").glob("*.yaml"))
+    words = yaml_keys(yamls) + ["extends", "file", "pass", "fail", "min", "max", "optional",
+                                "acceptable_min", "acceptable_max", "true", "false", "null",
+                                "~", "[]", "{}", "&a", "*a", "<<", "!!str", ".nan", ".inf"]
+    text = "".join('"%s"\n' % w.replace("\\", "\\\\").replace('"', '\\"') for w in words)
+    write(DICT / "yaml.dict", text)
+
+
+def meshes():
+    prefixes = {".ply": 0, ".dae": 1, ".obj": 2, ".stl": 3}
+    for f in sorted((ROOT / "scenes" / "meshes").iterdir()):
+        if f.suffix in prefixes:
+            write(CORPUS / "mesh" / f.name, bytes([prefixes[f.suffix]]) + f.read_bytes())
+
+
+def beam_file(beams):
+    out = b"SBBEAMS1" + struct.pack("<I", len(beams))
+    for time_s, angle, bin_size, data in beams:
+        out += struct.pack("<dddI", time_s, angle, bin_size, len(data)) + bytes(data)
+    return out
+
+
+def dataset(folder):
+    folder = pathlib.Path(folder)
+    manifest = json.loads((folder / "manifest.json").read_text())
+    raw = (folder / "beams" / "sweep_0000.bin").read_bytes()
+    count = struct.unpack_from("<I", raw, 8)[0]
+    beams, at = [], 12
+    for _ in range(min(count, 3)):
+        time_s, angle, bin_size, n = struct.unpack_from("<dddI", raw, at)
+        at += 28
+        beams.append((time_s, angle, bin_size, raw[at:at + n]))
+        at += n
+    bins = beam_file(beams)
+    poses = "".join((folder / "poses" / "sonar.tum").read_text().splitlines(True)[:len(beams)])
+    manifest["scene"]["file"] = "scenes/" + pathlib.Path(manifest["scene"]["file"]).name
+    manifest["sweeps"] = 1
+    manifest["beams"] = len(beams)
+    listed = dict(manifest, files=[
+        {"path": "beams/sweep_0000.bin", "bytes": len(bins),
+         "sha256": hashlib.sha256(bins).hexdigest()},
+        {"path": "poses/sonar.tum", "bytes": len(poses),
+         "sha256": hashlib.sha256(poses.encode()).hexdigest()}])
+    for name, m in (("listed", listed), ("unlisted", dict(manifest, files=[]))):
+        text = json.dumps(m, indent=1).encode()
+        write(CORPUS / "dataset" / name,
+              text + b"\n@@beams/sweep_0000.bin\n" + bins + b"\n@@poses/sonar.tum\n" +
+              poses.encode())
+
+
+if __name__ == "__main__":
+    scenes()
+    meshes()
+    if len(sys.argv) > 1:
+        dataset(sys.argv[1])
