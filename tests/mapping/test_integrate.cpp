@@ -133,7 +133,12 @@ TEST(IntegrateBatch, OccupiedWinsOverFreeWithinABatch) {
   const std::vector<std::vector<double>> obstacles{{1.02}, {2.02}};
   for (const int threads : {1, 2}) {
     MapTree tree(kResolution);
-    IntegrateBatch<KeySet>(tree, beams, obstacles, directions, 0.0, threads);
+    const BatchStats stats =
+        IntegrateBatch<KeySet>(tree, beams, obstacles, directions, 0.0, threads);
+    EXPECT_EQ(stats.beams, 2u);
+    EXPECT_EQ(stats.beams_with_obstacle, 2u);
+    EXPECT_EQ(stats.ray_casts, 2u);
+    EXPECT_EQ(stats.occupied_cells, 2u);  // 1.02 m occupied by one beam, free in the other
     FinishUpdates(tree);
     const octomap::OcTreeNode* near = tree.search(1.02, 0.0, 0.0);
     ASSERT_NE(near, nullptr);
@@ -142,6 +147,13 @@ TEST(IntegrateBatch, OccupiedWinsOverFreeWithinABatch) {
     ASSERT_NE(between, nullptr);
     EXPECT_FLOAT_EQ(between->getLogOdds(), tree.getProbMissLog()) << threads << " threads";
   }
+  // A beam without an obstacle counts as a beam, not as one with an obstacle.
+  MapTree tree(kResolution);
+  const std::vector<std::vector<double>> one{{1.02}, {}};
+  const BatchStats stats = IntegrateBatch<KeySet>(tree, beams, one, directions, 0.0, 1);
+  EXPECT_EQ(stats.beams, 2u);
+  EXPECT_EQ(stats.beams_with_obstacle, 1u);
+  EXPECT_EQ(stats.occupied_cells, 1u);
 }
 
 }  // namespace
