@@ -5,8 +5,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace sonarbench;
-  static const std::vector<std::string> kMeshes = {"floor", "wall_north", "wall_south",
-                                                   "wall_east", "wall_west"};
+  static const std::vector<std::string> kMeshes = {"floor", "wall_north", "wall_south", "wall_east",
+                                                   "wall_west"};
   return fuzz::KeepsTheContract([&] {
     YamlReader root =
         YamlReader::FromString(std::string(fuzz::AsText(data, size)), "criteria.yaml");

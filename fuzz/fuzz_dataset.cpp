@@ -12,8 +12,8 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace sonarbench;
   namespace fs = std::filesystem;
-  static const std::array<std::string_view, 4> kFiles = {
-      "manifest.json", "beams/sweep_0000.bin", "beams/sweep_0001.bin", "poses/sonar.tum"};
+  static const std::array<std::string_view, 4> kFiles = {"manifest.json", "beams/sweep_0000.bin",
+                                                         "beams/sweep_0001.bin", "poses/sonar.tum"};
   const fs::path dir = fuzz::ScratchDir() / "dataset";
   fs::remove_all(dir);
   fs::create_directories(dir);

@@ -209,8 +209,9 @@ TEST(DetectCanny, AnEdgeBetweenBeamsIsNoEcho) {
     config.method = method;
     const auto ranges = DetectObstacles(sweep, sensor, config);
     for (std::size_t b = 0; b < ranges.size(); ++b) {
-      EXPECT_TRUE(ranges[b].empty()) << "beam " << b << ": " << ranges[b].size() << " echoes, first at "
-                                     << (ranges[b].empty() ? 0.0 : ranges[b][0]) << " m";
+      EXPECT_TRUE(ranges[b].empty())
+          << "beam " << b << ": " << ranges[b].size() << " echoes, first at "
+          << (ranges[b].empty() ? 0.0 : ranges[b][0]) << " m";
     }
   }
 }

@@ -299,8 +299,9 @@ void CheckMatHeader(const std::string& bytes,
   const bool v5_or_v73 = bytes.size() >= 128 && bytes.compare(126, 2, "IM") == 0 &&
                          bytes[124] == '\0' && (bytes[125] == '\x01' || bytes[125] == '\x02');
   if (!v5_or_v73) {
-    throw fail("not a MAT v5 or v7.3 file (no MAT header in its first 128 bytes; expected the "
-               ".mat log of pings)");
+    throw fail(
+        "not a MAT v5 or v7.3 file (no MAT header in its first 128 bytes; expected the "
+        ".mat log of pings)");
   }
 }
 

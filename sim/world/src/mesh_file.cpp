@@ -371,7 +371,8 @@ std::optional<std::uint64_t> WholeNumber(const std::string& text) {
 // The ids the file's elements carry (id="..."), for its references to resolve against.
 std::set<std::string> XmlIds(const std::string& bytes) {
   std::set<std::string> ids;
-  for (std::size_t at = bytes.find("id="); at != std::string::npos; at = bytes.find("id=", at + 1)) {
+  for (std::size_t at = bytes.find("id="); at != std::string::npos;
+       at = bytes.find("id=", at + 1)) {
     if (at == 0 || !std::isspace(static_cast<unsigned char>(bytes[at - 1]))) continue;
     const std::size_t open = at + 3;
     if (open >= bytes.size() || (bytes[open] != '"' && bytes[open] != '\'')) continue;
@@ -394,7 +395,8 @@ void CheckColladaInstances(const std::string& bytes,
     if (name_end == std::string::npos || end == std::string::npos) return;
     const std::string tag = bytes.substr(at + 1, name_end - at - 1);
     if (tag == "instance_visual_scene" && ++visual_scenes > 1) {
-      throw fail(at, "a second <instance_visual_scene>, expected one (COLLADA's <scene> holds one)");
+      throw fail(at,
+                 "a second <instance_visual_scene>, expected one (COLLADA's <scene> holds one)");
     }
     const std::string key = tag == "instance_material" ? "target" : "url";
     const std::optional<std::string> ref =

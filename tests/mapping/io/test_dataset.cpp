@@ -71,8 +71,9 @@ TEST(Dataset, AManifestWithoutItsListOfFilesIsRefused) {
   // A number past a double's range is bad JSON as a syntax error is.
   const std::string path = test::WriteFile(dir, "manifest.json", R"({"sweeps": 1e999})");
   EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadDataset(dir.path().string()); }),
-            path + ": not valid JSON: [json.exception.out_of_range.406] number overflow parsing "
-                   "'1e999'");
+            path +
+                ": not valid JSON: [json.exception.out_of_range.406] number overflow parsing "
+                "'1e999'");
   manifest["files"] = nlohmann::json::array();
   test::WriteFile(dir, "manifest.json", manifest.dump());
   fs::create_directories(dir.path() / "poses");

@@ -142,8 +142,9 @@ TEST(MatLog, AFileWithoutAV5OrV73HeaderNeverReachesLibmatio) {
   shifted.resize(164, ' ');
   const std::string path = test::WriteFile(dir, "shifted.mat", shifted);
   EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
-            path + ": not a MAT v5 or v7.3 file (no MAT header in its first 128 bytes; expected "
-                   "the .mat log of pings)");
+            path +
+                ": not a MAT v5 or v7.3 file (no MAT header in its first 128 bytes; expected "
+                "the .mat log of pings)");
   std::string big_endian(128, ' ');
   big_endian.replace(0, 10, "MATLAB 5.0");
   big_endian.replace(124, 4, std::string("\x01\0MI", 4));
@@ -176,8 +177,9 @@ TEST(MatLog, AnArrayLargerThanItsBytesIsRefused) {
   sparse[128 + 8 + 8] = '\x05';
   test::WriteFile(dir, "huge.mat", sparse);
   EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
-            path + ": a corrupt MAT file (an array of class 5 (expected cell, struct, char or "
-                   "numeric arrays))");
+            path +
+                ": a corrupt MAT file (an array of class 5 (expected cell, struct, char or "
+                "numeric arrays))");
   // The same file stating the one element it holds is read as far as its layout: not a struct.
   mat.replace(128 + 8 + 16 + 8 + 4, 4, std::string("\x01\0\0\0", 4));
   test::WriteFile(dir, "huge.mat", mat);

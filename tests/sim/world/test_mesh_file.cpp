@@ -1,7 +1,6 @@
 #include <gtest/gtest.h>
 
 #include <array>
-
 #include <cstdint>
 #include <fstream>
 #include <sstream>
@@ -203,8 +202,9 @@ TEST(MeshFile, EveryFileAssimpWouldReadAsPlyIsCheckedFirst) {
   const std::string odd_first_line = "ply\x12" + ply.substr(3);
   for (const std::string name : {"bad.ply", "bad.obj", "BAD.PLY"}) {
     const std::string path = test::WriteFile(dir, name, odd_first_line);
-    EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(path); }),
-              path + ": not a readable PLY file: header line 1 holds the control character '\\x12'");
+    EXPECT_EQ(
+        test::InputErrorOf([&] { (void)LoadMeshFile(path); }),
+        path + ": not a readable PLY file: header line 1 holds the control character '\\x12'");
   }
   const std::string stl = test::WriteFile(dir, "stl.ply", "solid x\nendsolid x\n");
   EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(stl); }),
@@ -286,8 +286,9 @@ TEST(MeshFile, ColladaInstancesMustNameAnElementOfTheFile) {
   twice.insert(twice.find(scene), scene);
   const std::string path = test::WriteFile(dir, "twice.dae", twice);
   EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(path); }),
-            path + ":32: not a readable COLLADA file: a second <instance_visual_scene>, expected "
-                   "one (COLLADA's <scene> holds one)");
+            path +
+                ":32: not a readable COLLADA file: a second <instance_visual_scene>, expected "
+                "one (COLLADA's <scene> holds one)");
 }
 
 TEST(MeshFile, ColladaFilesAssimpCannotReadAreClearErrors) {
