@@ -3,7 +3,7 @@
 # are cores, each until SECONDS pass or RUNS inputs ran, on its seed corpus (fuzz/corpus/NAME,
 # read only). New inputs and findings go under BUILD_DIR/fuzz-out/NAME/. Prints a line per
 # harness: executions, coverage, and the finding; exits 1 if any harness found something.
-# SEED=N fixes libFuzzer's seed: the same binary and corpus then run the same inputs.
+# SEED=N fixes libFuzzer's seed (0, the default, draws one); RUNS=0 replays the corpus only.
 #
 #   fuzz/run.sh BUILD_DIR SECONDS [RUNS] [NAME...]       e.g. fuzz/run.sh build-fuzz 30
 set -euo pipefail
