@@ -443,6 +443,12 @@ void CheckCollada(const std::string& path, const std::string& bytes) {
   CheckColladaInstances(bytes, fail);
 }
 
+std::string Lowercase(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return text;
+}
+
 }  // namespace
 
 MeshFileData LoadMeshFile(const std::string& path) {
@@ -452,12 +458,8 @@ MeshFileData LoadMeshFile(const std::string& path) {
   start.resize(static_cast<std::size_t>(
       std::ifstream(path, std::ios::binary).read(start.data(), 4096).gcount()));
   // Assimp picks a reader by the extension and then by the content: either sends a file here.
-  std::string extension = std::filesystem::path(path).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  std::string lower = start;
-  std::transform(lower.begin(), lower.end(), lower.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string extension = Lowercase(std::filesystem::path(path).extension().string());
+  const std::string lower = Lowercase(start);
   if (extension == ".ply" || lower.starts_with("ply")) {
     CheckPly(path, ReadFileBytes(path));
   } else if (extension == ".dae" || lower.find("<collada") != std::string::npos) {
