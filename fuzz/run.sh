@@ -31,7 +31,7 @@ run_one() {
   fi
   local execs cov
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$out/log" | tail -1)
-  cov=$(grep -oE 'cov: [0-9]+ ft: [0-9]+' "$out/log" | tail -1)
+  cov=$(grep -oE 'cov: [0-9]+ ft: [0-9]+' "$out/log" | tail -1 || true)  # none uninstrumented
   printf '%-13s %10s executions  %-20s %s\n' "$name" "${execs:-?}" "${cov:-}" "$status" \
     | tee "$out/summary"
   [ "$status" = ok ]

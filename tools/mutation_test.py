@@ -130,14 +130,14 @@ def copy_tree(work):
     return src
 
 
-def suite_fails(build, suite, jobs):
+def suite_fails(build, suite, jobs, timeout=600):
     """Builds and runs one suite; returns why it failed, or None if it passed."""
     made = run(["cmake", "--build", str(build), "-j", str(jobs), "--target", suite], build)
     if made.returncode != 0:
         return "build error"
     try:
         ran = run([str(build / "tests" / suite), "--gtest_filter=" + NO_REAL_LOG,
-                   "--gtest_brief=1"], build, timeout=600)
+                   "--gtest_brief=1"], build, timeout=timeout)
     except subprocess.TimeoutExpired:
         return suite + ": timed out"
     if ran.returncode == 0:
@@ -160,10 +160,15 @@ def main():
                       "-DSONARBENCH_BUILD_BENCHMARKS=OFF"], build)
     if configured.returncode != 0:
         sys.exit(configured.stdout)
+    # A mutant that makes a suite run past 3 times its unchanged time (and 30 s) hangs: killed.
+    timeouts = {}
     for suite in SUITES:
+        run(["cmake", "--build", str(build), "-j", str(args.jobs), "--target", suite], build)
+        start = time.monotonic()
         why = suite_fails(build, suite, args.jobs)
         if why:
             sys.exit("the unchanged tree fails: " + why)
+        timeouts[suite] = 3 * (time.monotonic() - start) + 30
     killed, survivors, equivalent = 0, [], []
     for ident, name, old, new, reason in mutants:
         path = src / name
@@ -175,7 +180,7 @@ def main():
         try:
             why = None
             for suite in SUITES:
-                why = suite_fails(build, suite, args.jobs)
+                why = suite_fails(build, suite, args.jobs, timeouts[suite])
                 if why:
                     break
         finally:

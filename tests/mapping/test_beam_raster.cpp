@@ -154,5 +154,23 @@ TEST(BeamRaster, LargeBoxFallsBackToAHashSetWithTheSameCells) {
   EXPECT_EQ(cells, expected);
 }
 
+// A beam at the edge of the key range (±1638.4 m at 5 cm): the bitmap's box would reach past the
+// last key, so the cells are collected one ray at a time; the same cells either way.
+TEST(BeamRaster, ABeamAtTheEdgeOfTheKeyRangeFallsBackWithTheSameCells) {
+  octomap::OcTree tree(0.05);
+  std::mt19937_64 rng(6);
+  const octomap::point3d origin(1636.0f, -1636.5f, 0.3f);
+  auto ends = RandomBeam(rng, origin, 40);
+  std::size_t expected_visits = 0;
+  const auto expected = ReferenceCells(tree, origin, ends, expected_visits);
+  ASSERT_GT(expected.size(), 40u);
+  BeamRaster raster;
+  std::vector<std::uint64_t> cells;
+  EXPECT_EQ(raster.Trace(tree, origin, ends, cells), expected_visits);
+  EXPECT_TRUE(raster.used_fallback());
+  std::sort(cells.begin(), cells.end());
+  EXPECT_EQ(cells, expected);
+}
+
 }  // namespace
 }  // namespace sonarbench::mapping

@@ -17,15 +17,24 @@ TEST(BeamRayDirections, SpanTheNominalWedgeEdgeToEdge) {
   const SensorGeometry sensor;
   const auto directions = BeamRayDirections(sensor, 32, 64);
   ASSERT_EQ(directions.size(), 32u * 64u);
-  double max_azimuth = 0.0;
-  double max_elevation = 0.0;
+  double azimuth[2] = {0.0, 0.0};  // the least and the greatest
+  double elevation[2] = {0.0, 0.0};
   for (const auto& d : directions) {
     EXPECT_NEAR(d.norm(), 1.0, 1e-12);
-    max_azimuth = std::max(max_azimuth, std::abs(std::atan2(d.y(), d.x())));
-    max_elevation = std::max(max_elevation, std::abs(std::asin(d.z())));
+    azimuth[0] = std::min(azimuth[0], std::atan2(d.y(), d.x()));
+    azimuth[1] = std::max(azimuth[1], std::atan2(d.y(), d.x()));
+    elevation[0] = std::min(elevation[0], std::asin(d.z()));
+    elevation[1] = std::max(elevation[1], std::asin(d.z()));
   }
-  EXPECT_NEAR(max_azimuth, sensor.beam_width_horizontal_rad / 2, 1e-12);
-  EXPECT_NEAR(max_elevation, sensor.beam_width_vertical_rad / 2, 1e-12);
+  EXPECT_NEAR(azimuth[0], -sensor.beam_width_horizontal_rad / 2, 1e-12);
+  EXPECT_NEAR(azimuth[1], sensor.beam_width_horizontal_rad / 2, 1e-12);
+  EXPECT_NEAR(elevation[0], -sensor.beam_width_vertical_rad / 2, 1e-12);
+  EXPECT_NEAR(elevation[1], sensor.beam_width_vertical_rad / 2, 1e-12);
+  // Evenly spaced: the elevations of the first column, 35° / 63 apart.
+  for (int j = 1; j < 64; ++j) {
+    EXPECT_NEAR(std::asin(directions[32 * j].z()) - std::asin(directions[32 * (j - 1)].z()),
+                sensor.beam_width_vertical_rad / 63, 1e-12);
+  }
   const auto axis = BeamRayDirections(sensor, 1, 1);
   ASSERT_EQ(axis.size(), 1u);
   EXPECT_NEAR((axis[0] - Eigen::Vector3d::UnitX()).norm(), 0.0, 1e-12);

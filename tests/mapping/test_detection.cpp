@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "sonarbench/mapping/detection.hpp"
 
 namespace sonarbench::mapping {
@@ -214,6 +216,76 @@ TEST(DetectCanny, AnEdgeBetweenBeamsIsNoEcho) {
           << (ranges[b].empty() ? 0.0 : ranges[b][0]) << " m";
     }
   }
+}
+
+// An edge pixel one bin after an echo's is the same edge; any further one is an echo of its own. A
+// comb of one-bin spikes every 3 bins (bins 100-199), under low thresholds (20, 40: the blurred
+// comb's gradient swings by about 50), has a rising edge every 3 bins.
+TEST(DetectCanny, RisingEdgesTwoOrMoreBinsApartAreEchoesOfTheirOwn) {
+  const SensorGeometry sensor;
+  std::vector<Beam> sweep(12, MakeBeam(sensor));
+  for (Beam& beam : sweep) {
+    for (int k = 102; k < 200; k += 3) beam.intensities[static_cast<std::size_t>(k)] = 255;
+  }
+  DetectionConfig config;
+  config.method = DetectionConfig::Method::kCanny;
+  config.canny_low = 20.0;
+  config.canny_high = 40.0;
+  config.max_obstacles = 100;
+  const auto ranges = DetectObstacles(sweep, sensor, config);
+  const auto& middle = ranges[6];
+  ASSERT_GE(middle.size(), 30u);
+  for (std::size_t i = 2; i < middle.size(); ++i) {
+    EXPECT_NEAR(middle[i] - middle[i - 1], 3 * sensor.bin_size_m, 1e-9) << "echo " << i;
+  }
+}
+
+// Automatic Canny's hysteresis thresholds are (1 ∓ 0.33) × the median, here 100: 67 and 133. A step
+// of height s, blurred (5 taps, σ 1.4: its two middle taps sum to 0.543) and differentiated by the
+// 3×3 Sobel (4 × the central difference), has a gradient of 2.17 s. Steps of 80 (174, strong), 40
+// (87, weak but joined to the strong ones) and 20 (43, under the low threshold), in bands of beams.
+TEST(DetectCanny, AutomaticThresholdsAreAFractionOfTheMedian) {
+  const SensorGeometry sensor;
+  std::vector<Beam> sweep(28, MakeBeam(sensor));
+  for (std::size_t b = 0; b < sweep.size(); ++b) {
+    const int step = b < 8 ? 80 : (b < 16 ? 40 : 20);
+    Fill(sweep[b], 0, 300, 100);
+    Fill(sweep[b], 300, sensor.num_bins, static_cast<std::uint8_t>(100 + step));
+  }
+  DetectionConfig config;
+  config.method = DetectionConfig::Method::kAutoCanny;
+  const auto ranges = DetectObstacles(sweep, sensor, config);
+  // Beams within the blur's and Sobel's reach (3 rows) of a band's edge mix two bands.
+  for (std::size_t b : {0u, 4u, 7u, 11u, 12u, 19u, 23u, 27u}) {
+    if (b < 16) {
+      ASSERT_EQ(ranges[b].size(), 1u) << "beam " << b;
+      EXPECT_NEAR(ranges[b][0], sweep[b].BinCentreRange(300), 2 * sensor.bin_size_m);
+    } else {
+      EXPECT_TRUE(ranges[b].empty()) << "beam " << b << ": an echo at " << ranges[b][0] << " m";
+    }
+  }
+}
+
+// DetectObstacles runs the configured method: a slow ramp (1 per bin from bin 100, to 255) crosses
+// the threshold 70 at bin 170 (a moving average leaves a ramp as it is), and its gradient (Sobel: 8
+// per pixel) stays under Canny's thresholds.
+TEST(DetectObstacles, RunsTheConfiguredMethod) {
+  const SensorGeometry sensor;
+  std::vector<Beam> sweep(10, MakeBeam(sensor));
+  for (Beam& beam : sweep) {
+    for (int k = 100; k < sensor.num_bins; ++k) {
+      beam.intensities[static_cast<std::size_t>(k)] =
+          static_cast<std::uint8_t>(std::min(k - 100, 255));
+    }
+  }
+  DetectionConfig config;
+  config.max_obstacles = 1;
+  for (const auto& ranges : DetectObstacles(sweep, sensor, config)) {
+    ASSERT_EQ(ranges.size(), 1u);
+    EXPECT_DOUBLE_EQ(ranges[0], sweep[0].BinCentreRange(170));
+  }
+  config.method = DetectionConfig::Method::kCanny;
+  for (const auto& ranges : DetectObstacles(sweep, sensor, config)) EXPECT_TRUE(ranges.empty());
 }
 
 TEST(DetectCanny, FlatSweepHasNoEchoes) {

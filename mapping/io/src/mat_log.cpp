@@ -163,8 +163,8 @@ class MatV5Check {
     if (tag.type == kMatrix) Matrix(bytes, tag, depth);
   }
 
-  // An array: its flags, dimensions and name, then a numeric array's values, as many as its
-  // dimensions say, or a struct array's fields, one array per element and field.
+  // An array: its flags, dimensions and name, then a char or numeric array's values, as many as
+  // its dimensions say, or a struct array's fields, one array per element and field.
   void Matrix(const std::string& bytes, const Tag& matrix, int depth) const {
     if (matrix.bytes == 0) return;  // an empty array
     if (depth > kMostDepth) throw fail_("arrays nested deeper than " + std::to_string(kMostDepth));
@@ -191,8 +191,8 @@ class MatV5Check {
     const Tag name = ReadTag(bytes, dims.end, end);
     if (name.type != kInt8) throw fail_("an array without its name");
     std::size_t at = name.end;
-    if (array_class >= 6 && array_class <= 15) {  // numeric: double ... uint64
-      for (int part = 0; part < (complex ? 2 : 1); ++part) {
+    if (array_class == 4 || (array_class >= 6 && array_class <= 15)) {  // char; double ... uint64
+      for (int part = 0; part < (complex && array_class != 4 ? 2 : 1); ++part) {
         const Tag values = ReadTag(bytes, at, end);
         const std::size_t size = TypeBytes(values.type);
         if (size == 0 || static_cast<double>(values.bytes / size) != elements ||

@@ -180,6 +180,14 @@ TEST(MatLog, AnArrayLargerThanItsBytesIsRefused) {
             path +
                 ": a corrupt MAT file (an array of class 5 (expected cell, struct, char or "
                 "numeric arrays))");
+  // A char array's values are checked as a numeric array's are: libmatio sizes them by their tag.
+  std::string chars = mat;
+  chars[128 + 8 + 8] = '\x04';
+  chars.replace(128 + 8 + 16 + 8 + 4, 4, std::string("\x02\0\0\0", 4));  // 1 x 2 characters
+  chars.replace(128 + 8 + 16 + 16 + 24, 8, std::string("\x05\0\0\0\0\0\0\x6c", 8));
+  test::WriteFile(dir, "huge.mat", chars);
+  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+            path + ": a corrupt MAT file (an element states 1811939328 bytes where 8 are left)");
   // The same file stating the one element it holds is read as far as its layout: not a struct.
   mat.replace(128 + 8 + 16 + 8 + 4, 4, std::string("\x01\0\0\0", 4));
   test::WriteFile(dir, "huge.mat", mat);

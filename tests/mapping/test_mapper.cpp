@@ -1,0 +1,107 @@
+#include <gtest/gtest.h>
+
+#include <utility>
+#include <vector>
+
+#include "sonarbench/mapping/mapper.hpp"
+
+namespace sonarbench::mapping {
+namespace {
+
+// Cells are 5 cm; a cell is named by its centre. The sonar sits at the origin looking along +x
+// (head angle 0): at 1 m its 3° × 35° wedge spans ±0.026 m across and ±0.315 m up and down.
+constexpr double kResolution = 0.05;
+
+const octomap::OcTreeNode* Cell(const Mapper& mapper, double x, double y, double z) {
+  return mapper.tree().search(x, y, z);
+}
+
+bool IsFree(const Mapper& mapper, double x, double y, double z) {
+  const auto* node = Cell(mapper, x, y, z);
+  return node != nullptr && !mapper.tree().isNodeOccupied(node);
+}
+
+bool IsOccupied(const Mapper& mapper, double x, double y, double z) {
+  const auto* node = Cell(mapper, x, y, z);
+  return node != nullptr && mapper.tree().isNodeOccupied(node);
+}
+
+MapperConfig Config() {
+  MapperConfig config;
+  config.resolution_m = kResolution;
+  config.threads = 1;
+  return config;
+}
+
+Beam AxisBeam(const SensorGeometry& sensor, const Eigen::Vector3d& position = {0, 0, 0}) {
+  Beam beam;
+  beam.bin_size_m = sensor.bin_size_m;
+  beam.intensities.assign(static_cast<std::size_t>(sensor.num_bins), 0);
+  beam.T_world_sonar = PoseFromXyzRpy(position, Eigen::Vector3d::Zero());
+  return beam;
+}
+
+// A wall at 2.52 m: the cells of the wedge before it are free, the cell it is in occupied, the
+// cells behind it and outside the wedge untouched; each updated once, by the hit or miss log-odds.
+TEST(Mapper, AnEchoIsOccupiedAtItsRangeAndFreeBeforeIt) {
+  const SensorGeometry sensor;
+  Mapper mapper(Config(), sensor);
+  const std::vector<Beam> beams{AxisBeam(sensor)};
+  const std::vector<std::vector<double>> echoes{{2.52}};
+  mapper.Integrate(beams, echoes);
+  const auto* wall = Cell(mapper, 2.525, 0.025, 0.025);
+  ASSERT_NE(wall, nullptr);
+  EXPECT_FLOAT_EQ(wall->getLogOdds(), octomap::logodds(0.7));
+  const auto* water = Cell(mapper, 1.025, 0.025, 0.025);
+  ASSERT_NE(water, nullptr);
+  EXPECT_FLOAT_EQ(water->getLogOdds(), octomap::logodds(0.4));
+  EXPECT_TRUE(IsFree(mapper, 1.025, 0.025, 0.225));        // 12.4° up: inside the 17.5°
+  EXPECT_TRUE(IsFree(mapper, 2.475, -0.025, -0.025));      // the cell before the wall's
+  EXPECT_EQ(Cell(mapper, 3.025, 0.025, 0.025), nullptr);   // behind the wall
+  EXPECT_EQ(Cell(mapper, 1.025, 0.175, 0.025), nullptr);   // 8.5° across: outside the 1.5°
+  EXPECT_EQ(Cell(mapper, 1.025, 0.025, 0.425), nullptr);   // 21° up: outside the 17.5°
+  EXPECT_EQ(Cell(mapper, -1.025, 0.025, 0.025), nullptr);  // behind the sonar
+}
+
+// A beam without an echo clears the wedge to the sensor's maximum range (5.0 m), or to the
+// configured free range, or nothing at all.
+TEST(Mapper, ABeamWithoutAnEchoClearsAsConfigured) {
+  const SensorGeometry sensor;
+  const std::vector<Beam> beams{AxisBeam(sensor)};
+  const std::vector<std::vector<double>> none{{}};
+  Mapper to_max(Config(), sensor);
+  to_max.Integrate(beams, none);
+  EXPECT_TRUE(IsFree(to_max, 1.025, 0.025, 0.025));
+  EXPECT_TRUE(IsFree(to_max, 4.925, 0.025, 0.025));
+  EXPECT_EQ(Cell(to_max, 5.075, 0.025, 0.025), nullptr);
+  MapperConfig config = Config();
+  config.free_range_m = 2.0;
+  Mapper to_two(config, sensor);
+  to_two.Integrate(beams, none);
+  EXPECT_TRUE(IsFree(to_two, 1.925, 0.025, 0.025));
+  EXPECT_EQ(Cell(to_two, 2.075, 0.025, 0.025), nullptr);
+  config.clear_without_obstacle = false;
+  Mapper not_at_all(config, sensor);
+  not_at_all.Integrate(beams, none);
+  EXPECT_EQ(not_at_all.tree().size(), 0u);
+}
+
+// IntegrateSweeps detects and integrates a sweep (200 beams of 1.8°) at a time, a last partial
+// sweep included: here 300 beams, the last 100 of them 10 m further along x, all empty.
+TEST(Mapper, IntegrateSweepsIntegratesTheLastPartialSweep) {
+  const SensorGeometry sensor;
+  ASSERT_EQ(sensor.BeamsPerSweep(), 200);
+  std::vector<Beam> beams(200, AxisBeam(sensor));
+  beams.resize(300, AxisBeam(sensor, {10.0, 0.0, 0.0}));
+  Mapper mapper(Config(), sensor);
+  std::vector<std::pair<std::size_t, std::size_t>> progress;
+  mapper.IntegrateSweeps(
+      beams, [&](std::size_t done, std::size_t total) { progress.emplace_back(done, total); });
+  EXPECT_EQ(progress, (std::vector<std::pair<std::size_t, std::size_t>>{{1, 2}, {2, 2}}));
+  EXPECT_TRUE(IsFree(mapper, 1.025, 0.025, 0.025));
+  EXPECT_TRUE(IsFree(mapper, 11.025, 0.025, 0.025));
+  EXPECT_FALSE(IsOccupied(mapper, 11.025, 0.025, 0.025));
+}
+
+}  // namespace
+}  // namespace sonarbench::mapping
