@@ -22,6 +22,15 @@ std::string MetricsLine(const sonarbench::sim::MapMetrics& m) {
   return line.str();
 }
 
+void PrintVerdict(const std::string& name, const sonarbench::sim::Verdict& v) {
+  std::size_t met = 0;
+  for (const auto& c : v.results) met += c.status != sonarbench::sim::CriterionStatus::kFail;
+  for (const auto& w : v.warnings) std::cout << "warning: " << w << "\n";
+  std::cout << (v.passed ? "PASS " : "FAIL ") << name << ": " << met << "/" << v.results.size()
+            << " criteria met" << (v.expect_fail ? " (the scene expects a failure)" : "") << "\n";
+  for (const auto& reason : v.reasons) std::cout << "  " << reason << "\n";
+}
+
 sonarbench::sim::OutputClaim OneShotClaim(std::string command, std::vector<std::string> files,
                                           std::vector<std::string> inputs) {
   namespace sim = sonarbench::sim;

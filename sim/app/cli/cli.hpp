@@ -17,6 +17,7 @@
 
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/eval/score.hpp"
+#include "sonarbench/sim/eval/verdict.hpp"
 #include "sonarbench/sim/report/output_directory.hpp"
 #include "sonarbench/sim/world/budget.hpp"
 #include "sonarbench/sim/world/scene.hpp"
@@ -94,6 +95,8 @@ class ProgressLine {
 [[nodiscard]] sim::Scene LoadScene(const std::string& path, const sim::Budgets& budgets);
 /// "occupied precision P (tp/occupied), recall R (..), coverage C (..)": a map's scores.
 [[nodiscard]] std::string MetricsLine(const sim::MapMetrics& m);
+/// Prints the verdict's warnings, "PASS|FAIL NAME: M/N criteria met" and each reason.
+void PrintVerdict(const std::string& name, const sim::Verdict& v);
 /// What a one-shot command (run, map, fidelity) claims in its --out: `files`, the first of them the
 /// record, written last; the files it reads are never written or removed.
 [[nodiscard]] sim::OutputClaim OneShotClaim(std::string command, std::vector<std::string> files,

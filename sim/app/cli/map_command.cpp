@@ -55,7 +55,10 @@ int Map(const MapArgs& args) {
       args.input, sensor, config, scene ? &*scene : nullptr, args.budgets,
       [&](std::size_t done, std::size_t total) { progress.Update("map", done, total); });
   progress.Clear();
-  if (scene) result.metrics = sonarbench::sim::ScoreLogMap(result, *scene);
+  if (scene) {
+    result.metrics = sonarbench::sim::ScoreLogMap(result, *scene);
+    result.verdict = sonarbench::sim::Evaluate(scene->criteria, *result.metrics);
+  }
   sonarbench::sim::WriteLogMapOutputs(out.write_root().string(), result);
   out.Commit();
   const auto& t = result.totals;
@@ -67,7 +70,9 @@ int Map(const MapArgs& args) {
   std::cout << "timing [s]: import " << result.import_s << ", map " << result.map_s << "\n"
             << "wrote " << args.out
             << "/report.json, map.bt, map.ot, map_top.png, polar.png, fan.png\n";
-  return 0;
+  if (!result.verdict) return 0;
+  PrintVerdict(scene->name, *result.verdict);
+  return result.verdict->passed ? 0 : kExitCriteriaFailed;
 }
 
 // `sonarbench map`: its options, filled into `args` when parsed.
@@ -103,10 +108,10 @@ CLI::App* AddOptions(CLI::App& app, MapArgs& args) {
       ->excludes(scene_opt);
   command
       ->add_flag("--score", args.score,
-                 "Score the map against the --scene's surfaces as `run` scores a simulated one "
-                 "(precision, recall, coverage; report.json's metrics). A .mat log, static at its "
-                 "origin, is mapped from the scene's sonar pose, which must not move; a dataset's "
-                 "beams keep their poses")
+                 "Score the map against the --scene's surfaces and criteria as `run` scores a "
+                 "simulated one (report.json's metrics, verdict and criteria; exit 1 when a "
+                 "criterion fails). A .mat log, static at its origin, is mapped from the scene's "
+                 "sonar pose, which must not move; a dataset's beams keep their poses")
       ->needs(scene_opt);
   AddThreadsOption(command, args.threads);
   AddBudgetOptions(command, args.budgets);

@@ -23,14 +23,11 @@ struct RunArgs {
 void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::ScenarioResult& r,
                   const std::string& out) {
   const auto& t = r.timings;
-  const auto& v = r.verdict;
   std::cout << "beams " << r.beams << ", seed " << r.seed << ", threads " << r.threads << "\n"
             << MetricsLine(r.metrics) << "\n"
             << "timing [s]: scene " << t.build_scene_s << ", simulate " << t.simulate_s << ", map "
             << t.map_s << ", ground truth " << t.ground_truth_s << ", score " << t.score_s << "\n"
             << "wrote " << out << "/report.json, junit.xml, report.html, map.bt and images\n";
-  std::size_t met = 0;
-  for (const auto& c : v.results) met += c.status != sonarbench::sim::CriterionStatus::kFail;
   for (const auto& mesh : r.meshes) {
     if (mesh.check.zero_area_triangles > 0) {
       std::cout << "warning: mesh '" << mesh.name << "': " << mesh.check.zero_area_triangles
@@ -41,11 +38,7 @@ void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::Sc
                 << " non-manifold edges (three or more triangles share them)\n";
     }
   }
-  for (const auto& w : v.warnings) std::cout << "warning: " << w << "\n";
-  std::cout << (v.passed ? "PASS " : "FAIL ") << scene.name << ": " << met << "/"
-            << v.results.size() << " criteria met"
-            << (v.expect_fail ? " (the scene expects a failure)" : "") << "\n";
-  for (const auto& reason : v.reasons) std::cout << "  " << reason << "\n";
+  PrintVerdict(scene.name, r.verdict);
 }
 
 // A run that broke still leaves a junit.xml saying so (and no other output), for the CI

@@ -202,6 +202,10 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) 
                    {"polar", "polar.png"},
                    {"fan", "fan.png"}}}});
   if (result.metrics) report["metrics"] = MetricsJson(*result.metrics);
+  if (result.verdict) {
+    report["verdict"] = VerdictJson(*result.verdict);
+    report["criteria"] = CriteriaJson(*result.verdict);
+  }
   if (!result.warnings.empty()) report["warnings"] = result.warnings;
   std::vector<std::string> covered = kLogMapOutputFiles;
   std::erase(covered, "report.json");

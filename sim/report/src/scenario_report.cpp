@@ -117,24 +117,6 @@ nlohmann::json BoundJson(const std::optional<double>& bound) {
   return bound ? nlohmann::json(*bound) : nlohmann::json(nullptr);
 }
 
-nlohmann::json CriteriaJson(const Verdict& v) {
-  nlohmann::json results = nlohmann::json::array();
-  for (const CriterionResult& r : v.results) {
-    const Criterion& c = r.criterion;
-    results.push_back({{"metric", c.metric},
-                       {"actual", r.actual},
-                       {"expected", r.expected},
-                       {"min", BoundJson(c.min)},
-                       {"max", BoundJson(c.max)},
-                       {"acceptable_min", BoundJson(c.acceptable_min)},
-                       {"acceptable_max", BoundJson(c.acceptable_max)},
-                       {"margin", r.margin},
-                       {"optional", c.optional},
-                       {"status", StatusName(r.status)}});
-  }
-  return {{"expect", v.expect_fail ? "fail" : "pass"}, {"results", results}};
-}
-
 nlohmann::json PerMeshJson(const MapMetrics& m) {
   nlohmann::json out = nlohmann::json::array();
   for (const auto& r : m.per_mesh) {
@@ -299,6 +281,28 @@ void WriteText(const std::string& path, const std::string& text) {
 
 }  // namespace
 
+nlohmann::json VerdictJson(const Verdict& v) {
+  return {{"passed", v.passed}, {"reasons", v.reasons}, {"warnings", v.warnings}};
+}
+
+nlohmann::json CriteriaJson(const Verdict& v) {
+  nlohmann::json results = nlohmann::json::array();
+  for (const CriterionResult& r : v.results) {
+    const Criterion& c = r.criterion;
+    results.push_back({{"metric", c.metric},
+                       {"actual", r.actual},
+                       {"expected", r.expected},
+                       {"min", BoundJson(c.min)},
+                       {"max", BoundJson(c.max)},
+                       {"acceptable_min", BoundJson(c.acceptable_min)},
+                       {"acceptable_max", BoundJson(c.acceptable_max)},
+                       {"margin", r.margin},
+                       {"optional", c.optional},
+                       {"status", StatusName(r.status)}});
+  }
+  return {{"expect", v.expect_fail ? "fail" : "pass"}, {"results", results}};
+}
+
 nlohmann::json MetricsJson(const MapMetrics& m) {
   return {{"occupied_precision", m.occupied_precision},
           {"occupied_recall", m.occupied_recall},
@@ -339,10 +343,7 @@ nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& resu
                    {"file", scene.file},
                    {"extends", scene.extends},
                    {"sensor_model", scene.sensor_model_file}}},
-                 {"verdict",
-                  {{"passed", result.verdict.passed},
-                   {"reasons", result.verdict.reasons},
-                   {"warnings", result.verdict.warnings}}},
+                 {"verdict", VerdictJson(result.verdict)},
                  {"criteria", CriteriaJson(result.verdict)},
                  {"seed", result.seed},
                  {"threads", result.threads},

@@ -248,6 +248,23 @@ TEST(Cli, MapScoresALogAgainstASceneAsRunScoresItsSimulation) {
   const auto simulated = nlohmann::json::parse(ReadFile(run / "report.json"))["metrics"];
   EXPECT_GT(scored["counts"]["true_positive_cells"].get<std::size_t>(), 0u);
   EXPECT_EQ(scored, simulated);
+  EXPECT_NE(output.find("PASS cras-tank: 0/0 criteria met"), std::string::npos) << output;
+
+  // The scene's criteria decide as they do for `run`: a missed one exits 1, outputs written.
+  std::filesystem::create_directories(dir.path() / "strict");
+  const auto strict = TankSceneWithCriteria(
+      dir.path() / "strict", "criteria:\n  metrics: {occupied_recall: {min: 0.99}}\n");
+  EXPECT_EQ(RunCli("map " + ds.string() + " --scene " + strict.string() + " --score --out " +
+                       map.string(),
+                   &output),
+            1)
+      << output;
+  EXPECT_NE(output.find("FAIL cras-tank: 0/1 criteria met"), std::string::npos) << output;
+  EXPECT_NE(output.find("expected >= 0.99"), std::string::npos) << output;
+  const auto failed = nlohmann::json::parse(ReadFile(map / "report.json"));
+  EXPECT_FALSE(failed["verdict"]["passed"].get<bool>());
+  EXPECT_EQ(failed["criteria"]["results"][0]["metric"], "occupied_recall");
+  EXPECT_EQ(failed["criteria"]["results"][0]["status"], "fail");
 
   EXPECT_EQ(RunCli("map " + ds.string() + " --score --out " + map.string(), &output), 2);
   EXPECT_NE(output.find("--score requires --scene"), std::string::npos) << output;

@@ -9,6 +9,7 @@
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
 #include "sonarbench/sim/eval/score.hpp"
+#include "sonarbench/sim/eval/verdict.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 
 namespace sonarbench::sim {
@@ -32,6 +33,8 @@ struct LogMapResult {
   std::vector<BeamPose> poses;
   /// The map scored against a scene's surfaces (ScoreLogMap), if it was.
   std::optional<MapMetrics> metrics;
+  /// The metrics against the scene's criteria, when scored.
+  std::optional<Verdict> verdict;
   /// What the user should know about the score (a dataset simulated from other scene files).
   std::vector<std::string> warnings;
 };

@@ -17,6 +17,11 @@ inline constexpr int kScenarioReportSchema = 2;
 /// free accuracy, per mesh, surface distances and the counts behind each.
 [[nodiscard]] nlohmann::json MetricsJson(const MapMetrics& m);
 
+/// report.json's "verdict" (passed, reasons, warnings) and "criteria" (each criterion's bounds,
+/// actual, expected, margin and status) of a map scored against a scene's criteria.
+[[nodiscard]] nlohmann::json VerdictJson(const Verdict& v);
+[[nodiscard]] nlohmann::json CriteriaJson(const Verdict& v);
+
 /// report.json of a run: scene, parameters, metrics with their counts, each criterion's actual,
 /// expected and margin, the verdict, mapping totals and stage timings.
 [[nodiscard]] nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& result);
