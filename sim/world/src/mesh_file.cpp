@@ -408,6 +408,35 @@ void CheckColladaInstances(const std::string& bytes,
   }
 }
 
+// Assimp 5.2 aborts on a primitive (<triangles>, <polylist>, ...) of a nonzero count without its
+// index list <p>.
+void CheckColladaPrimitives(
+    const std::string& bytes,
+    const std::function<InputError(std::size_t, const std::string&)>& fail) {
+  for (const std::string tag :
+       {"triangles", "polylist", "polygons", "lines", "linestrips", "tristrips", "trifans"}) {
+    for (std::size_t at = bytes.find("<" + tag); at != std::string::npos;
+         at = bytes.find("<" + tag, at + 1)) {
+      const std::size_t name_end = at + 1 + tag.size();
+      const std::size_t open_end = bytes.find('>', name_end);
+      if (open_end == std::string::npos) return;  // Assimp's parser reports a cut-off tag
+      if (bytes[name_end] != '>' && !std::isspace(static_cast<unsigned char>(bytes[name_end]))) {
+        continue;  // another element whose name starts so
+      }
+      const std::optional<std::string> said =
+          XmlAttribute(bytes.substr(name_end, open_end - name_end), "count");
+      if (said && WholeNumber(*said) == 0u) continue;
+      const std::size_t close =
+          bytes[open_end - 1] == '/' ? open_end : bytes.find("</" + tag, open_end);
+      const std::string body = bytes.substr(open_end, close - open_end);
+      if (body.find("<p>") == std::string::npos && body.find("<p ") == std::string::npos) {
+        throw fail(at, "<" + tag + "> of " + (said ? "count " + *said : "no count") +
+                           " has no index list <p>, expected one");
+      }
+    }
+  }
+}
+
 void CheckCollada(const std::string& path, const std::string& bytes) {
   const auto fail = [&](std::size_t at, const std::string& what) {
     const auto line = std::count(bytes.begin(), bytes.begin() + static_cast<long>(at), '\n');
@@ -440,6 +469,7 @@ void CheckCollada(const std::string& path, const std::string& bytes) {
       }
     });
   }
+  CheckColladaPrimitives(bytes, fail);
   CheckColladaInstances(bytes, fail);
 }
 

@@ -281,6 +281,16 @@ TEST(MeshFile, ColladaInstancesMustNameAnElementOfTheFile) {
     EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(path); }),
               path + expected + ", expected url=\"#ID\" naming an element of this file");
   }
+  // Assimp aborts on a primitive of a nonzero count without its index list.
+  std::string no_list = dae;
+  const std::size_t list = no_list.find("<p>");
+  ASSERT_NE(list, std::string::npos);
+  no_list.erase(list, no_list.find("</p>") + 4 - list);
+  const std::string no_list_path = test::WriteFile(dir, "no-list.dae", no_list);
+  EXPECT_EQ(test::InputErrorOf([&] { (void)LoadMeshFile(no_list_path); }),
+            no_list_path +
+                ":20: not a readable COLLADA file: <triangles> of count 12 has no index list "
+                "<p>, expected one");
   const std::string scene = "<instance_visual_scene url=\"#Scene\"/>";
   std::string twice = dae;
   twice.insert(twice.find(scene), scene);
