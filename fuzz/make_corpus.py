@@ -3,6 +3,7 @@
 
 Usage: fuzz/make_corpus.py [DATASET]   (run from anywhere; writes fuzz/corpus/ and fuzz/dict/)
 
+The OctoMap seeds are small trees written in both formats here, byte for byte as OctoMap would.
 DATASET is a folder `sonarbench simulate` wrote; its manifest, first beams and poses seed the
 dataset harness, cut to a few beams. The .mat seeds (the real log's first beams) are written by
 libmatio and kept as they are. Files a harness found are kept in the corpus beside these.
@@ -96,8 +97,68 @@ def dataset(folder):
               poses.encode())
 
 
+def octree_files(leaves, resolution="0.05"):
+    """.bt and .ot bytes of an OcTree whose depth-16 leaves are `leaves` {(x, y, z): occupied}."""
+    def child(key, depth):
+        bit = 15 - depth
+        return ((key[0] >> bit) & 1) | (((key[1] >> bit) & 1) << 1) | (((key[2] >> bit) & 1) << 2)
+
+    def build(keys, depth):  # a node: None for a leaf, else {child index: node}
+        if depth == 16:
+            return None
+        groups = {}
+        for k in keys:
+            groups.setdefault(child(k, depth), []).append(k)
+        return {i: build(g, depth + 1) for i, g in sorted(groups.items())}
+
+    def occupied(keys):
+        return any(leaves[k] for k in keys)
+
+    def binary(node, keys, depth):
+        codes, inner = [0] * 8, []
+        for i, sub in node.items():
+            mine = [k for k in keys if child(k, depth) == i]
+            codes[i] = 3 if sub is not None else (2 if leaves[mine[0]] else 1)  # 2 occupied, 1 free
+            if sub is not None:
+                inner.append((sub, mine))
+        out = bytes([sum(codes[i] << (2 * i) for i in range(4)),
+                     sum(codes[4 + i] << (2 * i) for i in range(4))])
+        for sub, mine in inner:
+            out += binary(sub, mine, depth + 1)
+        return out
+
+    def full(node, keys, depth):
+        value = 0.85 if occupied(keys) else -0.4
+        if node is None:
+            return struct.pack("<fB", value, 0)
+        out = struct.pack("<fB", value, sum(1 << i for i in node))
+        for i, sub in node.items():
+            out += full(sub, [k for k in keys if child(k, depth) == i], depth + 1)
+        return out
+
+    def count(node):
+        return 1 + (sum(count(n) for n in node.values()) if node else 0)
+
+    keys = sorted(leaves)
+    root = build(keys, 0)
+    head = "id OcTree\nsize %d\nres %s\ndata\n" % (count(root), resolution)
+    return (b"# Octomap OcTree binary file\n" + head.encode() + binary(root, keys, 0),
+            b"# Octomap OcTree file\n" + head.encode() + full(root, keys, 0))
+
+
+def octrees():
+    c = 32768
+    wall = {(c + 40, c + y, c + z): True for y in range(-3, 3) for z in range(-2, 2)}
+    wall.update({(c + x, c + y, c + z): False for x in range(36, 40) for y in (0, 1) for z in (0,)})
+    for name, leaves in (("wall", wall), ("one_cell", {(c, c, c): True})):
+        bt, ot = octree_files(leaves)
+        write(CORPUS / "octomap" / (name + ".bt"), bt)
+        write(CORPUS / "octomap" / (name + ".ot"), ot)
+
+
 if __name__ == "__main__":
     scenes()
     meshes()
+    octrees()
     if len(sys.argv) > 1:
         dataset(sys.argv[1])

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Mutation testing of the mapping library and the scoring: do the tests catch a wrong mapper?
 
-Each mutant below is one operator or constant change to mapping/ or sim/eval/src/score.cpp. The
+Each mutant below is one operator or constant change to mapping/ (the OctoMap file reader in
+mapping/io/ included) or sim/eval/src/score.cpp. The
 tool copies the source tree to WORK, builds it once, then applies the mutants one at a time,
 rebuilds and runs the suites that cover that code, fastest first, stopping at the first that
 fails. A mutant is killed when a suite fails (or runs past its timeout), survives when all pass.
@@ -109,6 +110,14 @@ MUTANTS = [
      "(cells.occupied.contains(key) && cells.free.contains(key))", None),
     ("score-within-k", "sim/eval/src/score.cpp",
      "for (int k = 1; k < 3; ++k)", "for (int k = 1; k < 2; ++k)", None),
+    ("octomap-depth", "mapping/io/src/octomap_file.cpp",
+     "if (depth > kTreeDepth) {", "if (depth > kTreeDepth + 1) {", None),
+    ("octomap-trailing", "mapping/io/src/octomap_file.cpp",
+     "if (in.peek() != std::char_traits<char>::eof()) {", "if (false) {", None),
+    ("octomap-leaf-cells", "mapping/io/src/octomap_file.cpp",
+     "3 * (kTreeDepth - depth)", "3 * (kTreeDepth - depth - 1)", None),
+    ("octomap-inner-code", "mapping/io/src/octomap_file.cpp",
+     "inner[i] = code == 3;", "inner[i] = code == 2;", None),
 ]
 
 

@@ -37,6 +37,7 @@ struct Command {
 
 Command AddRunCommand(CLI::App& app);
 Command AddMapCommand(CLI::App& app);
+Command AddScoreCommand(CLI::App& app);
 Command AddFidelityCommand(CLI::App& app);
 Command AddSimulateCommand(CLI::App& app);
 Command AddSweepCommand(CLI::App& app);

@@ -59,7 +59,7 @@ int Map(const MapArgs& args) {
     result.metrics = sonarbench::sim::ScoreLogMap(result, *scene);
     result.verdict = sonarbench::sim::Evaluate(scene->criteria, *result.metrics);
   }
-  sonarbench::sim::WriteLogMapOutputs(out.write_root().string(), result);
+  sonarbench::sim::WriteLogMapOutputs(out.write_root().string(), result, scene ? &*scene : nullptr);
   out.Commit();
   const auto& t = result.totals;
   std::cout << result.beams << " beams (" << result.truncated_beams << " truncated) in "
@@ -68,8 +68,9 @@ int Map(const MapArgs& args) {
   if (result.metrics)
     std::cout << "against " << args.scene << ": " << MetricsLine(*result.metrics) << "\n";
   std::cout << "timing [s]: import " << result.import_s << ", map " << result.map_s << "\n"
-            << "wrote " << args.out
-            << "/report.json, map.bt, map.ot, map_top.png, polar.png, fan.png\n";
+            << "wrote " << args.out << "/report.json, report.html"
+            << (result.verdict ? ", junit.xml" : "")
+            << ", map.bt, map.ot, map_top.png, polar.png, fan.png\n";
   if (!result.verdict) return 0;
   PrintVerdict(scene->name, *result.verdict);
   return result.verdict->passed ? 0 : kExitCriteriaFailed;
@@ -83,7 +84,8 @@ CLI::App* AddOptions(CLI::App& app, MapArgs& args) {
       "(from `simulate` or `import`; its manifest's sensor is used) or a real MSIS log in MATLAB "
       ".mat form (the CRAS lab's parsedData layout; the vehicle static at the origin), or a folder "
       "holding one such log. Writes map.bt and map.ot (octovis), map_top.png (occupied cells "
-      "from above), polar.png and fan.png (the first sweep) and report.json into --out. The "
+      "from above), polar.png and fan.png (the first sweep), report.html and report.json (and "
+      "junit.xml with --score) into --out. The "
       "sensor is the SHAD Micron and the mapper uses its defaults unless --scene, --sensor or "
       "--mapping say otherwise.");
   command

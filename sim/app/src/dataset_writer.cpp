@@ -365,7 +365,9 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
       const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
       WriteBeams(root / mapping::SweepFile("beams", s, "bin"), beams);
       WriteText(root / mapping::SweepFile("truth", s, "csv"), TruthCsv(synthesized, first, scene));
-      WritePolarImage((root / mapping::SweepFile("images", s, "png")).string(), beams);
+      WritePolarImage((root / mapping::SweepFile("images", s, "png")).string(), beams,
+                      scene.name + ", seed " + std::to_string(seed) + ": sweep " +
+                          std::to_string(s) + ", polar");
       ++summary.sweeps_written;
     }
     if (options.progress) options.progress(++handled, mine);
@@ -409,7 +411,9 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const mapping::MatL
       ++summary.sweeps_skipped;
     } else {
       WriteBeams(root / mapping::SweepFile("beams", s, "bin"), sweep);
-      WritePolarImage((root / mapping::SweepFile("images", s, "png")).string(), sweep);
+      WritePolarImage(
+          (root / mapping::SweepFile("images", s, "png")).string(), sweep,
+          fs::path(log_path).filename().string() + ": sweep " + std::to_string(s) + ", polar");
       ++summary.sweeps_written;
     }
   }

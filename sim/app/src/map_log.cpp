@@ -4,6 +4,7 @@
 #include <chrono>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/mat_log.hpp"
@@ -13,6 +14,7 @@
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/report.hpp"
+#include "sonarbench/sim/report/report_page.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
@@ -158,16 +160,43 @@ MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene) {
       PerfectSensorCells(tracer, result.poses, result.sensor, scene.sensor.acoustics, map), meshes);
 }
 
-void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) {
-  namespace fs = std::filesystem;
-  CreateOutputDirectory(out_dir);
-  const fs::path dir(out_dir);
-  result.mapper->WriteBinary((dir / "map.bt").string());
-  result.mapper->WriteFull((dir / "map.ot").string());
-  const MapCells cells = CollectMapCells(result.mapper->tree());
-  WriteTopDownImage((dir / "map_top.png").string(), cells, {}, {});
-  WritePolarImage((dir / "polar.png").string(), result.first_sweep);
-  WriteFanImage((dir / "fan.png").string(), result.first_sweep, 0.01);
+namespace {
+
+// report.html of a mapped log: what was mapped, the scores and criteria when scored, the images.
+std::string LogMapHtml(const LogMapResult& result, const Scene* scene,
+                       const std::vector<ReportImage>& images, const MapCells& cells) {
+  const Verdict* verdict = result.verdict ? &*result.verdict : nullptr;
+  const std::string name = std::filesystem::path(result.input).filename().string();
+  std::ostringstream html;
+  html << HtmlPageStart(
+      "sonarbench map: " + name + (verdict ? (verdict->passed ? " PASS" : " FAIL") : ""),
+      "sonarbench map: " + name + (scene ? " against " + scene->name : ""), verdict);
+  const auto& t = result.totals;
+  html << TableHtml("Log and map",
+                    {{"input", result.input},
+                     {"kind", result.source == "mat" ? ".mat log" : "dataset"},
+                     {"beams", std::to_string(result.beams)},
+                     {"truncated beams", std::to_string(result.truncated_beams)},
+                     {"sweeps", std::to_string(result.sweeps)},
+                     {"beams with an obstacle", std::to_string(t.beams_with_obstacle)},
+                     {"occupied cells", std::to_string(cells.occupied.size())},
+                     {"free cells", std::to_string(cells.free.size())},
+                     {"resolution [m]", FormatMetricValue(result.mapper->config().resolution_m)},
+                     {"import [s]", Seconds(result.import_s)},
+                     {"map [s]", Seconds(result.map_s)}},
+                    false);
+  if (scene) html << "<p>Scored against scene <code>" << XmlEscape(scene->file) << "</code>.</p>\n";
+  for (const std::string& warning : result.warnings) {
+    html << "<p class=\"acceptable\">" << XmlEscape(warning) << "</p>\n";
+  }
+  if (verdict) html << CriteriaHtml(*verdict);
+  if (result.metrics) html << MetricsHtml(*result.metrics);
+  html << ImagesHtmlAndEnd(images);
+  return html.str();
+}
+
+// report.json of a mapped log, but for its scores and the files' hashes.
+nlohmann::json LogMapReportJson(const LogMapResult& result, const MapCells& cells) {
   const auto& t = result.totals;
   const auto& c = result.mapper->config();
   nlohmann::json report = ReportHeader();
@@ -200,7 +229,48 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) 
                    {"map_full", "map.ot"},
                    {"map_top", "map_top.png"},
                    {"polar", "polar.png"},
-                   {"fan", "fan.png"}}}});
+                   {"fan", "fan.png"},
+                   {"html", "report.html"}}}});
+  return report;
+}
+
+}  // namespace
+
+void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
+                        const Scene* scene) {
+  namespace fs = std::filesystem;
+  CreateOutputDirectory(out_dir);
+  const fs::path dir(out_dir);
+  result.mapper->WriteBinary((dir / "map.bt").string());
+  result.mapper->WriteFull((dir / "map.ot").string());
+  const MapCells cells = CollectMapCells(result.mapper->tree());
+  const std::string name = fs::path(result.input).filename().string();
+  MapView top;
+  top.resolution_m = result.mapper->config().resolution_m;
+  top.title = name + ": map from above";
+  const std::vector<ReportImage> images = {
+      {"map_top.png",
+       "Occupied cells from above (white), free cells grey, whole pixels per column.",
+       EncodePng(RenderMapView(cells, {}, {}, top))},
+      {"polar.png", "First sweep, polar: one row per beam in time order, range to the right.",
+       EncodePng(RenderPolarImage(result.first_sweep, name + ": first sweep, polar"))},
+      {"fan.png", "First sweep, Cartesian fan from above: the sonar at the centre, 1 cm per pixel.",
+       EncodePng(RenderFanImage(result.first_sweep, 0.01, name + ": first sweep, fan"))},
+  };
+  WriteReportImages(out_dir, images);
+  const bool scored = scene && result.verdict;
+  if (scored) {
+    WriteFileAtomically((dir / "junit.xml").string(), [&](std::ostream& out) {
+      out << ScoredJunitXml(*scene, "map", result.input,
+                            {{"scene_file", scene->file}, {"input", result.input}}, *result.verdict,
+                            result.import_s + result.map_s);
+    });
+  }
+  WriteFileAtomically((dir / "report.html").string(), [&](std::ostream& out) {
+    out << LogMapHtml(result, scored ? scene : nullptr, images, cells);
+  });
+  nlohmann::json report = LogMapReportJson(result, cells);
+  if (scored) report["outputs"]["junit"] = "junit.xml";
   if (result.metrics) report["metrics"] = MetricsJson(*result.metrics);
   if (result.verdict) {
     report["verdict"] = VerdictJson(*result.verdict);
@@ -209,6 +279,7 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result) 
   if (!result.warnings.empty()) report["warnings"] = result.warnings;
   std::vector<std::string> covered = kLogMapOutputFiles;
   std::erase(covered, "report.json");
+  if (!scored) std::erase(covered, "junit.xml");
   report["files_sha256"] = FilesSha256(out_dir, covered);
   WriteJson((dir / "report.json").string(), report);
 }

@@ -243,9 +243,11 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                           {real_profile, sim_profile}, false, 0.0));
 
   WritePng((dir / "polar.png").string(),
-           SideBySide(RenderPolarImage(sim_sweep), RenderPolarImage(real_sweep)));
+           SideBySide(RenderPolarImage(sim_sweep, "simulated: " + scene_file + ", first sweep"),
+                      RenderPolarImage(real_sweep, "real: " + log_file + ", first sweep")));
   WritePng((dir / "fan.png").string(),
-           SideBySide(RenderFanImage(sim_sweep, 0.01), RenderFanImage(real_sweep, 0.01)));
+           SideBySide(RenderFanImage(sim_sweep, 0.01, "simulated: " + scene_file + ", first sweep"),
+                      RenderFanImage(real_sweep, 0.01, "real: " + log_file + ", first sweep")));
 
   WriteJson((dir / "fidelity.json").string(), FidelityJson(r, scene_file, log_file));
 }

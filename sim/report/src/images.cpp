@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "figure.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 
 namespace sonarbench::sim {
@@ -24,32 +25,80 @@ void WritePng(const std::string& path, const cv::Mat& image) {
   });
 }
 
-cv::Mat RenderPolarImage(std::span<const mapping::Beam> sweep) {
+cv::Mat RenderPolarImage(std::span<const mapping::Beam> sweep, const std::string& title) {
   std::size_t bins = 0;
   for (const auto& beam : sweep) bins = std::max(bins, beam.intensities.size());
-  cv::Mat gray(static_cast<int>(sweep.size()), static_cast<int>(bins), CV_8UC1, cv::Scalar(0));
+  const int rows = std::max<int>(1, static_cast<int>(sweep.size()));
+  cv::Mat gray(rows, std::max<int>(1, static_cast<int>(bins)), CV_8UC1, cv::Scalar(0));
   for (std::size_t r = 0; r < sweep.size(); ++r) {
     std::copy(sweep[r].intensities.begin(), sweep[r].intensities.end(),
               gray.ptr<uchar>(static_cast<int>(r)));
   }
   cv::Mat colour;
   cv::applyColorMap(gray, colour, cv::COLORMAP_INFERNO);
-  cv::resize(colour, colour, cv::Size(), 2.0, 2.0, cv::INTER_NEAREST);
-  return colour;
+  const int scale_y = std::max(2, 200 / rows);
+  cv::resize(colour, colour, cv::Size(), 2.0, scale_y, cv::INTER_NEAREST);
+  // Rows in time order; a tick where the head angle passes a multiple of 45 deg, a line at 0.
+  figure::Axis y{static_cast<double>(rows), 0.0, "head angle [deg], beams in time order", {}};
+  auto degrees = [&](std::size_t r) {
+    const double deg = std::fmod(sweep[r].head_angle_rad / mapping::kDegToRad, 360.0);
+    return deg < 0.0 ? deg + 360.0 : deg;
+  };
+  for (std::size_t r = 0; r < sweep.size(); ++r) {
+    const double deg = degrees(r);
+    const double before = r == 0 ? deg - 1e-9 : degrees(r - 1);
+    const bool wrapped = deg < before;
+    const int crossed = static_cast<int>(std::floor(deg / 45.0));
+    if (!wrapped && crossed == static_cast<int>(std::floor(before / 45.0))) continue;
+    const int label = wrapped ? 0 : crossed * 45;
+    y.ticks.emplace_back(static_cast<double>(r), std::to_string(label));
+    if (label != 0) continue;
+    const int v = static_cast<int>(r) * scale_y;
+    for (int u = 0; u < colour.cols; u += 12) {
+      cv::line(colour, {u, v}, {std::min(u + 6, colour.cols - 1), v}, cv::Scalar(255, 255, 255), 1);
+    }
+  }
+  const double bin_size = sweep.empty() ? 0.0 : sweep.front().bin_size_m;
+  const figure::Axis x{0.0, bin_size * static_cast<double>(bins), "range [m]", {}};
+  return figure::Framed(colour, title, x, y, figure::IntensityBar(colour.rows));
 }
 
-void WritePolarImage(const std::string& path, std::span<const mapping::Beam> sweep) {
-  WritePng(path, RenderPolarImage(sweep));
+void WritePolarImage(const std::string& path, std::span<const mapping::Beam> sweep,
+                     const std::string& title) {
+  WritePng(path, RenderPolarImage(sweep, title));
 }
 
-cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m) {
+namespace {
+
+// The fan with metric axes in the sonar frame, head angle 0 (+x) marked, a scale bar and the
+// intensity colour bar.
+cv::Mat FramedFan(cv::Mat colour, int half, double pixel_m, const std::string& title) {
+  const cv::Scalar white(255, 255, 255);
+  const cv::Point centre(half, half);
+  cv::line(colour, centre, {colour.cols - 1, half}, white, 1, cv::LINE_AA);
+  cv::putText(colour, "head angle 0", {std::max(0, colour.cols - 120), half - 6},
+              cv::FONT_HERSHEY_SIMPLEX, 0.45, white, 1, cv::LINE_AA);
+  figure::DrawScaleBar(colour, pixel_m);
+  const double extent = (half + 0.5) * pixel_m;
+  return figure::Framed(colour, title, {-extent, extent, "x [m], sonar frame", {}},
+                        {-extent, extent, "y [m]", {}}, figure::IntensityBar(colour.rows));
+}
+
+}  // namespace
+
+cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m,
+                       const std::string& title) {
   double max_range = 0.0;
   for (const auto& beam : sweep) {
     max_range = std::max(max_range, beam.bin_size_m * static_cast<double>(beam.intensities.size()));
   }
   const int half = static_cast<int>(std::ceil(max_range / pixel_m));
   cv::Mat gray(2 * half + 1, 2 * half + 1, CV_8UC1, cv::Scalar(0));
-  if (sweep.empty()) return gray;
+  if (sweep.empty()) {
+    cv::Mat colour;
+    cv::applyColorMap(gray, colour, cv::COLORMAP_INFERNO);
+    return FramedFan(colour, half, pixel_m, title);
+  }
   // Beams sorted by head angle in [0, 2π): the beam nearest a bearing is in the group of equal
   // angles just below it or just above it (circularly); among those the smallest angular
   // distance wins, then the earliest beam, as a scan in sweep order would choose.
@@ -98,15 +147,26 @@ cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m) {
   }
   cv::Mat colour;
   cv::applyColorMap(gray, colour, cv::COLORMAP_INFERNO);
-  return colour;
+  return FramedFan(colour, half, pixel_m, title);
 }
 
-void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep, double pixel_m) {
-  WritePng(path, RenderFanImage(sweep, pixel_m));
+void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep, double pixel_m,
+                   const std::string& title) {
+  WritePng(path, RenderFanImage(sweep, pixel_m, title));
 }
 
-cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
-                      const mapping::KeySet& observable, const MapView& view) {
+namespace {
+
+// A map view's cells as labels, one per cell column (top) or slab cell (side), row 0 at the top:
+// 0 unknown, 1 free, 2 missed truth, 3 false positive, 4 true positive, 5 occupied without a
+// truth (higher wins); and the keys of its first and last column and row.
+struct ViewLabels {
+  cv::Mat label;
+  int lo_u = 0, hi_u = 0, lo_v = 0, hi_v = 0;
+};
+
+ViewLabels LabelView(const MapCells& map, const mapping::KeySet& truth,
+                     const mapping::KeySet& observable, const MapView& view) {
   // Image axes: u (key index) to the right, v up; the third axis is projected (top) or sliced.
   const int u = 0;
   const int v = view.kind == MapView::Kind::kTop ? 1 : 2;
@@ -116,25 +176,21 @@ cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
            std::abs(static_cast<int>(k[w]) - static_cast<int>(view.slab_key)) <=
                view.slab_half_cells;
   };
-  int lo_u = 1 << 16, lo_v = 1 << 16, hi_u = 0, hi_v = 0;
-  auto extend = [&](const mapping::KeySet& cells) {
-    for (const auto& k : cells) {
+  ViewLabels out{{}, 1 << 16, 0, 1 << 16, 0};
+  for (const mapping::KeySet* cells : {&map.occupied, &map.free, &truth}) {
+    for (const auto& k : *cells) {
       if (!in_view(k)) continue;
-      lo_u = std::min<int>(lo_u, k[u]);
-      hi_u = std::max<int>(hi_u, k[u]);
-      lo_v = std::min<int>(lo_v, k[v]);
-      hi_v = std::max<int>(hi_v, k[v]);
+      out.lo_u = std::min<int>(out.lo_u, k[u]);
+      out.hi_u = std::max<int>(out.hi_u, k[u]);
+      out.lo_v = std::min<int>(out.lo_v, k[v]);
+      out.hi_v = std::max<int>(out.hi_v, k[v]);
     }
-  };
-  extend(map.occupied);
-  extend(map.free);
-  extend(truth);
-  if (hi_u < lo_u) lo_u = hi_u = lo_v = hi_v = 0;
-  // Per pixel: 1 free, 2 missed truth, 3 false positive, 4 true positive (higher wins).
-  cv::Mat label(hi_v - lo_v + 1, hi_u - lo_u + 1, CV_8UC1, cv::Scalar(0));
+  }
+  if (out.hi_u < out.lo_u) out.lo_u = out.hi_u = out.lo_v = out.hi_v = 0;
+  out.label = cv::Mat(out.hi_v - out.lo_v + 1, out.hi_u - out.lo_u + 1, CV_8UC1, cv::Scalar(0));
   auto mark = [&](const octomap::OcTreeKey& k, uchar value) {
     if (!in_view(k)) return;
-    uchar& cell = label.at<uchar>(hi_v - k[v], k[u] - lo_u);
+    uchar& cell = out.label.at<uchar>(out.hi_v - k[v], k[u] - out.lo_u);
     cell = std::max(cell, value);
   };
   for (const auto& k : map.free) mark(k, 1);
@@ -144,16 +200,50 @@ cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
   // Without a truth (a real log), occupied is simply occupied: drawn white.
   const bool scored = !truth.empty();
   for (const auto& k : map.occupied) mark(k, !scored ? 5 : truth.contains(k) ? 4 : 3);
+  return out;
+}
+
+}  // namespace
+
+cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
+                      const mapping::KeySet& observable, const MapView& view) {
+  const ViewLabels labels = LabelView(map, truth, observable, view);
+  const cv::Mat& label = labels.label;
   const cv::Vec3b palette[] = {{0, 0, 0},   {70, 70, 70}, {255, 120, 0},
                                {0, 0, 230}, {0, 210, 0},  {255, 255, 255}};
+  const char* names[] = {"unknown",
+                         "free",
+                         "observable surface missed",
+                         "occupied, off surface",
+                         "occupied, on a surface",
+                         "occupied"};
+  bool present[6] = {};
   cv::Mat colour(label.size(), CV_8UC3);
   for (int r = 0; r < label.rows; ++r) {
-    for (int c = 0; c < label.cols; ++c)
-      colour.at<cv::Vec3b>(r, c) = palette[label.at<uchar>(r, c)];
+    for (int c = 0; c < label.cols; ++c) {
+      const uchar l = label.at<uchar>(r, c);
+      present[l] = true;
+      colour.at<cv::Vec3b>(r, c) = palette[l];
+    }
   }
-  const double scale = std::max(1.0, 400.0 / std::max(label.rows, label.cols));
+  // Whole pixels per cell, the longer side at least 800 pixels.
+  const int scale =
+      std::max(1, (800 + std::max(label.rows, label.cols) - 1) / std::max(label.rows, label.cols));
   cv::resize(colour, colour, cv::Size(), scale, scale, cv::INTER_NEAREST);
-  return colour;
+  std::vector<std::pair<cv::Vec3b, std::string>> legend;
+  for (int l = 0; l < 6; ++l) {
+    if (present[l]) legend.emplace_back(palette[l], names[l]);
+  }
+  const double res = view.resolution_m > 0.0 ? view.resolution_m : 1.0;
+  const char* unit = view.resolution_m > 0.0 ? " [m]" : " [cells]";
+  auto metres = [&](int key) { return (key - 32768) * res; };
+  figure::DrawScaleBar(colour, view.resolution_m > 0.0 ? res / scale : 0.0);
+  const figure::Axis x{metres(labels.lo_u), metres(labels.hi_u + 1), std::string("x") + unit, {}};
+  const figure::Axis y{metres(labels.lo_v),
+                       metres(labels.hi_v + 1),
+                       std::string(view.kind == MapView::Kind::kTop ? "y" : "z") + unit,
+                       {}};
+  return figure::Framed(colour, view.title, x, y, figure::Legend(legend));
 }
 
 namespace {
@@ -179,13 +269,61 @@ std::vector<double> XTicks(const std::vector<double>& xs, bool log2_x,
 
 }  // namespace
 
+namespace {
+
+constexpr int kPlotWidth = 720, kPlotHeight = 470, kPlotLeft = 80, kPlotRight = 20, kPlotTop = 50,
+              kPlotBottom = 60;
+
+// Where a plot's values fall in its image.
+struct PlotScale {
+  double x0, x1, y_min, y_top;
+  bool log2_x;
+  [[nodiscard]] double Fx(double x) const { return log2_x ? std::log2(std::max(x, 1e-9)) : x; }
+  [[nodiscard]] cv::Point At(double x, double y) const {
+    return {kPlotLeft +
+                static_cast<int>((Fx(x) - x0) / (x1 - x0) * (kPlotWidth - kPlotLeft - kPlotRight)),
+            kPlotHeight - kPlotBottom -
+                static_cast<int>((y - y_min) / (y_top - y_min) *
+                                 (kPlotHeight - kPlotTop - kPlotBottom))};
+  }
+};
+
+// Each series' points (a marker each, up to 64, or always when unjoined), joined by a line only
+// when its x values increase, and its legend entry in the lower right, where coverage-like
+// curves that rise to 1 leave room.
+void DrawSeries(cv::Mat& img, const std::vector<PlotSeries>& series, const PlotScale& scale) {
+  constexpr std::size_t kMaxMarkers = 64;
+  int legend_y = kPlotHeight - kPlotBottom - 12 - 18 * (static_cast<int>(series.size()) - 1);
+  for (const auto& s : series) {
+    const bool joined = std::adjacent_find(s.x.begin(), s.x.end(),
+                                           [](double a, double b) { return b <= a; }) == s.x.end();
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      const cv::Point p = scale.At(s.x[i], s.y[i]);
+      if (s.x.size() <= kMaxMarkers || !joined) {
+        cv::circle(img, p, 3, s.colour, cv::FILLED, cv::LINE_AA);
+      }
+      if (i > 0 && joined) {
+        cv::line(img, scale.At(s.x[i - 1], s.y[i - 1]), p, s.colour, 2, cv::LINE_AA);
+      }
+    }
+    cv::circle(img, {kPlotWidth - 238, legend_y - 4}, 3, s.colour, cv::FILLED, cv::LINE_AA);
+    if (joined) {
+      cv::line(img, {kPlotWidth - 250, legend_y - 4}, {kPlotWidth - 225, legend_y - 4}, s.colour,
+               2);
+    }
+    cv::putText(img, s.name, {kPlotWidth - 220, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.42,
+                cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    legend_y += 18;
+  }
+}
+
+}  // namespace
+
 cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
                        const std::string& y_label, const std::vector<PlotSeries>& series,
                        bool log2_x, double y_min, std::optional<double> y_max) {
-  constexpr int kWidth = 720, kHeight = 460, kLeft = 80, kRight = 20, kTop = 40, kBottom = 60;
   constexpr std::size_t kMaxValueTicks = 16;  // more x values: round ticks
-  constexpr std::size_t kMaxMarkers = 64;     // a longer series: a line alone
-  cv::Mat img(kHeight, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
+  cv::Mat img(kPlotHeight, kPlotWidth, CV_8UC3, cv::Scalar(255, 255, 255));
   std::vector<double> xs;
   double top = y_max.value_or(y_min);
   for (const auto& s : series) {
@@ -198,56 +336,39 @@ cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
   xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
   if (xs.empty()) return img;
   if (top <= y_min) top = y_min + 1.0;
-  auto fx = [&](double x) { return log2_x ? std::log2(std::max(x, 1e-9)) : x; };
-  const double x0 = fx(xs.front());
-  const double x1 = xs.size() > 1 ? fx(xs.back()) : x0 + 1.0;
-  auto px = [&](double x) {
-    return cv::Point(kLeft + static_cast<int>((fx(x) - x0) / (x1 - x0) * (kWidth - kLeft - kRight)),
-                     0);
-  };
-  auto py = [&](double y) {
-    return kHeight - kBottom -
-           static_cast<int>((y - y_min) / (top - y_min) * (kHeight - kTop - kBottom));
-  };
+  // Round y ticks, the top one at or above the data.
+  const std::vector<double> round = figure::RoundTicks(y_min, top, 4);
+  const double y_step = round.size() > 1 ? round[1] - round[0] : (top - y_min) / 4.0;
+  if (!y_max) top = y_min + std::ceil((top - y_min) / y_step - 1e-9) * y_step;
+  PlotScale scale{0.0, 1.0, y_min, top, log2_x};
+  scale.x0 = scale.Fx(xs.front());
+  scale.x1 = xs.size() > 1 ? scale.Fx(xs.back()) : scale.x0 + 1.0;
   const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
   const int font = cv::FONT_HERSHEY_SIMPLEX;
-  const std::vector<double> ticks = XTicks(xs, log2_x, kMaxValueTicks);
-  for (double x : ticks) {
-    const int u = px(x).x;
-    cv::line(img, {u, kTop}, {u, kHeight - kBottom}, grey, 1);
+  const int bottom = kPlotHeight - kPlotBottom;
+  for (double x : XTicks(xs, log2_x, kMaxValueTicks)) {
+    const int u = scale.At(x, y_min).x;
+    cv::line(img, {u, kPlotTop}, {u, bottom}, grey, 1);
     char text[32];
     std::snprintf(text, sizeof text, "%g", x);
-    cv::putText(img, text, {u - 8, kHeight - kBottom + 18}, font, 0.42, black, 1, cv::LINE_AA);
+    int baseline = 0;
+    const int width = cv::getTextSize(text, font, 0.42, 1, &baseline).width;
+    const int left = std::clamp(u - width / 2, 2, kPlotWidth - width - 2);  // never cut
+    cv::putText(img, text, {left, bottom + 18}, font, 0.42, black, 1, cv::LINE_AA);
   }
-  for (int i = 0; i <= 4; ++i) {
-    const double y = y_min + (top - y_min) * i / 4.0;
-    cv::line(img, {kLeft, py(y)}, {kWidth - kRight, py(y)}, grey, 1);
+  for (double y = y_min; y <= top + 1e-9 * y_step; y += y_step) {
+    const int v = scale.At(xs.front(), y).y;
+    cv::line(img, {kPlotLeft, v}, {kPlotWidth - kPlotRight, v}, grey, 1);
     char text[32];
-    std::snprintf(text, sizeof text, "%.3g", y);
-    cv::putText(img, text, {8, py(y) + 4}, font, 0.42, black, 1, cv::LINE_AA);
+    std::snprintf(text, sizeof text, "%g", std::abs(y) < 1e-12 ? 0.0 : y);
+    cv::putText(img, text, {8, v + 4}, font, 0.42, black, 1, cv::LINE_AA);
   }
-  cv::rectangle(img, {kLeft, kTop}, {kWidth - kRight, kHeight - kBottom}, black, 1);
-  cv::putText(img, title, {kLeft, 18}, font, 0.55, black, 1, cv::LINE_AA);
-  cv::putText(img, x_label, {kLeft + 180, kHeight - 18}, font, 0.5, black, 1, cv::LINE_AA);
-  cv::putText(img, y_label, {8, kTop - 6}, font, 0.45, black, 1, cv::LINE_AA);
-  // The legend sits in the lower right, where coverage-like curves that rise to 1 leave room.
-  int legend_y = kHeight - kBottom - 12 - 18 * (static_cast<int>(series.size()) - 1);
-  for (const auto& s : series) {
-    for (std::size_t i = 0; i < s.x.size(); ++i) {
-      const cv::Point p(px(s.x[i]).x, py(s.y[i]));
-      if (s.x.size() <= kMaxMarkers) cv::circle(img, p, 3, s.colour, cv::FILLED, cv::LINE_AA);
-      if (i > 0) cv::line(img, {px(s.x[i - 1]).x, py(s.y[i - 1])}, p, s.colour, 2, cv::LINE_AA);
-    }
-    cv::line(img, {kWidth - 250, legend_y - 4}, {kWidth - 225, legend_y - 4}, s.colour, 2);
-    cv::putText(img, s.name, {kWidth - 220, legend_y}, font, 0.42, black, 1, cv::LINE_AA);
-    legend_y += 18;
-  }
+  cv::rectangle(img, {kPlotLeft, kPlotTop}, {kPlotWidth - kPlotRight, bottom}, black, 1);
+  cv::putText(img, title, {kPlotLeft, 18}, font, 0.55, black, 1, cv::LINE_AA);
+  cv::putText(img, x_label, {kPlotLeft + 180, kPlotHeight - 18}, font, 0.5, black, 1, cv::LINE_AA);
+  cv::putText(img, y_label, {8, kPlotTop - 6}, font, 0.45, black, 1, cv::LINE_AA);
+  DrawSeries(img, series, scale);
   return img;
-}
-
-void WriteTopDownImage(const std::string& path, const MapCells& map, const mapping::KeySet& truth,
-                       const mapping::KeySet& observable) {
-  WritePng(path, RenderMapView(map, truth, observable, MapView{}));
 }
 
 }  // namespace sonarbench::sim

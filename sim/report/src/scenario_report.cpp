@@ -9,6 +9,7 @@
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/report.hpp"
+#include "sonarbench/sim/report/report_page.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -145,118 +146,33 @@ double TotalSeconds(const StageTimings& t) {
   return t.build_scene_s + t.simulate_s + t.map_s + t.ground_truth_s + t.score_s;
 }
 
-std::string Seconds(double s) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3f", s);
-  return text;
-}
-
-/// The images of a run, encoded once: written as files and embedded in the HTML report.
-struct Image {
-  const char* file;
-  const char* caption;
-  std::vector<unsigned char> png;
-};
-
-std::vector<Image> RenderImages(const ScenarioResult& result) {
-  const MapCells cells = CollectMapCells(result.mapper->tree());
-  MapView side;
-  side.kind = MapView::Kind::kSide;
-  side.slab_key = result.mapper->tree().coordToKey(
-      result.sonar_start_m.x(), result.sonar_start_m.y(), result.sonar_start_m.z())[1];
-  return {
+std::vector<ReportImage> RenderImages(const Scene& scene, const ScenarioResult& result) {
+  const std::string name = scene.name + ", seed " + std::to_string(result.seed);
+  std::vector<ReportImage> images = {
       {"polar.png", "First sweep, polar: one row per beam in time order, range to the right.",
-       EncodePng(RenderPolarImage(result.first_sweep))},
+       EncodePng(RenderPolarImage(result.first_sweep, name + ": first sweep, polar"))},
       {"fan.png", "First sweep, Cartesian fan from above: the sonar at the centre, 1 cm per pixel.",
-       EncodePng(RenderFanImage(result.first_sweep, 0.01))},
-      {"map_top.png",
-       "Map against truth from above, one pixel per cell column: green true positive, red only "
-       "false positives, blue observable truth missed, grey free.",
-       EncodePng(RenderMapView(cells, result.truth, result.observable, MapView{}))},
-      {"map_side.png",
-       "Side slice through the sonar (3 cells thick in y), x to the right, z up; same colours.",
-       EncodePng(RenderMapView(cells, result.truth, result.observable, side))},
+       EncodePng(RenderFanImage(result.first_sweep, 0.01, name + ": first sweep, fan"))},
   };
-}
-
-std::string HtmlEscape(std::string_view text) { return XmlEscape(text); }
-
-// report.html's criteria section: each criterion's actual, expected, margin and status.
-std::string CriteriaHtml(const Verdict& v) {
-  std::ostringstream html;
-  html << "<h2>Criteria</h2>\n";
-  if (v.results.empty()) {
-    html << "<p>The scene sets no criteria: the scenario passes when it runs.</p>\n";
-  } else {
-    html << "<table><tr><th>metric</th><th>actual</th><th>expected</th><th>margin</th>"
-            "<th>status</th><th>optional</th></tr>\n";
-    for (const CriterionResult& r : v.results) {
-      html << "<tr class=\"" << StatusName(r.status) << "\"><td>" << HtmlEscape(r.criterion.metric)
-           << "</td><td class=\"n\">" << FormatMetricValue(r.actual) << "</td><td>"
-           << HtmlEscape(r.expected) << "</td><td class=\"n\">" << FormatMetricValue(r.margin)
-           << "</td><td>" << StatusName(r.status) << "</td><td>"
-           << (r.criterion.optional ? "yes" : "no") << "</td></tr>\n";
-    }
-    html << "</table>\n";
+  for (ReportImage& image : MapTruthImages(result.mapper->tree(), result.truth, result.observable,
+                                           result.sonar_start_m, name)) {
+    images.push_back(std::move(image));
   }
-  return html.str();
-}
-
-// report.html's metrics section: every known metric with its definition, each mesh's recall, the
-// counts.
-std::string MetricsHtml(const MapMetrics& m) {
-  std::ostringstream html;
-  html << "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>value</th><th>definition</th></tr>\n";
-  for (const MetricInfo& info : KnownMetrics()) {
-    html << "<tr><td>" << info.name << "</td><td class=\"n\">"
-         << FormatMetricValue(MetricValue(m, info.name)) << "</td><td>"
-         << HtmlEscape(info.definition) << "</td></tr>\n";
-  }
-  for (const auto& r : m.per_mesh) {
-    html << "<tr><td>" << kMeshRecallPrefix << HtmlEscape(r.name) << "</td><td class=\"n\">"
-         << FormatMetricValue(r.recall) << "</td><td>" << r.observed_occupied_cells << " of "
-         << r.observable_cells << " observable cells of this mesh mapped occupied</td></tr>\n";
-  }
-  html << "</table>\n<p>Counts: " << m.truth_cells << " surface cells, " << m.observable_cells
-       << " observable, " << m.occupied_cells << " occupied (" << m.true_positive_cells
-       << " on a surface), " << m.free_cells
-       << " free. Unknown cells are neither occupied nor "
-          "free: they lower coverage and recall, never precision.</p>\n";
-  return html.str();
+  return images;
 }
 
 std::string ScenarioHtml(const Scene& scene, const ScenarioResult& result,
-                         const std::vector<Image>& images) {
+                         const std::vector<ReportImage>& images) {
   const Verdict& v = result.verdict;
-  const MapMetrics& m = result.metrics;
   std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>sonarbench: "
-       << HtmlEscape(scene.name) << " " << (v.passed ? "PASS" : "FAIL") << "</title>\n"
-       << "<style>body{font-family:sans-serif;margin:2em;max-width:70em}"
-          "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;"
-          "padding:.25em .6em;text-align:left}td.n{text-align:right;font-family:monospace}"
-          ".pass{background:#d9f2d9}.acceptable{background:#fff3cd}.fail{background:#f8d7da}"
-          ".verdict{font-size:1.5em;padding:.4em .8em;display:inline-block}"
-          "figure{display:inline-block;vertical-align:top;margin:.5em;max-width:32em}"
-          "img{max-width:100%;image-rendering:pixelated}</style></head><body>\n";
-  html << "<h1>sonarbench scenario: " << HtmlEscape(scene.name) << "</h1>\n"
-       << "<p class=\"verdict " << (v.passed ? "pass" : "fail") << "\">"
-       << (v.passed ? "PASS" : "FAIL") << (v.expect_fail ? " (expected to fail)" : "") << "</p>\n";
-  if (!v.reasons.empty() || !v.warnings.empty()) {
-    html << "<ul>\n";
-    for (const auto& r : v.reasons) html << "<li class=\"fail\">" << HtmlEscape(r) << "</li>\n";
-    for (const auto& w : v.warnings)
-      html << "<li class=\"acceptable\">" << HtmlEscape(w) << "</li>\n";
-    html << "</ul>\n";
-  }
-  html << "<p>Scene <code>" << HtmlEscape(scene.file) << "</code>, sensor model <code>"
-       << HtmlEscape(scene.sensor_model_file) << "</code>, seed " << result.seed << ", "
+  html << HtmlPageStart("sonarbench: " + scene.name + " " + (v.passed ? "PASS" : "FAIL"),
+                        "sonarbench scenario: " + scene.name, &v);
+  html << "<p>Scene <code>" << XmlEscape(scene.file) << "</code>, sensor model <code>"
+       << XmlEscape(scene.sensor_model_file) << "</code>, seed " << result.seed << ", "
        << result.beams << " beams in " << scene.sweeps << " sweeps, " << result.threads
-       << " threads, " << Seconds(TotalSeconds(result.timings)) << " s.</p>\n";
-
-  html << CriteriaHtml(v);
-  html << MetricsHtml(m);
-
+       << (result.threads == 1 ? " thread, " : " threads, ")
+       << Seconds(TotalSeconds(result.timings)) << " s.</p>\n";
+  html << CriteriaHtml(v) << MetricsHtml(result.metrics);
   const StageTimings& t = result.timings;
   html << "<h2>Timing</h2>\n<table><tr><th>stage</th><th>seconds</th></tr>\n";
   for (const auto& [stage, seconds] :
@@ -265,13 +181,7 @@ std::string ScenarioHtml(const Scene& scene, const ScenarioResult& result,
         std::pair{"score", t.score_s}}) {
     html << "<tr><td>" << stage << "</td><td class=\"n\">" << Seconds(seconds) << "</td></tr>\n";
   }
-  html << "</table>\n<h2>Images</h2>\n";
-  for (const Image& image : images) {
-    html << "<figure><img alt=\"" << image.file << "\" src=\"data:image/png;base64,"
-         << Base64(image.png) << "\"><figcaption><code>" << image.file
-         << "</code>: " << HtmlEscape(image.caption) << "</figcaption></figure>\n";
-  }
-  html << "</body></html>\n";
+  html << "</table>\n" << ImagesHtmlAndEnd(images);
   return html.str();
 }
 
@@ -381,50 +291,11 @@ nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& resu
 }
 
 std::string ScenarioJunitXml(const Scene& scene, const ScenarioResult& result) {
-  const Verdict& v = result.verdict;
-  const std::string suite = XmlEscape(scene.name);
-  const std::string classname = "sonarbench." + suite;
-  std::size_t failures = 0;
-  std::ostringstream cases;
-  // The run itself: fails only when an expect-fail scenario met all its criteria.
-  cases << "    <testcase classname=\"" << classname << "\" name=\"scenario\" time=\""
-        << Seconds(TotalSeconds(result.timings)) << "\">\n";
-  if (v.expect_fail && !v.passed) {
-    ++failures;
-    cases << "      <failure type=\"expectation\" message=\"" << XmlEscape(v.reasons.front())
-          << "\"/>\n";
-  }
-  cases << "      <system-out>seed " << result.seed << ", " << result.beams << " beams, "
-        << (v.expect_fail ? "expect: fail" : "expect: pass") << "</system-out>\n"
-        << "    </testcase>\n";
-  for (const CriterionResult& r : v.results) {
-    cases << "    <testcase classname=\"" << classname << "\" name=\""
-          << XmlEscape(r.criterion.metric) << "\" time=\"0\">\n";
-    const bool counts = r.status == CriterionStatus::kFail && !r.criterion.optional;
-    if (counts && !v.expect_fail) {
-      ++failures;
-      cases << "      <failure type=\"criterion\" message=\"" << XmlEscape(Describe(r)) << "\"/>\n";
-    } else {
-      std::string note = Describe(r);
-      if (r.criterion.optional && r.status != CriterionStatus::kPass) note += " (optional)";
-      if (counts && v.expect_fail) note += " (failure expected: expect: fail)";
-      cases << "      <system-out>" << XmlEscape(note) << "</system-out>\n";
-    }
-    cases << "    </testcase>\n";
-  }
-  const std::size_t tests = v.results.size() + 1;
-  std::ostringstream xml;
-  xml << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-      << "<testsuites name=\"sonarbench\" tests=\"" << tests << "\" failures=\"" << failures
-      << "\" errors=\"0\" time=\"" << Seconds(TotalSeconds(result.timings)) << "\">\n"
-      << "  <testsuite name=\"" << suite << "\" tests=\"" << tests << "\" failures=\"" << failures
-      << "\" errors=\"0\" skipped=\"0\" time=\"" << Seconds(TotalSeconds(result.timings)) << "\">\n"
-      << "    <properties>\n"
-      << "      <property name=\"scene_file\" value=\"" << XmlEscape(scene.file) << "\"/>\n"
-      << "      <property name=\"seed\" value=\"" << result.seed << "\"/>\n"
-      << "    </properties>\n"
-      << cases.str() << "  </testsuite>\n</testsuites>\n";
-  return xml.str();
+  return ScoredJunitXml(
+      scene, "scenario",
+      "seed " + std::to_string(result.seed) + ", " + std::to_string(result.beams) + " beams",
+      {{"scene_file", scene.file}, {"seed", std::to_string(result.seed)}}, result.verdict,
+      TotalSeconds(result.timings));
 }
 
 std::string ErrorJunitXml(std::string_view scenario, std::string_view error_type,
@@ -447,13 +318,8 @@ void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
   CreateOutputDirectory(out_dir);
   const fs::path dir(out_dir);
   result.mapper->WriteBinary((dir / "map.bt").string());
-  const std::vector<Image> images = RenderImages(result);
-  for (const Image& image : images) {
-    WriteFileAtomically((dir / image.file).string(), [&](std::ostream& out) {
-      out.write(reinterpret_cast<const char*>(image.png.data()),
-                static_cast<std::streamsize>(image.png.size()));
-    });
-  }
+  const std::vector<ReportImage> images = RenderImages(scene, result);
+  WriteReportImages(out_dir, images);
   WriteText((dir / "junit.xml").string(), ScenarioJunitXml(scene, result));
   WriteText((dir / "report.html").string(), ScenarioHtml(scene, result, images));
   // The report last, naming what it covers.

@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <octomap/OcTree.h>
 
 #include <cmath>
 #include <cstdio>
@@ -249,6 +250,17 @@ TEST(Cli, MapScoresALogAgainstASceneAsRunScoresItsSimulation) {
   EXPECT_GT(scored["counts"]["true_positive_cells"].get<std::size_t>(), 0u);
   EXPECT_EQ(scored, simulated);
   EXPECT_NE(output.find("PASS cras-tank: 0/0 criteria met"), std::string::npos) << output;
+  EXPECT_NE(ReadFile(map / "report.html").find("<p class=\"verdict pass\">PASS"),
+            std::string::npos);
+  EXPECT_NE(XmlLint(map / "junit.xml"), 1);  // 0 when well-formed, -1 without xmllint
+  // The same map from its .ot file, scored by `score`, scores the same.
+  ASSERT_EQ(RunCli("score " + (map / "map.ot").string() + " --scene " + scene.string() + " --out " +
+                       (dir.path() / "score").string(),
+                   &output),
+            0)
+      << output;
+  EXPECT_EQ(nlohmann::json::parse(ReadFile(dir.path() / "score" / "report.json"))["metrics"],
+            scored);
 
   // The scene's criteria decide as they do for `run`: a missed one exits 1, outputs written.
   std::filesystem::create_directories(dir.path() / "strict");
@@ -266,6 +278,12 @@ TEST(Cli, MapScoresALogAgainstASceneAsRunScoresItsSimulation) {
   EXPECT_EQ(failed["criteria"]["results"][0]["metric"], "occupied_recall");
   EXPECT_EQ(failed["criteria"]["results"][0]["status"], "fail");
 
+  EXPECT_NE(ReadFile(map / "junit.xml").find("<failure type=\"criterion\""), std::string::npos);
+  // Unscored, a map has no junit.xml: the scored run's is removed, not left stale.
+  EXPECT_EQ(RunCli("map " + ds.string() + " --out " + map.string(), &output), 0) << output;
+  EXPECT_FALSE(std::filesystem::exists(map / "junit.xml"));
+  EXPECT_TRUE(std::filesystem::exists(map / "report.html"));
+
   EXPECT_EQ(RunCli("map " + ds.string() + " --score --out " + map.string(), &output), 2);
   EXPECT_NE(output.find("--score requires --scene"), std::string::npos) << output;
   const std::string moving = test::SourcePath("scenes/rocks-slope.yaml");
@@ -276,6 +294,83 @@ TEST(Cli, MapScoresALogAgainstASceneAsRunScoresItsSimulation) {
   EXPECT_NE(output.find("rocks-slope.yaml: the sonar moves along the scene's trajectory"),
             std::string::npos)
       << output;
+}
+
+// An OcTree file of resolution `resolution_m` with one occupied cell at each of `points` [m].
+std::string WriteOcTree(const std::filesystem::path& path, double resolution_m,
+                        const std::vector<octomap::point3d>& points) {
+  octomap::OcTree tree(resolution_m);
+  for (const octomap::point3d& p : points) tree.updateNode(p, true);
+  tree.writeBinary(path.string());
+  return path.string();
+}
+
+TEST(Cli, ScoreScoresAMapFileAsRunScoresItsOwnMap) {
+  test::TempDir dir;
+  const auto scene = TankSceneWithCriteria(dir.path(), "");
+  const auto run = dir.path() / "run";
+  const auto score = dir.path() / "score";
+  std::string output;
+  ASSERT_EQ(RunCli("run " + scene.string() + " --out " + run.string(), &output), 0) << output;
+  ASSERT_EQ(RunCli("score " + (run / "map.bt").string() + " --scene " + scene.string() + " --out " +
+                       score.string(),
+                   &output),
+            0)
+      << output;
+  const auto scored = nlohmann::json::parse(ReadFile(score / "report.json"));
+  const auto simulated = nlohmann::json::parse(ReadFile(run / "report.json"));
+  EXPECT_GT(scored["metrics"]["counts"]["true_positive_cells"].get<std::size_t>(), 0u);
+  EXPECT_EQ(scored["metrics"], simulated["metrics"]);
+  EXPECT_EQ(scored["map"]["format"], "bt");
+  EXPECT_EQ(scored["map"]["resolution_m"], 0.05);
+  EXPECT_EQ(scored["frame_check"]["occupied_in_reach"], 1.0);
+  // The same cells, so the same picture size (the PNG header's width and height); the titles
+  // differ (the seed, the map file).
+  for (const char* image : {"map_top.png", "map_side.png"}) {
+    EXPECT_EQ(ReadFile(score / image).substr(16, 8), ReadFile(run / image).substr(16, 8)) << image;
+  }
+  EXPECT_NE(ReadFile(score / "report.html").find("sonarbench score: cras-tank"), std::string::npos);
+  EXPECT_NE(XmlLint(score / "junit.xml"), 1);  // 0 when well-formed, -1 without xmllint
+  EXPECT_NE(output.find("PASS cras-tank: 0/0 criteria met"), std::string::npos) << output;
+
+  // The scene's criteria decide, with run's exit codes and junit failures.
+  std::filesystem::create_directories(dir.path() / "strict");
+  const auto strict = TankSceneWithCriteria(
+      dir.path() / "strict", "criteria:\n  metrics: {occupied_recall: {min: 0.99}}\n");
+  EXPECT_EQ(RunCli("score " + (run / "map.bt").string() + " --scene " + strict.string() +
+                       " --out " + score.string(),
+                   &output),
+            1)
+      << output;
+  EXPECT_NE(output.find("FAIL cras-tank: 0/1 criteria met"), std::string::npos) << output;
+  EXPECT_NE(ReadFile(score / "junit.xml").find("<failure type=\"criterion\""), std::string::npos);
+}
+
+TEST(Cli, ScoreRefusesMapsItCannotScoreAndWritesNothing) {
+  test::TempDir dir;
+  const auto scene = TankSceneWithCriteria(dir.path(), "");
+  const auto out = dir.path() / "out";
+  const std::string color = test::WriteFile(
+      dir, "color.bt", "# Octomap OcTree binary file\nid ColorOcTree\nsize 0\nres 0.05\ndata\n");
+  const std::string text = test::WriteFile(dir, "notes.bt", "not a map\n");
+  // Far from the tank: another frame. Tiny cells: a truth too large to build.
+  const std::string far =
+      WriteOcTree(dir.path() / "far.bt", 0.05, {{100, 100, 100}, {0, 0, 0}, {100, 99, 100}});
+  const std::string tiny = WriteOcTree(dir.path() / "tiny.bt", 1e-4, {{0.5F, 0.5F, 0.5F}});
+  for (const auto& [map, expected] : std::vector<std::pair<std::string, std::string>>{
+           {color, "ColorOcTree"},
+           {text, "the first line is 'not a map'"},
+           {far, "1 of its 3 occupied cells lie within reach"},
+           {tiny, "--max-cells"}}) {
+    std::string output;
+    EXPECT_EQ(
+        RunCli("score " + map + " --scene " + scene.string() + " --out " + out.string(), &output),
+        2)
+        << output;
+    EXPECT_NE(output.find(map + ": "), std::string::npos) << output;
+    EXPECT_NE(output.find(expected), std::string::npos) << output;
+    EXPECT_FALSE(std::filesystem::exists(out)) << map;
+  }
 }
 
 // sonarbench writes only into what it owns: a user's files of its outputs' names are refused by
@@ -318,14 +413,16 @@ TEST(Cli, NeverReplacesOrRemovesWhatItDidNotWrite) {
   std::ofstream(results / "junit.xml") << "mine";
   EXPECT_EQ(RunCli("run " + scene.string() + " --out " + results.string(), &output), 2);
   EXPECT_NE(output.find("did not write: junit.xml"), std::string::npos) << output;
+  EXPECT_EQ(RunCli("map " + logs.string() + " --out " + results.string(), &output), 2);
+  EXPECT_NE(output.find("did not write: junit.xml"), std::string::npos) << output;
+  fs::rename(results / "junit.xml", results / "notes.txt");
   EXPECT_EQ(RunCli("map " + logs.string() + " --out " + results.string(), &output), 0) << output;
-  std::ofstream(results / "junit.xml", std::ios::trunc) << "still mine";
   fs::remove(results / "map.bt");
   std::ofstream(results / "map.bt") << "my map";
-  // map.bt is listed as sonarbench's, so the user's copy under that name is replaced; junit.xml,
+  // map.bt is listed as sonarbench's, so the user's copy under that name is replaced; notes.txt,
   // which map never claimed, stays.
   EXPECT_EQ(RunCli("map " + logs.string() + " --out " + results.string(), &output), 0) << output;
-  EXPECT_EQ(ReadFile(results / "junit.xml"), "still mine");
+  EXPECT_EQ(ReadFile(results / "notes.txt"), "mine");
 
   // A symlinked --out is followed.
   fs::create_directories(dir.path() / "real");
@@ -359,7 +456,7 @@ TEST(Cli, VersionAndUnknownCommands) {
   EXPECT_EQ(RunCli("--version", &output), 0);
   EXPECT_EQ(output, "sonarbench " + std::string(kVersion) + "\n");
   EXPECT_EQ(RunCli("frobnicate scenes", &output), 2);
-  EXPECT_NE(output.find("unknown command 'frobnicate'; the commands are run, map, fidelity, "
+  EXPECT_NE(output.find("unknown command 'frobnicate'; the commands are run, map, score, fidelity, "
                         "simulate, sweep, import"),
             std::string::npos)
       << output;

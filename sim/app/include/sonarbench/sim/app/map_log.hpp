@@ -71,12 +71,15 @@ struct LogMapResult {
 [[nodiscard]] MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene);
 
 /// The files WriteLogMapOutputs writes, relative to its `out_dir`.
-inline const std::vector<std::string> kLogMapOutputFiles = {"map.bt",    "map.ot",  "map_top.png",
-                                                            "polar.png", "fan.png", "report.json"};
+inline const std::vector<std::string> kLogMapOutputFiles = {
+    "map.bt", "map.ot", "map_top.png", "polar.png", "fan.png", "report.html", "junit.xml",
+    "report.json"};
 
-/// Writes `map.bt`, `map.ot`, `map_top.png`, `polar.png`, `fan.png` and `report.json` (with the
-/// scores under "metrics" if the map was scored, and the sha256 of the others under
+/// Writes `map.bt`, `map.ot`, `map_top.png`, `polar.png`, `fan.png`, `report.html`, with
+/// `scene` and a verdict (the map scored against it) `junit.xml`, and `report.json` (the scores
+/// under "metrics", verdict and criteria if scored, and the sha256 of the others under
 /// "files_sha256") into `out_dir`, each atomically, the report last.
-void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result);
+void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
+                        const Scene* scene = nullptr);
 
 }  // namespace sonarbench::sim

@@ -1,0 +1,212 @@
+#include "sonarbench/sim/app/score_map.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/report/report.hpp"
+#include "sonarbench/sim/report/report_page.hpp"
+#include "sonarbench/sim/report/scenario_report.hpp"
+#include "sonarbench/sim/sonar/simulation.hpp"
+#include "sonarbench/sim/world/mesh.hpp"
+#include "sonarbench/sim/world/ray_tracer.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+// OctoMap's keys address ±2^15 cells around the origin.
+constexpr double kKeyHalfRange = 32768.0;
+
+double SecondsSince(std::chrono::steady_clock::time_point& start) {
+  const auto now = std::chrono::steady_clock::now();
+  const double seconds = std::chrono::duration<double>(now - start).count();
+  start = now;
+  return seconds;
+}
+
+std::string Metres(const Eigen::Vector3d& p) {
+  char text[96];
+  std::snprintf(text, sizeof text, "(%.2f, %.2f, %.2f)", p.x(), p.y(), p.z());
+  return text;
+}
+
+std::string Percent(double share) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f%%", 100.0 * share);
+  return text;
+}
+
+// Refuses a resolution at which the scene's truth is over budget, before anything is built.
+void CheckTruthBudget(const std::string& map_file, double resolution_m, const Scene& scene,
+                      const Budgets& budgets) {
+  Scene at_map = scene;
+  at_map.mapping.resolution_m = resolution_m;
+  const double cells = EstimateScene(at_map).truth_cells;
+  if (!(cells <= budgets.max_cells)) {
+    throw InputError(map_file + ": at the map's resolution " + std::to_string(resolution_m) +
+                     " m the ground truth of " + scene.file + " takes about " +
+                     std::to_string(cells) + " cells, over the limit of " +
+                     std::to_string(budgets.max_cells) + " (--max-cells raises it)");
+  }
+}
+
+// Refuses a scene whose surfaces reach past the keys a map of `resolution_m` addresses.
+void CheckKeyRange(const std::string& map_file, double resolution_m, const Scene& scene,
+                   const std::vector<TriangleMesh>& meshes) {
+  const double reach = kKeyHalfRange * resolution_m;
+  for (const TriangleMesh& mesh : meshes) {
+    for (const Eigen::Vector3f& v : mesh.vertices) {
+      if (v.cast<double>().cwiseAbs().maxCoeff() < reach) continue;
+      throw InputError(map_file + ": a map of resolution " + std::to_string(resolution_m) +
+                       " m addresses only ±" + std::to_string(reach) + " m; mesh '" + mesh.name +
+                       "' of " + scene.file + " reaches " + Metres(v.cast<double>()));
+    }
+  }
+}
+
+// The frame check: the box the sonar reaches and the share of occupied cells inside it.
+void CheckFrame(MapFileScore& s, const Scene& scene, const std::vector<BeamPose>& poses) {
+  const double range = scene.sensor.geometry.MaxRangeM();
+  for (std::size_t b = 0; b < poses.size(); ++b) {
+    const Eigen::Vector3d p = poses[b].T_world_sonar.translation();
+    s.reach_lo_m = b == 0 ? p : s.reach_lo_m.cwiseMin(p);
+    s.reach_hi_m = b == 0 ? p : s.reach_hi_m.cwiseMax(p);
+  }
+  s.reach_lo_m.array() -= range;
+  s.reach_hi_m.array() += range;
+  const MapCells cells = CollectMapCells(*s.map);
+  std::size_t inside = 0;
+  for (const octomap::OcTreeKey& key : cells.occupied) {
+    const Eigen::Vector3d c(s.map->keyToCoord(key[0]), s.map->keyToCoord(key[1]),
+                            s.map->keyToCoord(key[2]));
+    inside +=
+        (c.array() >= s.reach_lo_m.array()).all() && (c.array() <= s.reach_hi_m.array()).all();
+  }
+  if (cells.occupied.empty()) return;
+  s.occupied_in_reach = static_cast<double>(inside) / static_cast<double>(cells.occupied.size());
+  if (s.occupied_in_reach >= kMinOccupiedInReach) return;
+  throw InputError(s.map_file + ": " + std::to_string(inside) + " of its " +
+                   std::to_string(cells.occupied.size()) +
+                   " occupied cells lie within reach of the sonar of " + scene.file + " (the box " +
+                   Metres(s.reach_lo_m) + " to " + Metres(s.reach_hi_m) +
+                   " m: its trajectory grown by its range); a map is scored in the scene's world "
+                   "frame, in metres. Is this map in another frame?");
+}
+
+double TotalSeconds(const MapFileScore& s) { return s.read_s + s.ground_truth_s + s.score_s; }
+
+std::string ScoreHtml(const Scene& scene, const MapFileScore& s,
+                      const std::vector<ReportImage>& images) {
+  const Verdict& v = s.verdict;
+  std::ostringstream html;
+  html << HtmlPageStart("sonarbench: " + scene.name + " " + (v.passed ? "PASS" : "FAIL"),
+                        "sonarbench score: " + scene.name, &v);
+  html << "<p>Map <code>" << XmlEscape(s.map_file) << "</code> (." << s.file.format << ", "
+       << s.file.resolution_m << " m cells, " << s.file.nodes << " nodes) against scene <code>"
+       << XmlEscape(scene.file) << "</code>, sensor model <code>"
+       << XmlEscape(scene.sensor_model_file) << "</code>, the truth seen from the "
+       << ScenarioBeamCount(scene) << " beams of its trajectory; " << Seconds(TotalSeconds(s))
+       << " s.</p>\n<p>Frame check: " << Percent(s.occupied_in_reach)
+       << " of the map's occupied cells lie within the sonar's reach, the box "
+       << Metres(s.reach_lo_m) << " to " << Metres(s.reach_hi_m) << " m (at least "
+       << Percent(kMinOccupiedInReach) << " must).</p>\n";
+  html << CriteriaHtml(v) << MetricsHtml(s.metrics) << ImagesHtmlAndEnd(images);
+  return html.str();
+}
+
+nlohmann::json Vector(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+
+}  // namespace
+
+MapFileScore ScoreMapFile(const std::string& map_file, const Scene& scene, const Budgets& budgets,
+                          const StageProgress& progress) {
+  auto clock = std::chrono::steady_clock::now();
+  MapFileScore s;
+  s.map_file = map_file;
+  s.map = mapping::ReadOcTreeFile(map_file, budgets.max_cells, &s.file);
+  CheckTruthBudget(map_file, s.file.resolution_m, scene, budgets);
+  std::vector<BeamPose> poses;
+  for (std::size_t b = 0; b < ScenarioBeamCount(scene); ++b) {
+    poses.push_back(ScheduleBeam(scene, b).pose);
+  }
+  if (!poses.empty()) s.sonar_start_m = poses.front().T_world_sonar.translation();
+  CheckFrame(s, scene, poses);
+  s.read_s = SecondsSince(clock);
+
+  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
+  CheckKeyRange(map_file, s.file.resolution_m, scene, meshes);
+  const RayTracer tracer(meshes);
+  s.truth = VoxelizeMeshes(meshes, *s.map);
+  s.observable = PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics,
+                                    *s.map, progress);
+  s.ground_truth_s = SecondsSince(clock);
+  s.metrics = ScoreMap(*s.map, s.truth, s.observable, meshes);
+  s.verdict = Evaluate(scene.criteria, s.metrics);
+  if (s.metrics.ghost_share > kGhostShareWarning) {
+    s.verdict.warnings.push_back(
+        FormatMetricValue(s.metrics.ghost_share) +
+        " of the map's occupied cells lie more than 2 "
+        "cells from every surface of the scene: is the map in the scene's frame (origin, axes, "
+        "metres)?");
+  }
+  s.score_s = SecondsSince(clock);
+  return s;
+}
+
+void WriteMapFileScoreOutputs(const std::string& out_dir, const Scene& scene,
+                              const MapFileScore& s) {
+  CreateOutputDirectory(out_dir);
+  const std::vector<ReportImage> images =
+      MapTruthImages(*s.map, s.truth, s.observable, s.sonar_start_m,
+                     scene.name + ", " + std::filesystem::path(s.map_file).filename().string());
+  WriteReportImages(out_dir, images);
+  WriteFileAtomically(out_dir + "/junit.xml", [&](std::ostream& out) {
+    out << ScoredJunitXml(scene, "score", s.map_file,
+                          {{"scene_file", scene.file}, {"map_file", s.map_file}}, s.verdict,
+                          TotalSeconds(s));
+  });
+  WriteFileAtomically(out_dir + "/report.html",
+                      [&](std::ostream& out) { out << ScoreHtml(scene, s, images); });
+  nlohmann::json report = ReportHeader();
+  report["schema_version"] = kScenarioReportSchema;
+  const MapCells cells = CollectMapCells(*s.map);
+  report.update({{"scene",
+                  {{"name", scene.name},
+                   {"file", scene.file},
+                   {"extends", scene.extends},
+                   {"sensor_model", scene.sensor_model_file}}},
+                 {"map",
+                  {{"file", s.map_file},
+                   {"format", s.file.format},
+                   {"resolution_m", s.file.resolution_m},
+                   {"nodes", s.file.nodes},
+                   {"occupied_cells", cells.occupied.size()},
+                   {"free_cells", cells.free.size()}}},
+                 {"frame_check",
+                  {{"reach_lo_m", Vector(s.reach_lo_m)},
+                   {"reach_hi_m", Vector(s.reach_hi_m)},
+                   {"occupied_in_reach", s.occupied_in_reach},
+                   {"min_occupied_in_reach", kMinOccupiedInReach}}},
+                 {"beams", ScenarioBeamCount(scene)},
+                 {"verdict", VerdictJson(s.verdict)},
+                 {"criteria", CriteriaJson(s.verdict)},
+                 {"metrics", MetricsJson(s.metrics)},
+                 {"timing",
+                  {{"read_s", s.read_s},
+                   {"ground_truth_s", s.ground_truth_s},
+                   {"score_s", s.score_s},
+                   {"total_s", TotalSeconds(s)}}},
+                 {"outputs",
+                  {{"map_top", "map_top.png"},
+                   {"map_side", "map_side.png"},
+                   {"junit", "junit.xml"},
+                   {"html", "report.html"}}}});
+  std::vector<std::string> covered = kMapFileScoreOutputFiles;
+  std::erase(covered, "report.json");
+  report["files_sha256"] = FilesSha256(out_dir, covered);
+  WriteJson(out_dir + "/report.json", report);
+}
+
+}  // namespace sonarbench::sim
