@@ -151,13 +151,18 @@ Eigen::Isometry3d StaticSonarPose(const Scene& scene) {
   return first;
 }
 
-MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene) {
+MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene, mapping::KeySet* truth,
+                       mapping::KeySet* observable) {
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
   const octomap::OcTree& map = result.mapper->tree();
-  return ScoreMap(
-      map, VoxelizeMeshes(meshes, map),
-      PerfectSensorCells(tracer, result.poses, result.sensor, scene.sensor.acoustics, map), meshes);
+  mapping::KeySet surface = VoxelizeMeshes(meshes, map);
+  mapping::KeySet seen =
+      PerfectSensorCells(tracer, result.poses, result.sensor, scene.sensor.acoustics, map);
+  const MapMetrics metrics = ScoreMap(map, surface, seen, meshes);
+  if (truth) *truth = std::move(surface);
+  if (observable) *observable = std::move(seen);
+  return metrics;
 }
 
 namespace {
@@ -245,20 +250,29 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
   result.mapper->WriteFull((dir / "map.ot").string());
   const MapCells cells = CollectMapCells(result.mapper->tree());
   const std::string name = fs::path(result.input).filename().string();
-  MapView top;
-  top.resolution_m = result.mapper->config().resolution_m;
-  top.title = name + ": map from above";
-  const std::vector<ReportImage> images = {
-      {"map_top.png",
-       "Occupied cells from above (white), free cells grey, whole pixels per column.",
-       EncodePng(RenderMapView(cells, {}, {}, top))},
-      {"polar.png", "First sweep, polar: one row per beam in time order, range to the right.",
-       EncodePng(RenderPolarImage(result.first_sweep, name + ": first sweep, polar"))},
-      {"fan.png", "First sweep, Cartesian fan from above: the sonar at the centre, 1 cm per pixel.",
-       EncodePng(RenderFanImage(result.first_sweep, 0.01, name + ": first sweep, fan"))},
-  };
-  WriteReportImages(out_dir, images);
   const bool scored = scene && result.verdict;
+  std::vector<ReportImage> images;
+  if (scored) {
+    Eigen::Vector3d sonar = Eigen::Vector3d::Zero();
+    if (!result.poses.empty()) sonar = result.poses.front().T_world_sonar.translation();
+    images = MapTruthImages(result.mapper->tree(), result.truth, result.observable, sonar,
+                            scene->name + ", " + name);
+  } else {
+    MapView top;
+    top.resolution_m = result.mapper->config().resolution_m;
+    top.title = name + ": map from above";
+    images.push_back(
+        {"map_top.png",
+         "Occupied cells from above (white), free cells grey, whole pixels per column.",
+         EncodePng(RenderMapView(cells, {}, {}, top))});
+  }
+  images.push_back(
+      {"polar.png", "First sweep, polar: one row per beam in time order, range to the right.",
+       EncodePng(RenderPolarImage(result.first_sweep, name + ": first sweep, polar"))});
+  images.push_back(
+      {"fan.png", "First sweep, Cartesian fan from above: the sonar at the centre, 1 cm per pixel.",
+       EncodePng(RenderFanImage(result.first_sweep, 0.01, name + ": first sweep, fan"))});
+  WriteReportImages(out_dir, images);
   if (scored) {
     WriteFileAtomically((dir / "junit.xml").string(), [&](std::ostream& out) {
       out << ScoredJunitXml(*scene, "map", result.input,
@@ -270,7 +284,10 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
     out << LogMapHtml(result, scored ? scene : nullptr, images, cells);
   });
   nlohmann::json report = LogMapReportJson(result, cells);
-  if (scored) report["outputs"]["junit"] = "junit.xml";
+  if (scored) {
+    report["outputs"]["junit"] = "junit.xml";
+    report["outputs"]["map_side"] = "map_side.png";
+  }
   if (result.metrics) report["metrics"] = MetricsJson(*result.metrics);
   if (result.verdict) {
     report["verdict"] = VerdictJson(*result.verdict);
@@ -279,7 +296,10 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
   if (!result.warnings.empty()) report["warnings"] = result.warnings;
   std::vector<std::string> covered = kLogMapOutputFiles;
   std::erase(covered, "report.json");
-  if (!scored) std::erase(covered, "junit.xml");
+  if (!scored) {
+    std::erase(covered, "junit.xml");
+    std::erase(covered, "map_side.png");
+  }
   report["files_sha256"] = FilesSha256(out_dir, covered);
   WriteJson((dir / "report.json").string(), report);
 }

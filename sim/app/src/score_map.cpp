@@ -171,19 +171,14 @@ void WriteMapFileScoreOutputs(const std::string& out_dir, const Scene& scene,
                       [&](std::ostream& out) { out << ScoreHtml(scene, s, images); });
   nlohmann::json report = ReportHeader();
   report["schema_version"] = kScenarioReportSchema;
-  const MapCells cells = CollectMapCells(*s.map);
-  report.update({{"scene",
-                  {{"name", scene.name},
-                   {"file", scene.file},
-                   {"extends", scene.extends},
-                   {"sensor_model", scene.sensor_model_file}}},
+  report.update({{"scene", SceneJson(scene)},
                  {"map",
                   {{"file", s.map_file},
                    {"format", s.file.format},
                    {"resolution_m", s.file.resolution_m},
                    {"nodes", s.file.nodes},
-                   {"occupied_cells", cells.occupied.size()},
-                   {"free_cells", cells.free.size()}}},
+                   {"occupied_cells", s.metrics.occupied_cells},
+                   {"free_cells", s.metrics.free_cells}}},
                  {"frame_check",
                   {{"reach_lo_m", Vector(s.reach_lo_m)},
                    {"reach_hi_m", Vector(s.reach_hi_m)},

@@ -191,6 +191,13 @@ void WriteText(const std::string& path, const std::string& text) {
 
 }  // namespace
 
+nlohmann::json SceneJson(const Scene& scene) {
+  return {{"name", scene.name},
+          {"file", scene.file},
+          {"extends", scene.extends},
+          {"sensor_model", scene.sensor_model_file}};
+}
+
 nlohmann::json VerdictJson(const Verdict& v) {
   return {{"passed", v.passed}, {"reasons", v.reasons}, {"warnings", v.warnings}};
 }
@@ -248,11 +255,7 @@ nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& resu
   const StageTimings& t = result.timings;
   nlohmann::json report = ReportHeader();
   report["schema_version"] = kScenarioReportSchema;
-  report.update({{"scene",
-                  {{"name", scene.name},
-                   {"file", scene.file},
-                   {"extends", scene.extends},
-                   {"sensor_model", scene.sensor_model_file}}},
+  report.update({{"scene", SceneJson(scene)},
                  {"verdict", VerdictJson(result.verdict)},
                  {"criteria", CriteriaJson(result.verdict)},
                  {"seed", result.seed},

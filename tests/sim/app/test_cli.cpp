@@ -279,9 +279,11 @@ TEST(Cli, MapScoresALogAgainstASceneAsRunScoresItsSimulation) {
   EXPECT_EQ(failed["criteria"]["results"][0]["status"], "fail");
 
   EXPECT_NE(ReadFile(map / "junit.xml").find("<failure type=\"criterion\""), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(map / "map_side.png"));  // scored: the map against truth
   // Unscored, a map has no junit.xml: the scored run's is removed, not left stale.
   EXPECT_EQ(RunCli("map " + ds.string() + " --out " + map.string(), &output), 0) << output;
   EXPECT_FALSE(std::filesystem::exists(map / "junit.xml"));
+  EXPECT_FALSE(std::filesystem::exists(map / "map_side.png"));
   EXPECT_TRUE(std::filesystem::exists(map / "report.html"));
 
   EXPECT_EQ(RunCli("map " + ds.string() + " --score --out " + map.string(), &output), 2);

@@ -31,8 +31,11 @@ struct LogMapResult {
   mapping::SensorGeometry sensor;
   /// Every beam's pose as mapped.
   std::vector<BeamPose> poses;
-  /// The map scored against a scene's surfaces (ScoreLogMap), if it was.
+  /// The map scored against a scene's surfaces (ScoreLogMap), if it was; the scene's surface
+  /// cells and those a perfect sensor sees, for the map's images.
   std::optional<MapMetrics> metrics;
+  mapping::KeySet truth;
+  mapping::KeySet observable;
   /// The metrics against the scene's criteria, when scored.
   std::optional<Verdict> verdict;
   /// What the user should know about the score (a dataset simulated from other scene files).
@@ -67,18 +70,22 @@ struct LogMapResult {
 /// Scores `result`'s map against `scene`'s surfaces as `sonarbench run` scores a simulated one
 /// (ScoreMap): the truth voxelised from the scene's meshes, the cells a perfect sensor could see
 /// from the poses the log's beams were mapped from, rays twice as dense as the scene's sensor
-/// samples each beam, over the log's own beam geometry.
-[[nodiscard]] MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene);
+/// samples each beam, over the log's own beam geometry. The surface and observable cells go to
+/// `truth` and `observable` when given.
+[[nodiscard]] MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene,
+                                     mapping::KeySet* truth = nullptr,
+                                     mapping::KeySet* observable = nullptr);
 
 /// The files WriteLogMapOutputs writes, relative to its `out_dir`.
 inline const std::vector<std::string> kLogMapOutputFiles = {
-    "map.bt", "map.ot", "map_top.png", "polar.png", "fan.png", "report.html", "junit.xml",
-    "report.json"};
+    "map.bt",  "map.ot",      "map_top.png", "map_side.png", "polar.png",
+    "fan.png", "report.html", "junit.xml",   "report.json"};
 
 /// Writes `map.bt`, `map.ot`, `map_top.png`, `polar.png`, `fan.png`, `report.html`, with
-/// `scene` and a verdict (the map scored against it) `junit.xml`, and `report.json` (the scores
-/// under "metrics", verdict and criteria if scored, and the sha256 of the others under
-/// "files_sha256") into `out_dir`, each atomically, the report last.
+/// `scene` and a verdict (the map scored against it) `junit.xml` and `map_side.png` (the map
+/// images then against the truth), and `report.json` (the scores under "metrics", verdict and
+/// criteria if scored, and the sha256 of the others under "files_sha256") into `out_dir`, each
+/// atomically, the report last.
 void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
                         const Scene* scene = nullptr);
 

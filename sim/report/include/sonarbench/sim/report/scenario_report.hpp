@@ -17,6 +17,9 @@ inline constexpr int kScenarioReportSchema = 2;
 /// free accuracy, per mesh, surface distances and the counts behind each.
 [[nodiscard]] nlohmann::json MetricsJson(const MapMetrics& m);
 
+/// report.json's "scene": its name, file, the file it extends and its sensor model's file.
+[[nodiscard]] nlohmann::json SceneJson(const Scene& scene);
+
 /// report.json's "verdict" (passed, reasons, warnings) and "criteria" (each criterion's bounds,
 /// actual, expected, margin and status) of a map scored against a scene's criteria.
 [[nodiscard]] nlohmann::json VerdictJson(const Verdict& v);
