@@ -3,7 +3,8 @@
 
 Usage: fuzz/make_corpus.py [DATASET]   (run from anywhere; writes fuzz/corpus/ and fuzz/dict/)
 
-The OctoMap seeds are small trees written in both formats here, byte for byte as OctoMap would.
+The OctoMap seeds are small trees written in both formats here, byte for byte as OctoMap would;
+the ROS 2 bag seeds are small MCAP files written here record by record (docs/ros2.md).
 DATASET is a folder `sonarbench simulate` wrote; its manifest, first beams and poses seed the
 dataset harness, cut to a few beams. The .mat seeds (the real log's first beams) are written by
 libmatio and kept as they are. Files a harness found are kept in the corpus beside these.
@@ -12,8 +13,10 @@ import hashlib
 import json
 import pathlib
 import re
+import math
 import struct
 import sys
+import zlib
 
 import yaml
 
@@ -156,9 +159,90 @@ def octrees():
         write(CORPUS / "octomap" / (name + ".ot"), ot)
 
 
+def cdr(*fields):
+    """CDR little-endian bytes of (format, value) fields, each aligned to its size."""
+    out = bytearray(b"\x00\x01\x00\x00")
+    for fmt, value in fields:
+        if fmt == "s":
+            data = value.encode() + b"\x00"
+            fields_out = struct.pack("<I", len(data)) + data
+            size = 4
+        elif fmt == "B*":
+            fields_out = struct.pack("<I", len(value)) + bytes(value)
+            size = 4
+        else:
+            fields_out = struct.pack("<" + fmt, value)
+            size = struct.calcsize(fmt)
+        while (len(out) - 4) % size:
+            out += b"\x00"
+        out += fields_out
+    return bytes(out)
+
+
+def header(sec, frame):
+    return [("i", sec), ("I", 0), ("s", frame)]
+
+
+def sonar_image(sec, angle, bins):
+    fields = header(sec, "sonar") + [("f", 0.0), ("f", 1500.0), ("I", 1), ("f", 35 * math.pi / 180),
+                                     ("I", 1), ("f", 3 * math.pi / 180), ("I", 1),
+                                     ("d", math.cos(angle)), ("d", math.sin(angle)), ("d", 0.0),
+                                     ("I", len(bins))]
+    fields += [("f", (k + 0.5) * 0.012531) for k in range(len(bins))]
+    return cdr(*fields, ("B", 0), ("I", 0), ("I", 1), ("B*", bins))
+
+
+def tf_message(sec, parent, child, x):
+    return cdr(("I", 1), *header(sec, parent), ("s", child), ("d", x), ("d", 0.0), ("d", 0.0),
+               ("d", 0.0), ("d", 0.0), ("d", 0.0), ("d", 1.0))
+
+
+def mcap(records_of_data, chunked):
+    """An MCAP file: header, schemas and channels, messages (in one chunk or not), a summary."""
+    def record(op, body):
+        return struct.pack("<BQ", op, len(body)) + body
+
+    def string(text):
+        data = text.encode() if isinstance(text, str) else text
+        return struct.pack("<I", len(data)) + data
+
+    schemas = [(1, "marine_acoustic_msgs/msg/ProjectedSonarImage"), (2, "tf2_msgs/msg/TFMessage")]
+    channels = [(1, 1, "/sonar/image"), (2, 2, "/tf"), (3, 2, "/tf_static")]
+    head = b"\x89MCAP0\r\n" + record(1, string("ros2") + string("make_corpus.py"))
+    meta = b"".join(record(3, struct.pack("<H", i) + string(n) + string("ros2msg") + string(""))
+                    for i, n in schemas)
+    meta += b"".join(record(4, struct.pack("<HH", i, s) + string(t) + string("cdr") + string(b""))
+                     for i, s, t in channels)
+    messages = b"".join(record(5, struct.pack("<HIQQ", ch, 0, t, t) + data)
+                        for ch, t, data in records_of_data)
+    if chunked:
+        times = [t for _, t, _ in records_of_data]
+        body = struct.pack("<QQQI", min(times), max(times), len(messages), zlib.crc32(messages))
+        messages = record(6, body + string("") + struct.pack("<Q", len(messages)) + messages)
+    data = head + meta + messages + record(15, struct.pack("<I", 0))
+    summary_start = len(data)
+    summary = meta + record(11, struct.pack("<QHIIIIQQ", len(records_of_data), 2, 3, 0, 0,
+                                            int(chunked), 0, 0) + string(b""))
+    footer = struct.pack("<BQQQ", 2, 20, summary_start, 0)
+    crc = zlib.crc32(summary + footer)
+    return data + summary + footer + struct.pack("<I", crc) + b"\x89MCAP0\r\n"
+
+
+def bags():
+    second = 1000000000
+    messages = [(3, 0, tf_message(0, "base_link", "sonar", 0.2))]
+    for b in range(3):
+        messages.append((2, b * second, tf_message(b, "map", "base_link", 0.1 * b)))
+        messages.append((1, b * second, sonar_image(b, 0.9 * b, [(b * 40 + k * 9) % 256
+                                                                for k in range(12)])))
+    write(CORPUS / "rosbag" / "chunked.mcap", mcap(messages, True))
+    write(CORPUS / "rosbag" / "flat.mcap", mcap(messages, False))
+
+
 if __name__ == "__main__":
     scenes()
     meshes()
     octrees()
+    bags()
     if len(sys.argv) > 1:
         dataset(sys.argv[1])

@@ -4,11 +4,13 @@
     python3 tools/mutate_inputs.py build/sim/sonarbench scene scenes/cras-tank.yaml --cases 400
     python3 tools/mutate_inputs.py build/sim/sonarbench mat data/cras-tank-static/dataset_static.mat
     python3 tools/mutate_inputs.py build/sim/sonarbench mesh scenes/meshes/quay_wall.ply --seed 9
+    python3 tools/mutate_inputs.py build/sim/sonarbench bag fuzz/corpus/rosbag/flat.mcap
 
 scene: each `key: value` line's value replaced by one of a set of bad values (a negative, zero,
     huge, NaN, a string, "", a list, a mapping, null), the copy simulated (`simulate --shard
     1/1000`: the scene is read whole, one sweep is made);
-mat: the file cut at fixed offsets, then copies with 1-8 bytes changed, each imported;
+mat, bag: the file cut at fixed offsets, then copies with 1-8 bytes changed, each imported (a
+    .mat log, or a ROS 2 bag);
 mesh: copies cut, with bytes or digits changed or a run of bytes repeated, each loaded as the one
     mesh of a small scene and simulated.
 
@@ -81,7 +83,7 @@ def byte_cases(data, rng, count, kinds):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('sonarbench')
-    parser.add_argument('kind', choices=['scene', 'mat', 'mesh'])
+    parser.add_argument('kind', choices=['scene', 'mat', 'bag', 'mesh'])
     parser.add_argument('input')
     parser.add_argument('--cases', type=int, default=100)
     parser.add_argument('--seed', type=int, default=1)
@@ -95,10 +97,11 @@ def main():
     if args.kind == 'scene':
         cases = scene_cases(args.input, rng)[:args.cases]
         command = ['simulate', target, '--out', out, '--shard', '1/1000', '--no-progress']
-    elif args.kind == 'mat':
+    elif args.kind in ('mat', 'bag'):
         data = open(args.input, 'rb').read()
         cuts = [0, 1, 4, 127, 128, 129, 135, 136, 200, 1000, len(data) // 4, len(data) // 2,
                 len(data) - 1]
+        cuts = [c for c in cuts if c < len(data)]
         cases = [('cut %d' % c, data[:c]) for c in cuts]
         cases += byte_cases(data, rng, max(args.cases - len(cases), 0), ['flip'])
         command = ['import', target, '--out', out]

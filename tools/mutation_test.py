@@ -118,6 +118,18 @@ MUTANTS = [
      "3 * (kTreeDepth - depth)", "3 * (kTreeDepth - depth - 1)", None),
     ("octomap-inner-code", "mapping/io/src/octomap_file.cpp",
      "inner[i] = code == 3;", "inner[i] = code == 2;", None),
+    ("mcap-chunk-crc", "mapping/io/src/mcap.cpp",
+     "if (crc != 0 && Crc32(plain) != crc)", "if (false && Crc32(plain) != crc)", None),
+    ("mcap-closing-magic", "mapping/io/src/mcap.cpp",
+     "if (file_.size() - end != kMagicSize ||", "if (false &&", None),
+    ("mcap-summary-crc", "mapping/io/src/mcap.cpp",
+     "crc_end = offset + 1 + 8 + 8 + 8;", "crc_end = offset + 1 + 8 + 8;", None),
+    ("rosbag-bins-equal", "mapping/io/src/rosbag.cpp",
+     "> 1e-3 * d) {", "> 1e3 * d) {", None),
+    ("rosbag-interpolate", "mapping/io/src/rosbag.cpp",
+     "(1 - s) * a.translation()", "s * a.translation()", None),
+    ("rosbag-head-angle", "mapping/io/src/rosbag.cpp",
+     "if (a < 0.0) a += kTwoPi;", "if (a < -1.0) a += kTwoPi;", None),
 ]
 
 

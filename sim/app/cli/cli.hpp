@@ -42,6 +42,7 @@ Command AddFidelityCommand(CLI::App& app);
 Command AddSimulateCommand(CLI::App& app);
 Command AddSweepCommand(CLI::App& app);
 Command AddImportCommand(CLI::App& app);
+Command AddExportCommand(CLI::App& app);
 
 // One self-overwriting progress line on stderr (stage, sweeps done, rate, time left), shown only
 // on an interactive terminal outside CI, at most five times a second.

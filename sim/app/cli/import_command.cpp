@@ -1,8 +1,13 @@
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 
 #include "cli.hpp"
 #include "sonarbench/io/mat_log.hpp"
+#include "sonarbench/io/mcap.hpp"
+#include "sonarbench/io/rosbag.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/world/sensor_model.hpp"
@@ -14,14 +19,55 @@ struct ImportArgs {
   std::string log;
   std::string out;
   std::string sensor;
+  std::string topic;
+  bool static_sonar = false;
   bool force = false;
 };
 
+// A ROS 2 bag's beams, posed by its transforms (or static at the origin with --static).
+sim::ImportedLog ReadBag(const ImportArgs& args, const mapping::SensorGeometry& sensor) {
+  mapping::RosbagReadOptions options;
+  options.sensor = sensor;
+  options.topic = args.topic;
+  options.static_sonar = args.static_sonar;
+  mapping::RosbagBeams bag = mapping::ReadRosbag(args.log, options);
+  bool moves = false;
+  for (const mapping::Beam& beam : bag.beams) {
+    moves = moves || !beam.T_world_sonar.isApprox(bag.beams.front().T_world_sonar, 1e-12);
+  }
+  sim::ImportedLog log{std::move(bag.beams), bag.truncated_beams, {}, {}};
+  log.info = {{"format", "mcap"},
+              {"topic", bag.topic},
+              {"sonar_frame", bag.sonar_frame},
+              {"world_frame", bag.world_frame},
+              {"poses", args.static_sonar ? "static" : (moves ? "tf, moving" : "tf, static")},
+              {"beams_outside_tf", bag.beams_outside_tf}};
+  log.options = {{"topic", args.topic}, {"static", args.static_sonar}};
+  if (bag.beams_outside_tf > 0) {
+    std::cout << bag.beams_outside_tf
+              << " beams left out: the transforms do not cover their time\n";
+  }
+  return log;
+}
+
 int Import(const ImportArgs& args) {
   namespace sim = sonarbench::sim;
-  sonarbench::mapping::SensorGeometry sensor;
+  mapping::SensorGeometry sensor;
   if (!args.sensor.empty()) sensor = sim::LoadSensorModel(args.sensor).geometry;
-  const sonarbench::mapping::MatLog log = sonarbench::mapping::ReadMatLog(args.log);
+  // A bag by its magic bytes, whatever its name; anything else is read as a .mat log.
+  char magic[8] = {};
+  std::ifstream(args.log, std::ios::binary).read(magic, sizeof magic);
+  const bool bag = std::memcmp(magic, mapping::kMcapMagic, sizeof magic) == 0 ||
+                   std::filesystem::path(args.log).extension() == ".mcap";
+  if (!bag && (!args.topic.empty() || args.static_sonar)) {
+    throw InputError("--topic and --static apply to ROS 2 bags (.mcap), not to " + args.log);
+  }
+  sim::ImportedLog log;
+  if (bag) {
+    log = ReadBag(args, sensor);
+  } else {
+    log = sim::ImportedMatLog(mapping::ReadMatLog(args.log));
+  }
   const sim::DatasetSummary summary =
       sim::ImportLogDataset(args.log, log, sensor, args.out, args.force);
   if (summary.already_complete) {
@@ -37,12 +83,18 @@ int Import(const ImportArgs& args) {
 CLI::App* AddOptions(CLI::App& app, ImportArgs& args) {
   CLI::App* command = app.add_subcommand(
       "import",
-      "Write a real .mat log as a dataset directory (the format `simulate` writes, without "
-      "truth), so `sonarbench map DIR` and other tools read both the same way.");
-  command->add_option("log", args.log, "Real log (.mat)")->required()->check(CLI::ExistingFile);
+      "Write a recorded log, a .mat log or a ROS 2 bag (.mcap), as a dataset directory (the "
+      "format `simulate` writes, without truth), so `sonarbench map DIR` reads both the same way.");
+  command->add_option("log", args.log, "Real log (.mat) or ROS 2 bag (.mcap)")
+      ->required()
+      ->check(CLI::ExistingFile);
   command->add_option("-o,--out", args.out, "Dataset directory")->required();
   command->add_option("--sensor", args.sensor, "Sensor model YAML (default: the SHAD Micron)")
       ->check(CLI::ExistingFile);
+  command->add_option("--topic", args.topic,
+                      "The bag's ProjectedSonarImage topic (default: its only one)");
+  command->add_flag("--static", args.static_sonar,
+                    "Bag without transforms: the sonar static at the origin, as a .mat log");
   command->add_flag("--force", args.force, "Replace an existing dataset");
   return command;
 }

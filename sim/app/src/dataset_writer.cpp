@@ -383,15 +383,20 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   return summary;
 }
 
-DatasetSummary ImportLogDataset(const std::string& log_path, const mapping::MatLog& log,
+ImportedLog ImportedMatLog(mapping::MatLog log) {
+  return {std::move(log.beams), log.truncated_beams, json::object(), json::object()};
+}
+
+DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& log,
                                 const mapping::SensorGeometry& sensor, const std::string& dir,
                                 bool force) {
   DatasetSummary summary;
   const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
   summary.sweeps_total = (log.beams.size() + per_sweep - 1) / per_sweep;
-  const json inputs = {{"tool", ReportHeader()["tool"]},
-                       {"log_sha256", mapping::Sha256OfFile(log_path)},
-                       {"sensor", mapping::SensorGeometryJson(sensor)}};
+  json inputs = {{"tool", ReportHeader()["tool"]},
+                 {"log_sha256", mapping::Sha256OfFile(log_path)},
+                 {"sensor", mapping::SensorGeometryJson(sensor)}};
+  if (!log.options.empty()) inputs["options"] = log.options;
   summary.config_sha256 = mapping::Sha256(inputs.dump());
   CheckOutputDirectory(dir);
   OutputClaim claim =
@@ -424,6 +429,7 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const mapping::MatL
       ManifestBase(sensor, summary.sweeps_total, log.beams.size(), summary.config_sha256);
   manifest["source"] = "import";
   manifest["log"] = {{"file", log_path}, {"truncated_beams", log.truncated_beams}};
+  manifest["log"].update(log.info);
   manifest["seed"] = nullptr;
   manifest["truth"] = nullptr;
   Finalize(out, claim.files, manifest);

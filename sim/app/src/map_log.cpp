@@ -52,6 +52,12 @@ std::optional<Eigen::Isometry3d> DatasetPlacement(const mapping::Dataset& datase
                                                   std::vector<std::string>& warnings) {
   const nlohmann::json& m = dataset.manifest;
   const std::string source = m.value("source", "");
+  // A bag whose transforms move the sonar is mapped where they put it; a static log goes to
+  // the scene's sonar pose.
+  const nlohmann::json log = m.value("log", nlohmann::json::object());
+  if (source == "import" && log.is_object() && log.value("poses", "") == "tf, moving") {
+    return std::nullopt;
+  }
   if (source == "import") return StaticSonarPose(scene);
   if (source != "simulate") {
     throw InputError(dir + "/manifest.json: 'source' is " + Quoted(source) +

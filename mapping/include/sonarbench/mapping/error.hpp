@@ -25,4 +25,7 @@ class EnvironmentError : public InputError {
 /// with "..." (a damaged file's line may be binary, or megabytes without a newline).
 [[nodiscard]] std::string Quoted(std::string_view text, std::size_t max = 80);
 
+/// Whether `text` is well-formed UTF-8 (what JSON reports and manifests can hold).
+[[nodiscard]] bool IsUtf8(std::string_view text);
+
 }  // namespace sonarbench

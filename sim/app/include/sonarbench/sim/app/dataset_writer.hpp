@@ -64,9 +64,22 @@ struct DatasetSummary {
 DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
                                const DatasetOptions& options);
 
-/// Writes a real log as a dataset: its beams by sweep, polar images, the sonar's poses (the
-/// identity: the vehicle was static), no truth. Same atomicity and overwrite rules.
-DatasetSummary ImportLogDataset(const std::string& log_path, const mapping::MatLog& log,
+/// A recorded log's beams (with their poses) and what the manifest says of it.
+struct ImportedLog {
+  std::vector<mapping::Beam> beams;
+  std::size_t truncated_beams = 0;
+  /// Added to the manifest's `log` (beside `file` and `truncated_beams`).
+  nlohmann::json info = nlohmann::json::object();
+  /// Options that change what is read from the file; part of the configuration hash.
+  nlohmann::json options = nlohmann::json::object();
+};
+
+/// A .mat log as an ImportedLog: static at the origin.
+[[nodiscard]] ImportedLog ImportedMatLog(mapping::MatLog log);
+
+/// Writes a recorded log (a .mat log, static at the origin, or a ROS 2 bag) as a dataset: its
+/// beams by sweep, polar images, the sonar's poses, no truth. Same atomicity and overwrite rules.
+DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& log,
                                 const mapping::SensorGeometry& sensor, const std::string& dir,
                                 bool force);
 

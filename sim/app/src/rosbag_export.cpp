@@ -1,0 +1,93 @@
+#include "sonarbench/sim/app/rosbag_export.hpp"
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/mcap.hpp"
+#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/report/report.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A rigid mounting moves the sonar with the vehicle to within this [m, rad]; TUM files keep
+// nine significant digits.
+constexpr double kMountTolerance = 1e-6;
+
+std::string LibraryName() { return std::string("sonarbench ") + kVersion; }
+
+// The header record's library field of an MCAP file, or "" when `path` is not one.
+std::string McapLibrary(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[8 + 9 + 4 + 256] = {};
+  in.read(head, sizeof head);
+  const std::string bytes(head, static_cast<std::size_t>(in.gcount()));
+  if (bytes.size() < 21 || bytes.compare(0, 8, mapping::kMcapMagic) != 0 || bytes[8] != 1) {
+    return {};
+  }
+  std::uint32_t n = 0;
+  std::memcpy(&n, bytes.data() + 17, 4);  // the profile's length
+  const std::size_t at = 21 + n;
+  if (at + 4 > bytes.size()) return {};
+  std::uint32_t m = 0;
+  std::memcpy(&m, bytes.data() + at, 4);
+  return bytes.substr(at + 4, std::min<std::size_t>(m, bytes.size() - at - 4));
+}
+
+}  // namespace
+
+mapping::RosbagContent RosbagFromDataset(const std::string& dir) {
+  mapping::Dataset dataset = mapping::ReadDataset(dir);
+  mapping::RosbagContent bag;
+  bag.sensor = dataset.sensor;
+  bag.beams = std::move(dataset.beams);
+  const fs::path vehicle_file = fs::path(dir) / "poses/vehicle.tum";
+  const fs::path sonar_file = fs::path(dir) / "poses/sonar_true.tum";
+  if (!fs::exists(vehicle_file) || !fs::exists(sonar_file)) return bag;
+  const auto vehicle = mapping::ReadTum(vehicle_file.string());
+  const auto sonar = mapping::ReadTum(sonar_file.string());
+  if (vehicle.size() != bag.beams.size() || sonar.size() != bag.beams.size()) {
+    throw InputError(vehicle_file.string() + ", " + sonar_file.string() +
+                     ": expected a pose for each of the dataset's " +
+                     std::to_string(bag.beams.size()) + " beams");
+  }
+  for (std::size_t b = 0; b < vehicle.size(); ++b) {
+    const Eigen::Isometry3d mount = vehicle[b].pose.inverse() * sonar[b].pose;
+    if (b == 0) bag.T_vehicle_sonar = mount;
+    const Eigen::Isometry3d change = bag.T_vehicle_sonar.inverse() * mount;
+    if (change.translation().norm() > kMountTolerance ||
+        Eigen::AngleAxisd(change.linear()).angle() > kMountTolerance) {
+      throw InputError(dir + ": the sonar moves on the vehicle (beam " + std::to_string(b) +
+                       " of poses/vehicle.tum and poses/sonar_true.tum); expected a rigid mount");
+    }
+    bag.true_vehicle.push_back(vehicle[b].pose);
+  }
+  return bag;
+}
+
+void WriteRosbagFile(const mapping::RosbagContent& bag, const std::string& path, bool force) {
+  std::error_code error;
+  if (fs::exists(path, error) || fs::is_symlink(path, error)) {
+    if (!fs::is_regular_file(path, error)) {
+      throw InputError(path + ": exists and is not a file; choose another --out");
+    }
+    if (!force) throw InputError(path + ": exists; pass --force to replace it");
+    if (McapLibrary(path).rfind("sonarbench", 0) != 0) {
+      throw InputError(path +
+                       ": exists and is not an MCAP file sonarbench wrote; --force "
+                       "replaces only those: choose another --out");
+    }
+  }
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty()) CheckOutputDirectory(parent.string());
+  if (!parent.empty()) CreateOutputDirectory(parent.string());
+  WriteFileAtomically(path,
+                      [&](std::ostream& out) { mapping::WriteRosbag(out, bag, LibraryName()); });
+}
+
+}  // namespace sonarbench::sim
