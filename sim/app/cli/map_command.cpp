@@ -59,6 +59,8 @@ int Map(const MapArgs& args) {
     result.metrics =
         sonarbench::sim::ScoreLogMap(result, *scene, &result.truth, &result.observable);
     result.verdict = sonarbench::sim::Evaluate(scene->criteria, *result.metrics);
+    result.certainty = sonarbench::sim::SweepCertainty(result.mapped, result.sensor, config,
+                                                       result.mapper->tree(), result.truth);
   }
   sonarbench::sim::WriteLogMapOutputs(out.write_root().string(), result, scene ? &*scene : nullptr);
   out.Commit();
@@ -70,7 +72,7 @@ int Map(const MapArgs& args) {
     std::cout << "against " << args.scene << ": " << MetricsLine(*result.metrics) << "\n";
   std::cout << "timing [s]: import " << result.import_s << ", map " << result.map_s << "\n"
             << "wrote " << args.out << "/report.json, report.html"
-            << (result.verdict ? ", junit.xml, map_side.png" : "")
+            << (result.verdict ? ", junit.xml, map_side.png, certainty.png, certainty.csv" : "")
             << ", map.bt, map.ot, map_top.png, polar.png, fan.png\n";
   if (!result.verdict) return 0;
   PrintVerdict(scene->name, *result.verdict);
@@ -85,11 +87,11 @@ CLI::App* AddOptions(CLI::App& app, MapArgs& args) {
       "(from `simulate` or `import`; its manifest's sensor is used) or a real MSIS log in MATLAB "
       ".mat form (the CRAS lab's parsedData layout; the vehicle static at the origin), or a folder "
       "holding one such log. Writes map.bt and map.ot (octovis), map_top.png (occupied cells "
-      "from above), polar.png and fan.png (the first sweep), report.html and report.json (and, "
-      "with --score, junit.xml and map_side.png, the map images then against the truth) into "
-      "--out. The sensor is the SHAD Micron and the mapper uses its defaults unless --scene, "
-      "--sensor or "
-      "--mapping say otherwise.");
+      "from above), polar.png and fan.png (the first sweep), report.html and report.json into "
+      "--out; with --score also junit.xml, map_side.png, and certainty.png and .csv (the "
+      "occupied cells' probability after each sweep), the map images then against the truth. "
+      "The sensor is the SHAD Micron and the mapper uses its defaults unless --scene, --sensor "
+      "or --mapping say otherwise.");
   command
       ->add_option("input", args.input,
                    "A dataset directory, a .mat log, or a folder holding one .mat log")

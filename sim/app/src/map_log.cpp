@@ -139,6 +139,7 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
   result.first_sweep.assign(beams.begin(),
                             beams.begin() + static_cast<long>(std::min(per_sweep, beams.size())));
   result.map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.mapped = std::move(beams);
   return result;
 }
 
@@ -245,20 +246,33 @@ nlohmann::json LogMapReportJson(const LogMapResult& result, const MapCells& cell
   return report;
 }
 
-}  // namespace
+// The seed paper's figure 12: the occupied cells' mean probability against sweeps.
+ReportImage CertaintyImage(const CertaintyCurve& curve, const std::string& name) {
+  std::vector<double> sweeps;
+  for (std::size_t s = 1; s <= curve.true_mean.size(); ++s)
+    sweeps.push_back(static_cast<double>(s));
+  const std::vector<PlotSeries> series = {
+      {"on a surface (" + std::to_string(curve.true_cells) + " cells)",
+       {60, 160, 60},
+       sweeps,
+       curve.true_mean},
+      {"off every surface (" + std::to_string(curve.false_cells) + " cells)",
+       {40, 40, 220},
+       sweeps,
+       curve.false_mean}};
+  return {"certainty.png",
+          "The cells the final map holds occupied, those on a scene surface and the others: their "
+          "mean occupancy probability after each sweep (the seed paper's figure 12; "
+          "certainty.csv).",
+          EncodePng(RenderLinePlot(name + ": certainty against sweeps", "sweeps",
+                                   "mean occupancy probability", series, false, 0.0, 1.0))};
+}
 
-void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
-                        const Scene* scene) {
-  namespace fs = std::filesystem;
-  CreateOutputDirectory(out_dir);
-  const fs::path dir(out_dir);
-  result.mapper->WriteBinary((dir / "map.bt").string());
-  result.mapper->WriteFull((dir / "map.ot").string());
-  const MapCells cells = CollectMapCells(result.mapper->tree());
-  const std::string name = fs::path(result.input).filename().string();
-  const bool scored = scene && result.verdict;
+// The map's images (against the truth when `scene`), then the first sweep's.
+std::vector<ReportImage> LogMapImages(const LogMapResult& result, const Scene* scene,
+                                      const std::string& name, const MapCells& cells) {
   std::vector<ReportImage> images;
-  if (scored) {
+  if (scene) {
     Eigen::Vector3d sonar = Eigen::Vector3d::Zero();
     if (!result.poses.empty()) sonar = result.poses.front().T_world_sonar.translation();
     images = MapTruthImages(result.mapper->tree(), result.truth, result.observable, sonar,
@@ -278,7 +292,29 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
   images.push_back(
       {"fan.png", "First sweep, Cartesian fan from above: the sonar at the centre, 1 cm per pixel.",
        EncodePng(RenderFanImage(result.first_sweep, 0.01, name + ": first sweep, fan"))});
+  return images;
+}
+
+}  // namespace
+
+void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
+                        const Scene* scene) {
+  namespace fs = std::filesystem;
+  CreateOutputDirectory(out_dir);
+  const fs::path dir(out_dir);
+  result.mapper->WriteBinary((dir / "map.bt").string());
+  result.mapper->WriteFull((dir / "map.ot").string());
+  const MapCells cells = CollectMapCells(result.mapper->tree());
+  const std::string name = fs::path(result.input).filename().string();
+  const bool scored = scene && result.verdict;
+  std::vector<ReportImage> images = LogMapImages(result, scored ? scene : nullptr, name, cells);
+  const bool certainty = scored && result.certainty;
+  if (certainty) images.push_back(CertaintyImage(*result.certainty, scene->name + ", " + name));
   WriteReportImages(out_dir, images);
+  if (certainty) {
+    WriteFileAtomically((dir / "certainty.csv").string(),
+                        [&](std::ostream& out) { out << CertaintyCsv(*result.certainty); });
+  }
   if (scored) {
     WriteFileAtomically((dir / "junit.xml").string(), [&](std::ostream& out) {
       out << ScoredJunitXml(*scene, "map", result.input,
@@ -305,6 +341,12 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
   if (!scored) {
     std::erase(covered, "junit.xml");
     std::erase(covered, "map_side.png");
+  }
+  if (!certainty) {
+    std::erase(covered, "certainty.csv");
+    std::erase(covered, "certainty.png");
+  } else {
+    report["outputs"]["certainty"] = {"certainty.csv", "certainty.png"};
   }
   report["files_sha256"] = FilesSha256(out_dir, covered);
   WriteJson((dir / "report.json").string(), report);

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -280,10 +281,15 @@ TEST(Cli, MapScoresALogAgainstASceneAsRunScoresItsSimulation) {
 
   EXPECT_NE(ReadFile(map / "junit.xml").find("<failure type=\"criterion\""), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(map / "map_side.png"));  // scored: the map against truth
+  // Certainty sweep by sweep: a row a sweep, in the report's files.
+  const std::string certainty = ReadFile(map / "certainty.csv");
+  EXPECT_EQ(std::count(certainty.begin(), certainty.end(), '\n'), 2);  // header, one sweep
+  EXPECT_TRUE(failed["files_sha256"].contains("certainty.png"));
   // Unscored, a map has no junit.xml: the scored run's is removed, not left stale.
   EXPECT_EQ(RunCli("map " + ds.string() + " --out " + map.string(), &output), 0) << output;
   EXPECT_FALSE(std::filesystem::exists(map / "junit.xml"));
   EXPECT_FALSE(std::filesystem::exists(map / "map_side.png"));
+  EXPECT_FALSE(std::filesystem::exists(map / "certainty.csv"));
   EXPECT_TRUE(std::filesystem::exists(map / "report.html"));
 
   EXPECT_EQ(RunCli("map " + ds.string() + " --score --out " + map.string(), &output), 2);
@@ -438,8 +444,8 @@ TEST(Cli, NeverReplacesOrRemovesWhatItDidNotWrite) {
 
 // A dataset is scored only against the scene it was simulated from.
 // A ROS 2 bag carries a dataset whole: the real log, imported, exported as a bag and imported
-// again, maps and scores against the tank to the same bytes; so does a simulated dataset whose sonar moves
-// (its poses from /tf and /tf_static), whose bag also carries the true pose.
+// again, maps and scores against the tank to the same bytes; so does a simulated dataset whose
+// sonar moves (its poses from /tf and /tf_static), whose bag also carries the true pose.
 TEST(Cli, ADatasetThroughARos2BagMapsToTheSameBytes) {
   REQUIRE_REAL_LOG();
   test::TempDir dir;

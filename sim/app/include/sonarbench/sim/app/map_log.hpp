@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sonarbench/mapping/mapper.hpp"
+#include "sonarbench/sim/app/certainty.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/eval/verdict.hpp"
@@ -27,6 +28,8 @@ struct LogMapResult {
   mapping::BatchStats totals;
   std::unique_ptr<mapping::Mapper> mapper;
   std::vector<mapping::Beam> first_sweep;
+  /// Every beam as mapped, from the pose it was mapped from.
+  std::vector<mapping::Beam> mapped;
   /// The beams' geometry: the log's own for a dataset, else the one MapLog was given.
   mapping::SensorGeometry sensor;
   /// Every beam's pose as mapped.
@@ -38,6 +41,8 @@ struct LogMapResult {
   mapping::KeySet observable;
   /// The metrics against the scene's criteria, when scored.
   std::optional<Verdict> verdict;
+  /// The occupied cells' probability sweep by sweep, when scored (SweepCertainty).
+  std::optional<CertaintyCurve> certainty;
   /// What the user should know about the score (a dataset simulated from other scene files).
   std::vector<std::string> warnings;
 };
@@ -78,14 +83,14 @@ struct LogMapResult {
 
 /// The files WriteLogMapOutputs writes, relative to its `out_dir`.
 inline const std::vector<std::string> kLogMapOutputFiles = {
-    "map.bt",  "map.ot",      "map_top.png", "map_side.png", "polar.png",
-    "fan.png", "report.html", "junit.xml",   "report.json"};
+    "map.bt",    "map.ot",  "map_top.png", "map_side.png", "certainty.png", "certainty.csv",
+    "polar.png", "fan.png", "report.html", "junit.xml",    "report.json"};
 
 /// Writes `map.bt`, `map.ot`, `map_top.png`, `polar.png`, `fan.png`, `report.html`, with
 /// `scene` and a verdict (the map scored against it) `junit.xml` and `map_side.png` (the map
-/// images then against the truth), and `report.json` (the scores under "metrics", verdict and
-/// criteria if scored, and the sha256 of the others under "files_sha256") into `out_dir`, each
-/// atomically, the report last.
+/// images then against the truth) and, with a certainty curve, `certainty.csv` and `.png`, and
+/// `report.json` (the scores under "metrics", verdict and criteria if scored, and the sha256 of the
+/// others under "files_sha256") into `out_dir`, each atomically, the report last.
 void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
                         const Scene* scene = nullptr);
 
