@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
   const std::vector<app::Command> commands = {
       app::AddRunCommand(cli),      app::AddMapCommand(cli),      app::AddScoreCommand(cli),
       app::AddFidelityCommand(cli), app::AddSimulateCommand(cli), app::AddSweepCommand(cli),
-      app::AddImportCommand(cli), app::AddExportCommand(cli)};
+      app::AddImportCommand(cli),   app::AddExportCommand(cli)};
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
