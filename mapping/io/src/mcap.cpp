@@ -6,6 +6,7 @@
 #include <array>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <set>
 #include <string_view>
 
@@ -440,6 +441,34 @@ void McapWriter::Finish() {
   Put<std::uint32_t>(footer, Crc32(summary));
   Emit(kFooter, footer);
   out_.write(kMcapMagic, kMagicSize);
+}
+
+bool StartsAsMcap(const std::string& path) {
+  std::string magic(kMagicSize, '\0');
+  std::ifstream in(path, std::ios::binary);
+  return in.read(magic.data(), kMagicSize) && magic == std::string(kMcapMagic, kMagicSize);
+}
+
+std::optional<std::string> McapLibrary(const std::string& path) {
+  constexpr std::uint64_t kMaxHeader = 1 << 20;  // a header's two strings; longer is not MCAP
+  std::ifstream in(path, std::ios::binary);
+  std::string head(kMagicSize + 9, '\0');
+  if (!in.read(head.data(), static_cast<std::streamsize>(head.size())) ||
+      head.compare(0, kMagicSize, kMcapMagic) != 0 || head[kMagicSize] != kHeader) {
+    return std::nullopt;
+  }
+  const auto length =
+      Cursor(std::string_view(head).substr(kMagicSize + 1), "").Get<std::uint64_t>("length");
+  if (length > kMaxHeader) return std::nullopt;
+  std::string body(length, '\0');
+  if (!in.read(body.data(), static_cast<std::streamsize>(length))) return std::nullopt;
+  try {
+    Cursor c(body, "");
+    (void)c.String("profile");
+    return c.String("library");
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
 }
 
 McapFile ReadMcap(const std::string& path, std::uint64_t max_bytes) {

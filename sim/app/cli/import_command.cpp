@@ -1,6 +1,4 @@
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -55,10 +53,8 @@ int Import(const ImportArgs& args) {
   mapping::SensorGeometry sensor;
   if (!args.sensor.empty()) sensor = sim::LoadSensorModel(args.sensor).geometry;
   // A bag by its magic bytes, whatever its name; anything else is read as a .mat log.
-  char magic[8] = {};
-  std::ifstream(args.log, std::ios::binary).read(magic, sizeof magic);
-  const bool bag = std::memcmp(magic, mapping::kMcapMagic, sizeof magic) == 0 ||
-                   std::filesystem::path(args.log).extension() == ".mcap";
+  const bool bag =
+      mapping::StartsAsMcap(args.log) || std::filesystem::path(args.log).extension() == ".mcap";
   if (!bag && (!args.topic.empty() || args.static_sonar)) {
     throw InputError("--topic and --static apply to ROS 2 bags (.mcap), not to " + args.log);
   }

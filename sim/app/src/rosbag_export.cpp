@@ -1,8 +1,6 @@
 #include "sonarbench/sim/app/rosbag_export.hpp"
 
-#include <cstring>
 #include <filesystem>
-#include <fstream>
 
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/mcap.hpp"
@@ -20,24 +18,6 @@ namespace fs = std::filesystem;
 constexpr double kMountTolerance = 1e-6;
 
 std::string LibraryName() { return std::string("sonarbench ") + kVersion; }
-
-// The header record's library field of an MCAP file, or "" when `path` is not one.
-std::string McapLibrary(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char head[8 + 9 + 4 + 256] = {};
-  in.read(head, sizeof head);
-  const std::string bytes(head, static_cast<std::size_t>(in.gcount()));
-  if (bytes.size() < 21 || bytes.compare(0, 8, mapping::kMcapMagic) != 0 || bytes[8] != 1) {
-    return {};
-  }
-  std::uint32_t n = 0;
-  std::memcpy(&n, bytes.data() + 17, 4);  // the profile's length
-  const std::size_t at = 21 + n;
-  if (at + 4 > bytes.size()) return {};
-  std::uint32_t m = 0;
-  std::memcpy(&m, bytes.data() + at, 4);
-  return bytes.substr(at + 4, std::min<std::size_t>(m, bytes.size() - at - 4));
-}
 
 }  // namespace
 
@@ -77,7 +57,7 @@ void WriteRosbagFile(const mapping::RosbagContent& bag, const std::string& path,
       throw InputError(path + ": exists and is not a file; choose another --out");
     }
     if (!force) throw InputError(path + ": exists; pass --force to replace it");
-    if (McapLibrary(path).rfind("sonarbench", 0) != 0) {
+    if (mapping::McapLibrary(path).value_or("").rfind("sonarbench", 0) != 0) {
       throw InputError(path +
                        ": exists and is not an MCAP file sonarbench wrote; --force "
                        "replaces only those: choose another --out");

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -88,5 +89,11 @@ struct McapFile {
 
 /// The first bytes of an MCAP file.
 inline constexpr char kMcapMagic[] = "\x89MCAP0\r\n";
+
+/// Whether `path` begins with kMcapMagic (a file that cannot be read does not).
+[[nodiscard]] bool StartsAsMcap(const std::string& path);
+/// The `library` field of the header record of the MCAP file `path` (who wrote it), or nullopt
+/// when `path` does not begin as an MCAP file does. Reads the magic and the header only.
+[[nodiscard]] std::optional<std::string> McapLibrary(const std::string& path);
 
 }  // namespace sonarbench::mapping
