@@ -3,7 +3,7 @@
 // run, against a naive OctoMap pipeline. Prints a table with each variant's median time over
 // --repeats runs and its speed-up against the naive pipeline and against std::unordered_set.
 //
-//   pipeline_bench [LOG.mat] [--repeats N] [--resolution M] [--sets-only]
+//   pipeline_bench [LOG.mat] [--repeats N] [--resolution M] [--sets-only] [--exact-only]
 //
 // Every mapper variant must produce the same map, leaf for leaf (checked; a mismatch is an
 // error). The naive pipeline is: one thread, per beam OctoMap's computeRayKeys into its KeySet,
@@ -71,6 +71,7 @@ template <typename Set>
 std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sensor,
                       const MapperConfig& config, int threads, BatchStats* totals,
                       BatchWorkspace<Set>& workspace) {
+  if (totals != nullptr) *totals = BatchStats{};
   MapTree tree = MakeTree(config);
   const auto directions = BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical);
   const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
@@ -80,6 +81,25 @@ std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sens
     const auto obstacles = DetectObstacles(sweep, sensor, config.detection);
     const BatchStats stats =
         IntegrateBatch(tree, sweep, obstacles, directions, sensor.MaxRangeM(), threads, workspace);
+    if (totals != nullptr) *totals += stats;
+  }
+  FinishUpdates(tree);
+  return Bytes(tree);
+}
+
+// The production pipeline in exact mode (every cell of each beam's wedge once).
+std::string RunExact(const std::vector<Beam>& beams, const SensorGeometry& sensor,
+                     const MapperConfig& config, int threads, BatchStats* totals) {
+  if (totals != nullptr) *totals = BatchStats{};
+  MapTree tree = MakeTree(config);
+  BatchWorkspace<KeyOpenSet> workspace;
+  const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
+  const std::span<const Beam> all(beams);
+  for (std::size_t first = 0; first < all.size(); first += per_sweep) {
+    const auto sweep = all.subspan(first, std::min(per_sweep, all.size() - first));
+    const auto obstacles = DetectObstacles(sweep, sensor, config.detection);
+    const BatchStats stats =
+        IntegrateExactBatch(tree, sweep, obstacles, sensor, sensor.MaxRangeM(), threads, workspace);
     if (totals != nullptr) *totals += stats;
   }
   FinishUpdates(tree);
@@ -198,11 +218,12 @@ double ReplaySetStreams(const std::vector<SetStreams>& streams, std::uint64_t& c
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The whole mapper with each key set against the naive pipeline (Table 1).
+// The whole mapper with each key set, and in exact mode, against the naive pipeline (Table 1).
 int PipelineTable(const MatLog& log, const SensorGeometry& sensor, const MapperConfig& config,
-                  int cores, int repeats) {
+                  int cores, int repeats, bool exact_only) {
   BatchStats totals;
-  const std::vector<Variant> variants = {
+  BatchStats exact_totals;
+  const std::vector<Variant> all_variants = {
       {"naive OctoMap (computeRayKeys + KeySet + updateNode per beam)", 1,
        [&] { return RunNaive(log.beams, sensor, config); }},
       {"mapper, std::unordered_set (OctoMap KeySet)", cores,
@@ -215,43 +236,66 @@ int PipelineTable(const MatLog& log, const SensorGeometry& sensor, const MapperC
        [&] { return RunMapper<Quadratic>(log.beams, sensor, config, cores, &totals); }},
       {"mapper, OpenKeySet quadratic, in-place, 1 thread", 1,
        [&] { return RunMapper<Quadratic>(log.beams, sensor, config, 1, nullptr); }},
+      {"mapper, exact wedge (integration: exact)", cores,
+       [&] { return RunExact(log.beams, sensor, config, cores, &exact_totals); }},
+      {"mapper, exact wedge, 1 thread", 1,
+       [&] { return RunExact(log.beams, sensor, config, 1, nullptr); }},
   };
+  constexpr std::size_t kRays = 4;   // the ray row whose stages are printed
+  constexpr std::size_t kExact = 6;  // the first exact row
+  std::vector<Variant> variants = all_variants;
+  if (exact_only) variants = {all_variants[0], all_variants[kExact], all_variants[kExact + 1]};
+  const std::size_t exact_row = exact_only ? 1 : kExact;
   std::vector<double> times;
-  std::string reference;
+  std::string ray_map, exact_map;
   for (std::size_t v = 0; v < variants.size(); ++v) {
     std::vector<double> runs;
     std::string bytes;
     for (int r = 0; r < repeats; ++r) {
-      if (v == 4 && r > 0) totals = BatchStats{};
       const auto start = std::chrono::steady_clock::now();
       bytes = variants[v].run();
       runs.push_back(
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     }
-    if (v == 1) reference = bytes;
-    if (v > 1 && bytes != reference) {
-      std::fprintf(stderr, "error: '%s' built a different map than std::unordered_set\n",
+    times.push_back(Median(runs));
+    if (v == 0) continue;
+    std::string& reference = v >= exact_row ? exact_map : ray_map;
+    if (reference.empty()) reference = bytes;
+    if (bytes != reference) {
+      std::fprintf(stderr, "error: '%s' built a different map than the first of its mode\n",
                    variants[v].name.c_str());
       return 1;
     }
-    times.push_back(Median(runs));
   }
-  std::printf("\n%-62s %7s %9s %9s %9s\n", "variant", "threads", "median s", "vs naive", "vs std");
+  std::printf("\n%-62s %7s %9s %9s\n", "variant", "threads", "median s", "vs naive");
   for (std::size_t v = 0; v < variants.size(); ++v) {
-    std::printf("%-62s %7d %9.2f %8.2fx %8.2fx\n", variants[v].name.c_str(), variants[v].threads,
-                times[v], times[0] / times[v], times[1] / times[v]);
+    std::printf("%-62s %7d %9.2f %8.2fx\n", variants[v].name.c_str(), variants[v].threads, times[v],
+                times[0] / times[v]);
   }
-  const double updated = static_cast<double>(totals.free_cells + totals.occupied_cells);
+  std::printf("\nthe mapper variants of each mode built the identical map\n");
+  if (!exact_only) {
+    const double updated = static_cast<double>(totals.free_cells + totals.occupied_cells);
+    std::printf(
+        "rays: cell visits %zu, cells updated (per sweep, summed) %.0f: %.1f visits per "
+        "updated cell\n",
+        totals.cell_visits, updated, static_cast<double>(totals.cell_visits) / updated);
+    std::printf(
+        "rays: distinct free cells per beam, summed: %zu (%.1f visits each)\n",
+        totals.beam_free_cells,
+        static_cast<double>(totals.cell_visits) / static_cast<double>(totals.beam_free_cells));
+    std::printf("stages of '%s' (last run): cast %.2f s, split %.2f s, update %.2f s\n",
+                all_variants[kRays].name.c_str(), totals.cast_s, totals.split_s, totals.update_s);
+  }
+  const double exact_updated =
+      static_cast<double>(exact_totals.free_cells + exact_totals.occupied_cells);
   std::printf(
-      "\nall mapper variants built the identical map\n"
-      "cell visits %zu, cells updated (per sweep, summed) %.0f: %.1f visits per updated cell\n",
-      totals.cell_visits, updated, static_cast<double>(totals.cell_visits) / updated);
-  std::printf(
-      "distinct free cells per beam, summed: %zu (%.1f visits each)\n", totals.beam_free_cells,
-      static_cast<double>(totals.cell_visits) / static_cast<double>(totals.beam_free_cells));
+      "exact: cells examined %zu (%zu decided by clipping), distinct free cells per beam, "
+      "summed %zu, cells updated (per sweep, summed) %.0f\n",
+      exact_totals.cell_visits, exact_totals.clipped_cells, exact_totals.beam_free_cells,
+      exact_updated);
   std::printf("stages of '%s' (last run): cast %.2f s, split %.2f s, update %.2f s\n",
-              variants[4].name.c_str(), totals.cast_s, totals.split_s, totals.update_s);
-
+              all_variants[kExact].name.c_str(), exact_totals.cast_s, exact_totals.split_s,
+              exact_totals.update_s);
   return 0;
 }
 
@@ -307,10 +351,13 @@ int Main(int argc, char** argv) {
   std::string path = SONARBENCH_REAL_LOG;
   int repeats = 3;
   bool sets_only = false;
+  bool exact_only = false;
   MapperConfig config;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) {
       repeats = std::max(1, std::atoi(argv[++i]));
+    } else if (std::strcmp(argv[i], "--exact-only") == 0) {
+      exact_only = true;
     } else if (std::strcmp(argv[i], "--sets-only") == 0) {
       sets_only = true;
     } else if (std::strcmp(argv[i], "--resolution") == 0 && i + 1 < argc) {
@@ -318,8 +365,9 @@ int Main(int argc, char** argv) {
     } else if (argv[i][0] != '-') {
       path = argv[i];
     } else {
-      std::fprintf(
-          stderr, "usage: pipeline_bench [LOG.mat] [--repeats N] [--resolution M] [--sets-only]\n");
+      std::fprintf(stderr,
+                   "usage: pipeline_bench [LOG.mat] [--repeats N] [--resolution M] [--sets-only] "
+                   "[--exact-only]\n");
       return 2;
     }
   }
@@ -331,9 +379,11 @@ int Main(int argc, char** argv) {
               config.rays_vertical, cores);
 
   if (!sets_only) {
-    if (const int status = PipelineTable(log, sensor, config, cores, repeats); status != 0) {
+    if (const int status = PipelineTable(log, sensor, config, cores, repeats, exact_only);
+        status != 0) {
       return status;
     }
+    if (exact_only) return 0;
   }
   return SetTable(log, sensor, config, cores, repeats);
 }

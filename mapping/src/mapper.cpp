@@ -76,6 +76,14 @@ BatchStats Mapper::Integrate(std::span<const Beam> beams,
                              std::span<const std::vector<double>> obstacles) {
   State& s = *state_;
   s.stale = true;
+  if (config_.integration == Integration::kExact) {
+    if (config_.key_set == KeySetKind::kStd) {
+      return IntegrateExactBatch(s.tree, beams, obstacles, sensor_, s.free_range_m, s.threads,
+                                 s.std_workspace);
+    }
+    return IntegrateExactBatch(s.tree, beams, obstacles, sensor_, s.free_range_m, s.threads,
+                               s.open_workspace);
+  }
   if (config_.key_set == KeySetKind::kStd) {
     return IntegrateBatch(s.tree, beams, obstacles, s.directions, s.free_range_m, s.threads,
                           s.std_workspace);

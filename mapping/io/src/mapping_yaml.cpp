@@ -8,6 +8,9 @@ namespace sonarbench::mapping {
 MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
   MapperConfig c = std::move(base);
   node.Optional("resolution_m", c.resolution_m, InRange(0.001, 10.0));
+  std::string integration = c.integration == Integration::kExact ? "exact" : "rays";
+  node.Optional("integration", integration, OneOf({"rays", "exact"}));
+  c.integration = integration == "exact" ? Integration::kExact : Integration::kRays;
   node.Optional("rays_horizontal", c.rays_horizontal, IntInRange(1, 4096));
   node.Optional("rays_vertical", c.rays_vertical, IntInRange(1, 4096));
   if (auto detection = node.OptionalChild("detection")) {

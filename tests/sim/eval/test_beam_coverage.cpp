@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "sonarbench/mapping/detail/beam_wedge.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/divisions_study.hpp"
 #include "sonarbench/sim/eval/beam_coverage.hpp"
@@ -94,6 +95,45 @@ TEST(MeasureBeamCoverage, RaysStayInsideAndMoreRaysCoverMore) {
   std::printf("coverage 4x8 %.3f, 32x64 %.3f, 64x256 %.3f of %zu cells (%zu undecided)\n",
               sparse.coverage, paper.coverage, dense.coverage, paper.wedge_cells,
               paper.undecided_cells);
+}
+
+// The mapper's exact mode marks, for a beam with a detection at range r, the cells ExactWedgeCells
+// decides are in the wedge within r: every `inside` cell, and no cell outside; of the `undecided`
+// band (between the inner and the outer polyhedral cone) it takes every cell, its cone being the
+// outer one. Random poses, head angles and ranges.
+TEST(ExactWedgeCells, AreTheCellsOfTheMappersExactMode) {
+  const octomap::OcTree key_space(0.05);
+  const mapping::SensorGeometry micron;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::size_t undecided = 0;
+  for (int trial = 0; trial < 16; ++trial) {
+    const auto beam =
+        BeamAt({unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5}, 6.283 * unit(rng),
+               trial % 4 == 0 ? Vector3d::Zero()
+                              : Vector3d(unit(rng) - 0.5, unit(rng) - 0.5, 3.0 * unit(rng)));
+    const double range = 0.3 + 2.2 * unit(rng);
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const WedgeCells wedge = ExactWedgeCells(beam, micron, range, key_space);
+    std::vector<std::uint64_t> free, occupied;
+    const double obstacle[] = {range};
+    (void)mapping::ExactBeamCells(key_space, mapping::BeamWedge(micron, beam), obstacle, 0.0, free,
+                                  occupied);
+    mapping::KeySet exact;
+    for (const auto* keys : {&free, &occupied}) {
+      for (const auto packed : *keys) exact.insert(mapping::UnpackKey(packed));
+    }
+    for (const auto& key : wedge.inside) EXPECT_TRUE(exact.contains(key));
+    for (const auto& key : wedge.undecided) EXPECT_TRUE(exact.contains(key));
+    std::size_t outside = 0;
+    for (const auto& key : exact) {
+      outside += wedge.inside.contains(key) || wedge.undecided.contains(key) ? 0 : 1;
+    }
+    EXPECT_EQ(outside, 0u);
+    EXPECT_EQ(exact.size(), wedge.inside.size() + wedge.undecided.size());
+    undecided += wedge.undecided.size();
+  }
+  std::printf("undecided cells over all trials: %zu\n", undecided);
 }
 
 }  // namespace

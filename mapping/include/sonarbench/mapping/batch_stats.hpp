@@ -11,6 +11,9 @@ struct BatchStats {
   std::size_t ray_casts = 0;
   /// Cell visits by all rays, repeats included.
   std::size_t cell_visits = 0;
+  /// Exact mode: of the cells examined (cell_visits), those its bounds did not decide, which
+  /// were decided by clipping the cell's faces.
+  std::size_t clipped_cells = 0;
   /// Distinct free cells of each beam, summed over the beams: what goes into the key sets.
   std::size_t beam_free_cells = 0;
   /// Distinct cells updated free / occupied.
@@ -27,6 +30,7 @@ struct BatchStats {
     beams_with_obstacle += o.beams_with_obstacle;
     ray_casts += o.ray_casts;
     cell_visits += o.cell_visits;
+    clipped_cells += o.clipped_cells;
     beam_free_cells += o.beam_free_cells;
     free_cells += o.free_cells;
     occupied_cells += o.occupied_cells;

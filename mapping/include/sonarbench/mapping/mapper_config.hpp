@@ -40,10 +40,17 @@ enum class KeySetKind {
   kStd,             ///< std::unordered_set with OctoMap's KeyHash (OctoMap's KeySet)
 };
 
+/// How a beam's volume becomes cells (docs/mapper.md).
+enum class Integration {
+  kRays,   ///< rays_horizontal × rays_vertical ray casts (the seed paper)
+  kExact,  ///< every cell that meets the beam's wedge, examined once (BeamWedge)
+};
+
 /// Parameters of the production mapper. In-class defaults are the seed paper's choices.
 struct MapperConfig {
   /// Edge of an OctoMap leaf cell [m].
   double resolution_m = 0.05;
+  Integration integration = Integration::kRays;
   /// Ray casts across the beam's horizontal width (the paper's H; 32 by its study).
   int rays_horizontal = 32;
   /// Ray casts across the beam's vertical width (the paper's V; 64 by its study).

@@ -6,11 +6,13 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <span>
+#include <tuple>
 #include <unordered_set>
 #include <vector>
 
 #include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/mapping/detail/beam_raster.hpp"
+#include "sonarbench/mapping/detail/beam_wedge.hpp"
 #include "sonarbench/mapping/detail/key_set.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
@@ -41,6 +43,9 @@ struct BasicBeamCells {
   BeamRaster raster;
   std::vector<octomap::point3d> ends;
   std::vector<std::uint64_t> beam_free;
+  std::vector<std::uint64_t> beam_occupied;
+  /// Cells of the exact mode decided by clipping their faces (BeamWedge::CellSpan).
+  std::size_t clipped = 0;
   /// A beam's keys that go on to the sets: not caught by recent_free / recent_occupied.
   std::vector<std::uint64_t> fresh_free;
   std::vector<std::uint64_t> fresh_occupied;
@@ -61,6 +66,7 @@ struct BasicBeamCells {
     recent_occupied.clear();
     visits = 0;
     beam_free_cells = 0;
+    clipped = 0;
   }
 
   /// Calls `f(packed)` for each key of `set`, one of the two, in the set's order.
@@ -133,6 +139,31 @@ void CastBeam(const octomap::OcTree& tree, const Beam& beam,
     if (!cells.recent_free.CheckAndRemember(packed)) cells.fresh_free.push_back(packed);
   }
   cells.Insert(cells.free, cells.fresh_free);
+}
+
+/// Adds to `cells` the keys of one beam under the exact semantics (ExactBeamCells): every cell
+/// of the wedge examined once, free before the first obstacle, occupied on each obstacle's shell,
+/// clearing out to `free_range_m` without an obstacle (0 = clear nothing).
+template <typename Set>
+void CastBeamExact(const octomap::OcTree& tree, const SensorGeometry& sensor, const Beam& beam,
+                   std::span<const double> obstacle_ranges_m, double free_range_m,
+                   BasicBeamCells<Set>& cells) {
+  cells.beam_free.clear();
+  cells.beam_occupied.clear();
+  const WedgeCellCounts counts = ExactBeamCells(tree, BeamWedge(sensor, beam), obstacle_ranges_m,
+                                                free_range_m, cells.beam_free, cells.beam_occupied);
+  cells.visits += counts.examined;
+  cells.clipped += counts.clipped;
+  cells.beam_free_cells += cells.beam_free.size();
+  for (auto [keys, recent, set] :
+       {std::tuple(&cells.beam_free, &cells.recent_free, &cells.free),
+        std::tuple(&cells.beam_occupied, &cells.recent_occupied, &cells.occupied)}) {
+    cells.fresh_free.clear();
+    for (const std::uint64_t packed : *keys) {
+      if (!recent->CheckAndRemember(packed)) cells.fresh_free.push_back(packed);
+    }
+    cells.Insert(*set, cells.fresh_free);
+  }
 }
 
 }  // namespace sonarbench::mapping

@@ -157,25 +157,22 @@ std::array<std::size_t, 3> UpdateOctant(MapTree& tree, BatchWorkspace<Set>& work
 
 }  // namespace integrate_detail
 
-/// Casts the rays of a batch of beams on `threads` threads, each into its own key sets of type
-/// `Set`, merges the threads' cells (no lock per key), lets occupied win over free, and applies
-/// one log-odds update per cell. The result does not depend on `threads` or on `Set`: a set's
-/// content does not depend on insertion order, and each cell gets exactly one update. Call
-/// FinishUpdates before reading the tree.
-template <typename Set>
-BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
-                          std::span<const std::vector<double>> obstacles,
-                          std::span<const Eigen::Vector3d> directions, double free_range_m,
-                          int threads, BatchWorkspace<Set>& workspace) {
+/// The cells of a batch of beams, on `threads` threads: `cast(i, cells)` adds beam i's free and
+/// occupied cells to one thread's BasicBeamCells. The threads' cells are merged (no lock per
+/// key), occupied wins over free, and each cell gets one log-odds update. The result does not
+/// depend on `threads` or on `Set`: a set's content does not depend on insertion order, and each
+/// cell gets exactly one update. Call FinishUpdates before reading the tree.
+template <typename Set, typename Cast>
+BatchStats IntegrateCells(MapTree& tree, std::span<const Beam> beams,
+                          std::span<const std::vector<double>> obstacles, int threads,
+                          BatchWorkspace<Set>& workspace, Cast&& cast) {
   const double start = omp_get_wtime();
   workspace.Reset(threads);
   auto& per_thread = workspace.per_thread;
   const auto count = static_cast<std::int64_t>(beams.size());
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 4)
   for (std::int64_t b = 0; b < count; ++b) {
-    const auto i = static_cast<std::size_t>(b);
-    CastBeam(tree, beams[i], directions, obstacles[i], free_range_m,
-             per_thread[static_cast<std::size_t>(omp_get_thread_num())]);
+    cast(static_cast<std::size_t>(b), per_thread[static_cast<std::size_t>(omp_get_thread_num())]);
   }
   const double cast_done = omp_get_wtime();
   integrate_detail::SplitByOctant(workspace, threads);
@@ -202,15 +199,41 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
   }
   stats.beams = beams.size();
   for (const auto& o : obstacles) stats.beams_with_obstacle += o.empty() ? 0 : 1;
-  stats.ray_casts = beams.size() * directions.size();
   for (const auto& cells : per_thread) {
     stats.cell_visits += cells.visits;
+    stats.clipped_cells += cells.clipped;
     stats.beam_free_cells += cells.beam_free_cells;
   }
   stats.cast_s = cast_done - start;
   stats.split_s = split_done - cast_done;
   stats.update_s = omp_get_wtime() - split_done;
   return stats;
+}
+
+/// IntegrateCells with each beam's cells from its H×V ray casts (CastBeam).
+template <typename Set>
+BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
+                          std::span<const std::vector<double>> obstacles,
+                          std::span<const Eigen::Vector3d> directions, double free_range_m,
+                          int threads, BatchWorkspace<Set>& workspace) {
+  BatchStats stats = IntegrateCells(
+      tree, beams, obstacles, threads, workspace, [&](std::size_t i, BasicBeamCells<Set>& cells) {
+        CastBeam(tree, beams[i], directions, obstacles[i], free_range_m, cells);
+      });
+  stats.ray_casts = beams.size() * directions.size();
+  return stats;
+}
+
+/// IntegrateCells with each beam's cells from its exact wedge (CastBeamExact).
+template <typename Set>
+BatchStats IntegrateExactBatch(MapTree& tree, std::span<const Beam> beams,
+                               std::span<const std::vector<double>> obstacles,
+                               const SensorGeometry& sensor, double free_range_m, int threads,
+                               BatchWorkspace<Set>& workspace) {
+  return IntegrateCells(tree, beams, obstacles, threads, workspace,
+                        [&](std::size_t i, BasicBeamCells<Set>& cells) {
+                          CastBeamExact(tree, sensor, beams[i], obstacles[i], free_range_m, cells);
+                        });
 }
 
 /// The same with a workspace of its own, for a single batch.
