@@ -93,33 +93,39 @@ Tri Or(Tri a, Tri b) {
   if (a == Tri::kTrue || b == Tri::kTrue) return Tri::kTrue;
   return a == Tri::kFalse && b == Tri::kFalse ? Tri::kFalse : Tri::kUnknown;
 }
-// near <= r, given near in [lo, hi]; and its mirror for far >= r.
-Tri AtMost(double lo, double hi, double r) {
-  return r < lo ? Tri::kFalse : (r >= hi ? Tri::kTrue : Tri::kUnknown);
-}
 
-enum class Mark { kNone, kFree, kOccupied, kUndecided };
+enum class Mark {
+  kNone,
+  kFree,
+  kOccupied,
+  kFreeIfMeets,  ///< free if the cell meets the wedge, untouched if not
+  kUndecided,    ///< the bounds do not settle it
+};
 
-// The exact semantics (beam_wedge.hpp) on a span whose near end lies in [near_lo, near_hi] and
-// far end in [far_lo, far_hi]; kUndecided when the bounds do not settle it. `meets` is whether
-// the cell is known to meet the wedge.
-Mark Decide(double near_lo, double near_hi, double far_lo, double far_hi, bool meets,
+// The exact semantics (beam_wedge.hpp) for a cell that meets the wedge (or, for kFreeIfMeets,
+// may), from bounds on its span: the squared near end lies in [near_lo, near_hi], the squared
+// far end in [far_lo, far_hi]. Squared ranges compare as the ranges do.
+Mark Decide(double near_lo, double near_hi, double far_lo, double far_hi,
             std::span<const double> obstacles, double r_first) {
   Tri occupied = Tri::kFalse;
-  for (const double r : obstacles) {
+  for (const double range : obstacles) {
+    const double r = range * range;
+    const Tri near_le = r < near_lo ? Tri::kFalse : (r >= near_hi ? Tri::kTrue : Tri::kUnknown);
     const Tri far_ge = r > far_hi ? Tri::kFalse : (r <= far_lo ? Tri::kTrue : Tri::kUnknown);
-    occupied = Or(occupied, And(AtMost(near_lo, near_hi, r), far_ge));
+    occupied = Or(occupied, And(near_le, far_ge));
   }
-  if (occupied == Tri::kTrue) return Mark::kOccupied;  // a known end lies inside the wedge
+  if (occupied == Tri::kTrue) return Mark::kOccupied;
   if (occupied == Tri::kUnknown) return Mark::kUndecided;
-  if (r_first <= 0.0 || far_lo >= r_first) return Mark::kNone;
-  if (far_hi < r_first) return meets ? Mark::kFree : Mark::kUndecided;
-  return Mark::kUndecided;
+  const double r = r_first * r_first;
+  if (r_first <= 0.0 || far_lo >= r) return Mark::kNone;
+  return far_hi < r ? Mark::kFreeIfMeets : Mark::kUndecided;
 }
 
-Mark DecideExact(const BeamWedge::Span& s, std::span<const double> obstacles, double r_first) {
-  if (!s.meets) return Mark::kNone;
-  return Decide(s.near, s.near, s.far, s.far, true, obstacles, r_first);
+double Square(double x) { return x * x; }
+
+// The corner offsets of a cell: σ_j = (±1, ±1, ±1), bit k of j set for +1 along axis k.
+Vector3d Corner(int j, double half) {
+  return {(j & 1) ? half : -half, (j & 2) ? half : -half, (j & 4) ? half : -half};
 }
 
 // Per beam: the wedge's planes in a form the per-cell loop reads fast.
@@ -127,21 +133,107 @@ struct CellTester {
   const BeamWedge& wedge;
   double half;
   double spread[4];     // half · ‖n_i‖₁: how far n_i·p varies over a cell
-  double corner[4][8];  // half · n_i·σ_j for the corner offsets σ_j in {-1, +1}³
+  double corner[4][8];  // half · n_i·σ_j
+  // Separating axes of a cell and K besides K's planes: the cell's axes and the cross products
+  // of its edges with K's edge rays, with half · ‖L‖₁ and on which sides K reaches to infinity.
+  struct Axis {
+    Vector3d l;
+    double spread;
+    bool below;  // K has points with L·p < 0
+    bool above;  // K has points with L·p > 0
+  };
+  std::array<Axis, 15> axes;
   std::span<const double> obstacles;
   double r_first;
   double r_far;
+  double r_near2;  // the square of the least of r_first and the detection ranges
 
   CellTester(const BeamWedge& w, double h, std::span<const double> o, double first, double far)
       : wedge(w), half(h), obstacles(o), r_first(first), r_far(far) {
+    double nearest = first;
+    for (const double r : o) nearest = std::min(nearest, r);
+    r_near2 = nearest > 0.0 ? nearest * nearest : -1.0;
     for (int i = 0; i < 4; ++i) {
       const Vector3d& n = w.normal(i);
       spread[i] = h * n.lpNorm<1>();
-      for (int j = 0; j < 8; ++j) {
-        const Vector3d sigma((j & 1) ? h : -h, (j & 2) ? h : -h, (j & 4) ? h : -h);
-        corner[i][j] = n.dot(sigma);
+      for (int j = 0; j < 8; ++j) corner[i][j] = n.dot(Corner(j, h));
+    }
+    for (int k = 0; k < 3; ++k) {
+      for (int e = -1; e < 4; ++e) {
+        const Vector3d l = e < 0 ? Vector3d(Vector3d::Unit(k)) : Vector3d::Unit(k).cross(w.edge(e));
+        Axis& a = axes[static_cast<std::size_t>(k * 5 + e + 1)];
+        a = {l, h * l.lpNorm<1>(), false, false};
+        for (int g = 0; g < 4; ++g) {
+          a.below |= l.dot(w.edge(g)) < 0.0;
+          a.above |= l.dot(w.edge(g)) > 0.0;
+        }
       }
     }
+  }
+
+  // Whether the cell centred at `c` meets K: no separating axis (K's planes already passed).
+  [[nodiscard]] bool Meets(const Vector3d& c) const {
+    for (const Axis& a : axes) {
+      const double d = a.l.dot(c);
+      if ((!a.above && d - a.spread > 0.0) || (!a.below && d + a.spread < 0.0)) return false;
+    }
+    return true;
+  }
+
+  // The exact squared span of a cell cut by plane i alone: the far end at a corner on the inner
+  // side or where an edge crosses the plane; the near end at the box's point nearest the apex if
+  // that is on the inner side, else at clamp(-λ n) with λ > 0 putting it on the plane (the
+  // minimum of |p|² over box ∩ {n·p <= 0}, a separable problem with one constraint).
+  void SinglePlaneSpan(const Vector3d& c, int i, double s, double& near2, double& far2) const {
+    double v[8];
+    far2 = 0.0;
+    for (int j = 0; j < 8; ++j) {
+      v[j] = s + corner[i][j];
+      if (v[j] <= 0.0) far2 = std::max(far2, (c + Corner(j, half)).squaredNorm());
+    }
+    for (int j = 0; j < 8; ++j) {
+      for (int bit = 1; bit < 8; bit <<= 1) {
+        const int k = j | bit;
+        if ((j & bit) != 0 || (v[j] <= 0.0) == (v[k] <= 0.0)) continue;
+        const double t = v[j] / (v[j] - v[k]);
+        const Vector3d a = c + Corner(j, half);
+        far2 = std::max(far2, (a + t * (Corner(k, half) - Corner(j, half))).squaredNorm());
+      }
+    }
+    const Vector3d& n = wedge.normal(i);
+    const Vector3d lo = c.array() - half, hi = c.array() + half;
+    auto clamp = [&](double lambda) {
+      Vector3d p;
+      for (int k = 0; k < 3; ++k) p[k] = std::clamp(-lambda * n[k], lo[k], hi[k]);
+      return p;
+    };
+    Vector3d p = clamp(0.0);
+    double f = n.dot(p);
+    if (f > 0.0) {
+      // n·clamp(-λ n) falls with λ, linearly between the breakpoints where a coordinate clamps.
+      std::array<double, 7> breaks{};
+      int count = 0;
+      for (int k = 0; k < 3; ++k) {
+        if (n[k] == 0.0) continue;
+        for (const double bound : {lo[k], hi[k]}) {
+          const double lambda = -bound / n[k];
+          if (lambda > 0.0) breaks[static_cast<std::size_t>(count++)] = lambda;
+        }
+      }
+      std::sort(breaks.begin(), breaks.begin() + count);
+      double lambda_a = 0.0, f_a = f;
+      for (int b = 0; b < count; ++b) {
+        const double lambda_b = breaks[static_cast<std::size_t>(b)];
+        const double f_b = n.dot(clamp(lambda_b));
+        if (f_b <= 0.0) {
+          p = clamp(lambda_a + f_a * (lambda_b - lambda_a) / (f_a - f_b));
+          break;
+        }
+        lambda_a = lambda_b;
+        f_a = f_b;
+      }
+    }
+    near2 = p.squaredNorm();
   }
 
   // The cell centred at `c` (relative to the origin); `clipped` counts the exact clippings.
@@ -154,30 +246,84 @@ struct CellTester {
       if (s[i] + spread[i] > 0.0) cut |= 1u << i;
     }
     const Vector3d a = c.cwiseAbs();
-    const double near_lo = (a - Vector3d::Constant(half)).cwiseMax(0.0).norm();
-    if (near_lo > r_far) return Mark::kNone;
-    const double far_hi = (a + Vector3d::Constant(half)).norm();
-    if (cut == 0) return Decide(near_lo, near_lo, far_hi, far_hi, true, obstacles, r_first);
+    const double near_lo = (a.array() - half).cwiseMax(0.0).matrix().squaredNorm();
+    if (near_lo > r_far * r_far) return Mark::kNone;
+    const double far_hi = (a.array() + half).matrix().squaredNorm();
+    if (cut == 0) return DecideMet(Decide(near_lo, near_lo, far_hi, far_hi, obstacles, r_first));
+    // Most cells lie away from every shell: the box's own ranges settle them.
+    const Mark by_box = Decide(near_lo, kInf, -kInf, far_hi, obstacles, r_first);
+    if (by_box == Mark::kNone) return by_box;
+    if (by_box == Mark::kFreeIfMeets && std::has_single_bit(cut)) return Mark::kFree;
     // The corners inside K bound the span from within.
-    double near_hi = kInf;
-    double far_lo = -kInf;
+    double near_hi = kInf, far_lo = -kInf;
     for (int j = 0; j < 8; ++j) {
       bool in = true;
-      for (int i = 0; i < 4; ++i) in &= s[i] + corner[i][j] <= 0.0;
+      for (int i = 0; i < 4; ++i) in &= ((cut >> i) & 1u) == 0 || s[i] + corner[i][j] <= 0.0;
       if (!in) continue;
-      const double r =
-          (c + Vector3d((j & 1) ? half : -half, (j & 2) ? half : -half, (j & 4) ? half : -half))
-              .norm();
+      const double r = (c + Corner(j, half)).squaredNorm();
       near_hi = std::min(near_hi, r);
       far_lo = std::max(far_lo, r);
     }
-    // Cut by one plane only, the cell meets K: its part on the inner side is not empty.
-    const bool meets = near_hi < kInf || std::has_single_bit(cut);
-    const Mark m = Decide(near_lo, near_hi, far_lo, far_hi, meets, obstacles, r_first);
+    const Mark m = Decide(near_lo, near_hi, far_lo, far_hi, obstacles, r_first);
+    if (std::has_single_bit(cut)) {  // the cell meets K: its part on the inner side is not empty
+      if (m != Mark::kUndecided) return DecideMet(m);
+      const int i = std::countr_zero(cut);
+      double near2, far2;
+      SinglePlaneSpan(c, i, s[i], near2, far2);
+      return DecideMet(Decide(near2, near2, far2, far2, obstacles, r_first));
+    }
+    if (m == Mark::kFreeIfMeets) return near_hi < kInf || Meets(c) ? Mark::kFree : Mark::kNone;
     if (m != Mark::kUndecided) return m;
+    if (near_hi == kInf && !Meets(c)) return Mark::kNone;
     ++clipped;
-    return DecideExact(wedge.CellSpan(c, half), obstacles, r_first);
+    const BeamWedge::Span span = wedge.CellSpan(c, half);
+    if (!span.meets) return Mark::kNone;
+    const double n2 = span.near * span.near, f2 = span.far * span.far;
+    return DecideMet(Decide(n2, n2, f2, f2, obstacles, r_first));
   }
+
+  // Classifies the cells kc_lo..kc_hi of a column along axis `c` (`centre`'s other coordinates
+  // set, `c0` the first cell's), appending their keys (`key`'s other coordinates set). A cell
+  // whose box lies wholly nearer than every detection range, and which one plane at most cuts,
+  // is free if it lies inside K's other planes: the fast path most cells take.
+  void Column(Vector3d centre, int c, double c0, int kc_lo, int kc_hi, double res,
+              octomap::OcTreeKey key, std::vector<std::uint64_t>& free_keys,
+              std::vector<std::uint64_t>& occupied_keys, std::size_t& clipped) const {
+    const int u = (c + 1) % 3, w = (c + 2) % 3;
+    const double across = Square(std::abs(centre[u]) + half) + Square(std::abs(centre[w]) + half);
+    double s0[4], ds[4];
+    for (int i = 0; i < 4; ++i) {
+      const Vector3d& n = wedge.normal(i);
+      s0[i] = n[u] * centre[u] + n[w] * centre[w];
+      ds[i] = n[c];
+    }
+    for (int kc = kc_lo; kc <= kc_hi; ++kc) {
+      const double cc = c0 + (kc - kc_lo) * res;
+      if (across + Square(std::abs(cc) + half) < r_near2) {
+        int cuts = 0;
+        bool outside = false;
+        for (int i = 0; i < 4; ++i) {
+          const double si = s0[i] + ds[i] * cc;
+          outside |= si - spread[i] > 0.0;
+          cuts += si + spread[i] > 0.0 ? 1 : 0;
+        }
+        if (outside) continue;
+        centre[c] = cc;
+        if (cuts >= 2 && !Meets(centre)) continue;
+        key[c] = static_cast<octomap::key_type>(kc);
+        free_keys.push_back(PackKey(key));
+        continue;
+      }
+      centre[c] = cc;
+      const Mark m = Classify(centre, clipped);
+      if (m == Mark::kNone) continue;
+      key[c] = static_cast<octomap::key_type>(kc);
+      (m == Mark::kOccupied ? occupied_keys : free_keys).push_back(PackKey(key));
+    }
+  }
+
+  // A decision on a cell known to meet K.
+  static Mark DecideMet(Mark m) { return m == Mark::kFreeIfMeets ? Mark::kFree : m; }
 };
 
 // The pyramid K ∩ {axis·p <= r}, which holds the wedge's cells within range r: its apex and
@@ -191,29 +337,200 @@ struct Pyramid {
     for (int i = 0; i < 4; ++i) corner[i] = (r / w.edge(i).dot(w.axis())) * w.edge(i);
     corner[4] = Vector3d::Zero();
   }
+};
 
-  // The extent along `axis` of the pyramid's part within the slabs lo <= p[s] <= hi (s = 0 or
-  // 1 of `slab_axes`), over its edges. Returns false when no edge meets the slabs.
-  bool EdgeExtent(int axis, int slabs, const int* slab_axes, const double* lo, const double* hi,
-                  double& min, double& max) const {
-    bool any = false;
-    for (const auto& e : kEdges) {
-      const Vector3d& a = corner[e[0]];
-      const Vector3d& b = corner[e[1]];
-      double t0 = 0.0, t1 = 1.0;
-      bool in = true;
-      for (int k = 0; k < slabs && in; ++k)
-        in = ClipToSlab(a, b, slab_axes[k], lo[k], hi[k], t0, t1);
-      if (!in) continue;
-      any = true;
-      for (const double t : {t0, t1}) {
-        const double v = a[axis] + t * (b[axis] - a[axis]);
-        min = std::min(min, v);
-        max = std::max(max, v);
+// The pyramid's edges within one row of cells (a slab along u), as segments with their extent
+// along w: what the row's columns need of them.
+struct RowEdges {
+  int n = 0;
+  Vector3d a[8], b[8];
+  double w_lo[8], w_hi[8];
+};
+
+// One beam's cells, row by row and column by column: columns run along the world axis `c`
+// nearest the beam's elevation axis (the wedge's long side), rows along u, w across.
+class WedgeScan {
+ public:
+  WedgeScan(const octomap::OcTree& tree, const BeamWedge& wedge, std::span<const double> obstacles,
+            double r_first, double r_far)
+      : tree_(tree),
+        wedge_(wedge),
+        obstacles_(obstacles),
+        res_(tree.getResolution()),
+        r_first_(r_first),
+        r_far_(r_far),
+        pyramid_(wedge, r_far),
+        tester_(wedge, 0.5 * tree.getResolution(), obstacles, r_first, r_far) {
+    wedge.up().cwiseAbs().maxCoeff(&c_);
+    u_ = (c_ + 1) % 3;
+    w_ = (c_ + 2) % 3;
+    for (int k = 0; k < 3; ++k) {  // keys of the pyramid's bounding box
+      double min = 0.0, max = 0.0;
+      for (const Vector3d& p : pyramid_.corner) {
+        min = std::min(min, p[k]);
+        max = std::max(max, p[k]);
+      }
+      lo_[k] = KeyOf(k, min - kSlack);
+      hi_[k] = KeyOf(k, max + kSlack);
+    }
+  }
+
+  WedgeCellCounts Run(std::vector<std::uint64_t>& free_keys,
+                      std::vector<std::uint64_t>& occupied_keys) const {
+    WedgeCellCounts counts;
+    for (int ku = lo_[u_]; ku <= hi_[u_]; ++ku) {
+      RowEdges edges;
+      double w_min = kInf, w_max = -kInf;
+      const double cu = Rel(u_, ku);
+      if (!Row(cu, edges, w_min, w_max)) continue;
+      const int kw_hi = std::min(hi_[w_], KeyOf(w_, w_max + kSlack));
+      for (int kw = std::max(lo_[w_], KeyOf(w_, w_min - kSlack)); kw <= kw_hi; ++kw) {
+        Column(ku, kw, edges, free_keys, occupied_keys, counts);
       }
     }
-    return any;
+    return counts;
   }
+
+ private:
+  // The key of the cell holding coordinate `relative` (to the origin) along `axis`, clamped to
+  // the key range.
+  [[nodiscard]] int KeyOf(int axis, double relative) const {
+    const double k = std::floor((wedge_.origin()[axis] + relative) / res_) +
+                     static_cast<double>(tree_.coordToKey(0.0));
+    return static_cast<int>(std::clamp(k, 0.0, 65535.0));
+  }
+  // The centre of key `key`'s cells along `axis`, relative to the origin.
+  [[nodiscard]] double Rel(int axis, int key) const {
+    return tree_.keyToCoord(static_cast<octomap::key_type>(key)) - wedge_.origin()[axis];
+  }
+
+  // The pyramid's edges within the row of cells centred at u = cu, and the row's extent along w.
+  bool Row(double cu, RowEdges& edges, double& w_min, double& w_max) const {
+    const double half = 0.5 * res_;
+    for (const auto& e : Pyramid::kEdges) {
+      const Vector3d& a = pyramid_.corner[e[0]];
+      const Vector3d& b = pyramid_.corner[e[1]];
+      double t0 = 0.0, t1 = 1.0;
+      if (!ClipToSlab(a, b, u_, cu - half - kSlack, cu + half + kSlack, t0, t1)) continue;
+      const auto i = static_cast<std::size_t>(edges.n++);
+      edges.a[i] = a + t0 * (b - a);
+      edges.b[i] = a + t1 * (b - a);
+      edges.w_lo[i] = std::min(edges.a[i][w_], edges.b[i][w_]);
+      edges.w_hi[i] = std::max(edges.a[i][w_], edges.b[i][w_]);
+      w_min = std::min(w_min, edges.w_lo[i]);
+      w_max = std::max(w_max, edges.w_hi[i]);
+    }
+    return edges.n > 0;
+  }
+
+  // The extent along c of the pyramid's part within the column [u0, u1] × [w0, w1]: at the
+  // row's edges within the column, or on the column's four lines within the pyramid.
+  bool ColumnExtent(const RowEdges& edges, double u0, double u1, double w0, double w1,
+                    double& c_min, double& c_max) const {
+    for (int i = 0; i < edges.n; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      if (edges.w_hi[k] < w0 - kSlack || edges.w_lo[k] > w1 + kSlack) continue;
+      double t0 = 0.0, t1 = 1.0;
+      if (!ClipToSlab(edges.a[k], edges.b[k], w_, w0 - kSlack, w1 + kSlack, t0, t1)) continue;
+      for (const double t : {t0, t1}) {
+        const double v = edges.a[k][c_] + t * (edges.b[k][c_] - edges.a[k][c_]);
+        c_min = std::min(c_min, v);
+        c_max = std::max(c_max, v);
+      }
+    }
+    for (const double pu : {u0, u1}) {
+      for (const double pw : {w0, w1}) {
+        double t_lo = -kInf, t_hi = kInf;
+        for (int i = 0; i < 5; ++i) {
+          const Vector3d& n = i < 4 ? wedge_.normal(i) : wedge_.axis();
+          const double bound = (i < 4 ? 0.0 : r_far_) - n[u_] * pu - n[w_] * pw;
+          if (n[c_] > 0.0) {
+            t_hi = std::min(t_hi, bound / n[c_]);
+          } else if (n[c_] < 0.0) {
+            t_lo = std::max(t_lo, bound / n[c_]);
+          } else if (bound < 0.0) {
+            t_hi = -kInf;
+          }
+        }
+        if (t_lo > t_hi) continue;
+        c_min = std::min(c_min, t_lo);
+        c_max = std::max(c_max, t_hi);
+      }
+    }
+    return c_min <= c_max;
+  }
+
+  // The runs of keys along c to examine in the column (sorted; they may overlap): the cells
+  // within the first range's ball (free or on its shell), and for each later range those its
+  // sphere passes through. Returns how many.
+  int Runs(double u0, double u1, double w0, double w1, double c_min, double c_max,
+           std::array<int, 2>* runs) const {
+    const double du = std::max({u0, -u1, 0.0}), dw = std::max({w0, -w1, 0.0});
+    const double Du = std::max(-u0, u1), Dw = std::max(-w0, w1);
+    int n = 0;
+    auto add_run = [&](double lo_c, double hi_c) {
+      lo_c = std::max(lo_c, c_min);
+      hi_c = std::min(hi_c, c_max);
+      if (lo_c > hi_c) return;
+      runs[n++] = {std::max(lo_[c_], KeyOf(c_, lo_c - kSlack)),
+                   std::min(hi_[c_], KeyOf(c_, hi_c + kSlack))};
+    };
+    // With many ranges, one run over the farthest range's ball holds them all.
+    const bool one_run = obstacles_.size() >= kMaxRuns;
+    for (std::size_t k = 0; k <= (one_run ? 0 : obstacles_.size()); ++k) {
+      const double r = one_run ? r_far_ : k == 0 ? r_first_ : obstacles_[k - 1];
+      if (k > 0 && r <= r_first_) continue;
+      const double ball2 = r * r - du * du - dw * dw;
+      if (ball2 < 0.0) continue;
+      const double ball = std::sqrt(ball2);
+      const double shell2 = r * r - Du * Du - Dw * Dw;  // a cell reaches r if its |c| does this
+      if (k == 0 || shell2 <= 0.0) {
+        add_run(-ball, ball);
+      } else {
+        const double shell = std::sqrt(shell2);
+        add_run(-ball, -shell + res_);
+        add_run(shell - res_, ball);
+      }
+    }
+    std::sort(runs, runs + n);
+    return n;
+  }
+
+  void Column(int ku, int kw, const RowEdges& edges, std::vector<std::uint64_t>& free_keys,
+              std::vector<std::uint64_t>& occupied_keys, WedgeCellCounts& counts) const {
+    const double half = 0.5 * res_;
+    const double cu = Rel(u_, ku), cw = Rel(w_, kw);
+    double c_min = kInf, c_max = -kInf;
+    if (!ColumnExtent(edges, cu - half, cu + half, cw - half, cw + half, c_min, c_max)) return;
+    std::array<int, 2> runs[2 * kMaxRuns];
+    const int n = Runs(cu - half, cu + half, cw - half, cw + half, c_min, c_max, runs);
+    Vector3d centre;
+    centre[u_] = cu;
+    centre[w_] = cw;
+    octomap::OcTreeKey key;
+    key[static_cast<unsigned>(u_)] = static_cast<octomap::key_type>(ku);
+    key[static_cast<unsigned>(w_)] = static_cast<octomap::key_type>(kw);
+    int next = std::numeric_limits<int>::min();  // the first key not yet examined
+    for (int i = 0; i < n; ++i) {
+      const int first = std::max(runs[i][0], next);
+      if (first > runs[i][1]) continue;
+      counts.examined += static_cast<std::size_t>(runs[i][1] - first + 1);
+      tester_.Column(centre, c_, Rel(c_, first), first, runs[i][1], res_, key, free_keys,
+                     occupied_keys, counts.clipped);
+      next = std::max(next, runs[i][1] + 1);
+    }
+  }
+
+  const octomap::OcTree& tree_;
+  const BeamWedge& wedge_;
+  std::span<const double> obstacles_;
+  double res_;
+  double r_first_;
+  double r_far_;
+  Pyramid pyramid_;
+  CellTester tester_;
+  int c_ = 0, u_ = 1, w_ = 2;
+  int lo_[3], hi_[3];
 };
 
 }  // namespace
@@ -291,127 +608,11 @@ WedgeCellCounts ExactBeamCells(const octomap::OcTree& tree, const BeamWedge& wed
                                std::span<const double> obstacle_ranges_m, double free_range_m,
                                std::vector<std::uint64_t>& free_keys,
                                std::vector<std::uint64_t>& occupied_keys) {
-  WedgeCellCounts counts;
   const double r_first = obstacle_ranges_m.empty() ? free_range_m : obstacle_ranges_m.front();
   double r_far = r_first;
   for (const double r : obstacle_ranges_m) r_far = std::max(r_far, r);
-  if (r_far <= 0.0) return counts;
-  const double res = tree.getResolution();
-  const double half = 0.5 * res;
-  const Vector3d& o = wedge.origin();
-  const Pyramid pyramid(wedge, r_far);
-  // Columns run along the world axis nearest the beam's elevation axis (the wedge's long side).
-  int c = 0;
-  wedge.up().cwiseAbs().maxCoeff(&c);
-  const int u = (c + 1) % 3;
-  const int w = (c + 2) % 3;
-  // Keys of the pyramid's bounding box, within the key range.
-  auto key_of = [&](double coordinate) {
-    const double k = std::floor(coordinate / res) + static_cast<double>(tree.coordToKey(0.0));
-    return static_cast<int>(std::clamp(k, 0.0, 65535.0));
-  };
-  int lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) {
-    double min = 0.0, max = 0.0;
-    for (const Vector3d& p : pyramid.corner) {
-      min = std::min(min, p[k]);
-      max = std::max(max, p[k]);
-    }
-    lo[k] = key_of(o[k] + min - kSlack);
-    hi[k] = key_of(o[k] + max + kSlack);
-  }
-  const CellTester tester(wedge, half, obstacle_ranges_m, r_first, r_far);
-  auto rel = [&](int axis, int key) {
-    return tree.keyToCoord(static_cast<octomap::key_type>(key)) - o[axis];
-  };
-  for (int ku = lo[u]; ku <= hi[u]; ++ku) {
-    const double u0 = rel(u, ku) - half, u1 = rel(u, ku) + half;
-    double w_min = kInf, w_max = -kInf;
-    const int row_axes[1] = {u};
-    const double row_lo[1] = {u0 - kSlack}, row_hi[1] = {u1 + kSlack};
-    if (!pyramid.EdgeExtent(w, 1, row_axes, row_lo, row_hi, w_min, w_max)) continue;
-    const int kw_lo = std::max(lo[w], key_of(o[w] + w_min - kSlack));
-    const int kw_hi = std::min(hi[w], key_of(o[w] + w_max + kSlack));
-    for (int kw = kw_lo; kw <= kw_hi; ++kw) {
-      const double w0 = rel(w, kw) - half, w1 = rel(w, kw) + half;
-      // The column's extent along c: the pyramid's edges within it, its four lines within the
-      // pyramid, then the ball.
-      double c_min = kInf, c_max = -kInf;
-      const int axes[2] = {u, w};
-      const double col_lo[2] = {u0 - kSlack, w0 - kSlack}, col_hi[2] = {u1 + kSlack, w1 + kSlack};
-      pyramid.EdgeExtent(c, 2, axes, col_lo, col_hi, c_min, c_max);
-      for (const double pu : {u0, u1}) {
-        for (const double pw : {w0, w1}) {
-          double t_lo = -kInf, t_hi = kInf;
-          for (int i = 0; i < 5; ++i) {
-            const Vector3d& n = i < 4 ? wedge.normal(i) : wedge.axis();
-            const double bound = (i < 4 ? 0.0 : r_far) - n[u] * pu - n[w] * pw;
-            if (n[c] > 0.0)
-              t_hi = std::min(t_hi, bound / n[c]);
-            else if (n[c] < 0.0)
-              t_lo = std::max(t_lo, bound / n[c]);
-            else if (bound < 0.0)
-              t_hi = -kInf;
-          }
-          if (t_lo > t_hi) continue;
-          c_min = std::min(c_min, t_lo);
-          c_max = std::max(c_max, t_hi);
-        }
-      }
-      if (c_min > c_max) continue;
-      // The cells to examine: those within the first range's ball (free or on its shell), and
-      // for each later range those its sphere passes through.
-      const double du = std::max({u0, -u1, 0.0}), dw = std::max({w0, -w1, 0.0});
-      const double Du = std::max(-u0, u1), Dw = std::max(-w0, w1);
-      std::array<int, 2> runs[2 * kMaxRuns];
-      int n = 0;
-      auto add_run = [&](double lo_c, double hi_c) {
-        lo_c = std::max(lo_c, c_min);
-        hi_c = std::min(hi_c, c_max);
-        if (lo_c > hi_c) return;
-        runs[n][0] = std::max(lo[c], key_of(o[c] + lo_c - kSlack));
-        runs[n][1] = std::min(hi[c], key_of(o[c] + hi_c + kSlack));
-        ++n;
-      };
-      // With many ranges, one run over the farthest range's ball holds them all.
-      const bool one_run = obstacle_ranges_m.size() >= kMaxRuns;
-      for (std::size_t k = 0; k <= (one_run ? 0 : obstacle_ranges_m.size()); ++k) {
-        const double r = one_run ? r_far : k == 0 ? r_first : obstacle_ranges_m[k - 1];
-        if (k > 0 && r <= r_first) continue;
-        const double ball2 = r * r - du * du - dw * dw;
-        if (ball2 < 0.0) continue;
-        const double ball = std::sqrt(ball2);
-        const double shell2 = r * r - Du * Du - Dw * Dw;  // a cell reaches r if its |c| does this
-        if (k == 0 || shell2 <= 0.0) {
-          add_run(-ball, ball);
-        } else {
-          const double shell = std::sqrt(shell2);
-          add_run(-ball, -shell + res);
-          add_run(shell - res, ball);
-        }
-      }
-      std::sort(runs, runs + n);
-      Vector3d centre;
-      centre[u] = rel(u, ku);
-      centre[w] = rel(w, kw);
-      octomap::OcTreeKey key;
-      key[u] = static_cast<octomap::key_type>(ku);
-      key[w] = static_cast<octomap::key_type>(kw);
-      int next = std::numeric_limits<int>::min();  // the first key not yet examined
-      for (int i = 0; i < n; ++i) {
-        for (int kc = std::max(runs[i][0], next); kc <= runs[i][1]; ++kc) {
-          centre[c] = rel(c, kc);
-          ++counts.examined;
-          const Mark m = tester.Classify(centre, counts.clipped);
-          if (m == Mark::kNone) continue;
-          key[c] = static_cast<octomap::key_type>(kc);
-          (m == Mark::kOccupied ? occupied_keys : free_keys).push_back(PackKey(key));
-        }
-        next = std::max(next, runs[i][1] + 1);
-      }
-    }
-  }
-  return counts;
+  if (r_far <= 0.0) return {};
+  return WedgeScan(tree, wedge, obstacle_ranges_m, r_first, r_far).Run(free_keys, occupied_keys);
 }
 
 }  // namespace sonarbench::mapping
