@@ -117,8 +117,12 @@ Mark Decide(double near_lo, double near_hi, double far_lo, double far_hi,
   if (occupied == Tri::kTrue) return Mark::kOccupied;
   if (occupied == Tri::kUnknown) return Mark::kUndecided;
   const double r = r_first * r_first;
-  if (r_first <= 0.0 || far_lo >= r) return Mark::kNone;
-  return far_hi < r ? Mark::kFreeIfMeets : Mark::kUndecided;
+  if (r_first <= 0.0) return Mark::kNone;
+  // With a detection, free means wholly before it; clearing without one, any part before it.
+  const double lo = obstacles.empty() ? near_lo : far_lo;
+  const double hi = obstacles.empty() ? near_hi : far_hi;
+  if (lo >= r) return Mark::kNone;
+  return hi < r ? Mark::kFreeIfMeets : Mark::kUndecided;
 }
 
 double Square(double x) { return x * x; }

@@ -49,7 +49,7 @@ std::uint64_t Key(const octomap::OcTree& tree, double x, double y, double z) {
 //   detection at 0.5 m: cells 0-9 free (the last ends at 0.475), cell 10 holds 0.5: occupied;
 //   at 0.475, the face between cells 9 and 10: both meet that shell, both occupied, 0-8 free;
 //   at 0.2 and 0.4: cells 0-3 free, 4 and 8 occupied, 5-7 and beyond untouched;
-//   none, clearing out to 0.3: cells 0-5 free (cell 6 reaches 0.325).
+//   none, clearing out to 0.3: cells 0-6 free (cell 6, from 0.275, is partly before it).
 TEST(ExactBeamCells, ANeedleBeamMarksTheCellsCountedByHand) {
   const octomap::OcTree tree(kResolution);
   SensorGeometry needle;
@@ -71,7 +71,7 @@ TEST(ExactBeamCells, ANeedleBeamMarksTheCellsCountedByHand) {
   EXPECT_EQ(two.free, row({0, 1, 2, 3}));
   EXPECT_EQ(two.occupied, row({4, 8}));
   const Cells cleared = Exact(tree, needle, beam, {}, 0.3);
-  EXPECT_EQ(cleared.free, row({0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(cleared.free, row({0, 1, 2, 3, 4, 5, 6}));
   EXPECT_TRUE(cleared.occupied.empty());
   const Cells nothing = Exact(tree, needle, beam, {}, 0.0);
   EXPECT_TRUE(nothing.free.empty() && nothing.occupied.empty());
@@ -169,6 +169,16 @@ TEST(ExactBeamCells, HoldsEveryCellOfDenseRayCastsAndMissesNone) {
     }
     EXPECT_EQ(missed_inside, 0u) << missed << " cells missed by the rays";
     EXPECT_LE(exact.examined, 2 * all.size());
+    // Without a detection, clearing out to the range: every cell the rays clear is cleared.
+    const Cells cleared = Exact(tree, micron, beam, {}, range);
+    EXPECT_TRUE(cleared.occupied.empty());
+    BeamCells clearing;
+    CastBeam(tree, beam, dense, std::vector<double>{}, range, clearing);
+    std::size_t not_cleared = 0;
+    for (const auto& key : clearing.free)
+      not_cleared += cleared.free.contains(PackKey(key)) ? 0 : 1;
+    EXPECT_EQ(not_cleared, 0u);
+    EXPECT_GE(cleared.free.size(), exact.free.size());
   }
 }
 

@@ -9,6 +9,7 @@
 
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/detail/beam_wedge.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
@@ -27,6 +28,11 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+
+std::vector<PlotSeries> Plus(std::vector<PlotSeries> a, const std::vector<PlotSeries>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
 
 std::string ItemFile(std::size_t index) {
   char name[64];
@@ -82,10 +88,49 @@ StudyInputs PrepareInputs(const Scene& scene, const std::vector<TriangleMesh>& m
   return in;
 }
 
+// What the exact mode marks of one coverage beam, as MeasureBeamCoverage counts ray casts.
+BeamCoverage MeasureExactCoverage(const StudyInputs::CoverageBeam& b,
+                                  const mapping::SensorGeometry& sensor,
+                                  const octomap::OcTree& key_space) {
+  std::vector<std::uint64_t> free, occupied;
+  const double obstacle[] = {b.range_m};
+  const auto counts = mapping::ExactBeamCells(key_space, mapping::BeamWedge(sensor, b.beam),
+                                              obstacle, 0.0, free, occupied);
+  BeamCoverage c;
+  c.wedge_cells = b.wedge.inside.size();
+  c.undecided_cells = b.wedge.undecided.size();
+  c.visited_cells = free.size() + occupied.size();
+  c.visits = counts.examined;
+  std::size_t visited_undecided = 0;
+  for (const auto* keys : {&free, &occupied}) {
+    for (const std::uint64_t packed : *keys) {
+      const octomap::OcTreeKey key = mapping::UnpackKey(packed);
+      if (b.wedge.inside.contains(key)) {
+        ++c.covered_cells;
+      } else if (b.wedge.undecided.contains(key)) {
+        ++visited_undecided;
+      } else {
+        ++c.visited_outside;
+      }
+    }
+  }
+  auto ratio = [](std::size_t n, std::size_t d) {
+    return d == 0 ? 0.0 : static_cast<double>(n) / static_cast<double>(d);
+  };
+  c.coverage = ratio(c.covered_cells, c.wedge_cells);
+  c.coverage_lower =
+      ratio(c.covered_cells, c.wedge_cells + (c.undecided_cells - visited_undecided));
+  c.coverage_upper = ratio(c.covered_cells + visited_undecided, c.wedge_cells + visited_undecided);
+  c.visits_per_cell = ratio(c.visits, c.visited_cells);
+  return c;
+}
+
 json RunItem(const Scene& scene, const StudyInputs& in, const StudyItem& item, int threads) {
+  const bool exact = item.group == "exact";
   mapping::MapperConfig config = scene.mapping;
-  config.rays_horizontal = item.rays_horizontal;
-  config.rays_vertical = item.rays_vertical;
+  config.integration = exact ? mapping::Integration::kExact : mapping::Integration::kRays;
+  config.rays_horizontal = exact ? config.rays_horizontal : item.rays_horizontal;
+  config.rays_vertical = exact ? config.rays_vertical : item.rays_vertical;
   config.threads = threads;
   const auto start = std::chrono::steady_clock::now();
   mapping::Mapper mapper(config, scene.sensor.geometry);
@@ -98,8 +143,9 @@ json RunItem(const Scene& scene, const StudyInputs& in, const StudyItem& item, i
   double lower_num = 0, upper_num = 0;
   for (const auto& b : in.coverage_beams) {
     const BeamCoverage c =
-        MeasureBeamCoverage(b.beam, scene.sensor.geometry, b.range_m, item.rays_horizontal,
-                            item.rays_vertical, mapper.tree(), b.wedge);
+        exact ? MeasureExactCoverage(b, scene.sensor.geometry, mapper.tree())
+              : MeasureBeamCoverage(b.beam, scene.sensor.geometry, b.range_m, item.rays_horizontal,
+                                    item.rays_vertical, mapper.tree(), b.wedge);
     wedge += c.wedge_cells;
     undecided += c.undecided_cells;
     covered += c.covered_cells;
@@ -157,20 +203,36 @@ void WriteOutputs(const fs::path& root, const std::vector<json>& items, const js
     }
     return s;
   };
-  const cv::Scalar blue(200, 80, 0), red(30, 30, 220), green(40, 160, 40), purple(160, 40, 160);
-  WritePng(
-      (root / "coverage_vs_divisions.png").string(),
-      RenderLinePlot(
-          "Beam-volume coverage and map recall against ray divisions", "divisions", "fraction",
-          {series("horizontal", "rays_horizontal", "beam_coverage", "beam volume, H (V = 64)",
-                  blue),
-           series("vertical", "rays_vertical", "beam_coverage", "beam volume, V (H = 32)", red),
-           series("horizontal", "rays_horizontal", "map_recall", "map recall, H (V = 64)", green),
-           series("vertical", "rays_vertical", "map_recall", "map recall, V (H = 32)", purple)},
-          true, 0.0, 1.0));
-  PlotSeries time{"all items", blue, {}, {}};
+  const cv::Scalar blue(200, 80, 0), red(30, 30, 220), green(40, 160, 40), purple(160, 40, 160),
+      grey(70, 70, 70);
+  // The exact item, if studied, as a level line across the plot.
+  auto exact_line = [&](const char* value, const std::string& name, cv::Scalar colour, double x0,
+                        double x1) {
+    std::vector<PlotSeries> line;
+    for (const json& item : items) {
+      if (item["group"] != "exact") continue;
+      const double y = item[value].get<double>();
+      line.push_back({name, colour, {x0, x1}, {y, y}});
+    }
+    return line;
+  };
+  WritePng((root / "coverage_vs_divisions.png").string(),
+           RenderLinePlot("Beam-volume coverage and map recall against ray divisions", "divisions",
+                          "fraction",
+                          Plus(exact_line("map_recall", "map recall, exact", grey, 1.0, 128.0),
+                               {series("horizontal", "rays_horizontal", "beam_coverage",
+                                       "beam volume, H (V = 64)", blue),
+                                series("vertical", "rays_vertical", "beam_coverage",
+                                       "beam volume, V (H = 32)", red),
+                                series("horizontal", "rays_horizontal", "map_recall",
+                                       "map recall, H (V = 64)", green),
+                                series("vertical", "rays_vertical", "map_recall",
+                                       "map recall, V (H = 32)", purple)}),
+                          true, 0.0, 1.0));
+  PlotSeries time{"rays, all items", blue, {}, {}};
   std::vector<std::pair<double, double>> points;
   for (const json& item : items) {
+    if (item["group"] == "exact") continue;
     points.emplace_back(item["rays_horizontal"].get<double>() * item["rays_vertical"].get<double>(),
                         item["map_s"].get<double>());
   }
@@ -179,9 +241,12 @@ void WriteOutputs(const fs::path& root, const std::vector<json>& items, const js
     time.x.push_back(x);
     time.y.push_back(y);
   }
+  const double fewest_rays = points.empty() ? 1.0 : points.front().first;
+  const double most_rays = points.empty() ? 2.0 : std::max(2.0 * fewest_rays, points.back().first);
   WritePng((root / "time_vs_divisions.png").string(),
            RenderLinePlot("Mapping time against rays per beam (H x V)", "rays per beam", "seconds",
-                          {time}, true, 0.0));
+                          Plus(exact_line("map_s", "exact", grey, fewest_rays, most_rays), {time}),
+                          true, 0.0));
   json study = header;
   study["items"] = items;
   WriteJson((root / "study.json").string(), study);
@@ -196,6 +261,7 @@ std::vector<StudyItem> DivisionsStudyItems() {
   for (int h = 4; h <= 64; h *= 2) {
     for (int v = 8; v <= 128; v *= 2) items.push_back({"grid", h, v});
   }
+  items.push_back({"exact", 0, 0});
   return items;
 }
 

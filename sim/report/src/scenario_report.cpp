@@ -34,6 +34,7 @@ const char* DetectionMethodName(mapping::DetectionConfig::Method method) {
 
 nlohmann::json MappingJson(const mapping::MapperConfig& c) {
   return {{"resolution_m", c.resolution_m},
+          {"integration", c.integration == mapping::Integration::kExact ? "exact" : "rays"},
           {"rays_horizontal", c.rays_horizontal},
           {"rays_vertical", c.rays_vertical},
           {"detection",

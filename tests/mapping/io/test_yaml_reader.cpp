@@ -34,6 +34,15 @@ TEST(YamlReader, DefaultsComeFromTheStruct) {
   EXPECT_EQ(config.rays_vertical, mapping::MapperConfig{}.rays_vertical);
 }
 
+TEST(YamlReader, IntegrationIsExactUnlessRaysAreAskedFor) {
+  EXPECT_EQ(ReadMapping("resolution_m: 0.1\n").integration, mapping::Integration::kExact);
+  EXPECT_EQ(ReadMapping("integration: rays\n").integration, mapping::Integration::kRays);
+  EXPECT_EQ(ReadMapping("integration: exact\n").integration, mapping::Integration::kExact);
+  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("integration: dense\n"); },
+                                   {"scene.yaml:1:14", "'integration'", "rays", "exact",
+                                    "got 'dense'"}));
+}
+
 TEST(YamlReader, UnknownKeyNamesFileLineAndKey) {
   EXPECT_TRUE(
       ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nray_horizontal: 3\n"); },

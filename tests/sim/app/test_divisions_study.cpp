@@ -62,5 +62,30 @@ TEST(DivisionsStudy, ShardsMergeAndMoreVerticalRaysCoverMore) {
   EXPECT_TRUE(RunDivisionsStudy(scene, out.string(), options).complete);
 }
 
+// The exact mode's item: its cells are the wedge's (coverage 1, none outside, the undecided band
+// taken), each examined about once, and no ray cast.
+TEST(DivisionsStudy, TheExactItemCoversTheWholeWedge) {
+  test::TempDir dir;
+  Scene scene = LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  StudyOptions options;
+  options.sweeps = 1;
+  options.coverage_beams = 4;
+  options.items = {{"vertical", 32, 64}, {"exact", 0, 0}};
+  const auto out = dir.path() / "study";
+  ASSERT_TRUE(RunDivisionsStudy(scene, out.string(), options).complete);
+  std::ifstream in(out / "study.json");
+  const auto items = nlohmann::json::parse(in)["items"];
+  ASSERT_EQ(items.size(), 2u);
+  const auto& exact = items[1];
+  EXPECT_EQ(exact["group"], "exact");
+  EXPECT_EQ(exact["beam_coverage"].get<double>(), 1.0);
+  EXPECT_EQ(exact["beam_coverage_upper"].get<double>(), 1.0);
+  EXPECT_EQ(exact["visited_outside_cells"], 0);
+  EXPECT_EQ(exact["ray_casts"], 0);
+  EXPECT_LT(exact["visits_per_cell"].get<double>(), 1.5);
+  EXPECT_LT(items[0]["beam_coverage"].get<double>(), 1.0);
+  EXPECT_GT(exact["map_recall"].get<double>(), 0.0);
+}
+
 }  // namespace
 }  // namespace sonarbench::sim

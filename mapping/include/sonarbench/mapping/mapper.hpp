@@ -19,11 +19,11 @@ namespace sonarbench::mapping {
 /// without the " done." that Debian's liboctomap prints on stderr for each file.
 void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out);
 
-/// The production mapper: detection, beam-volume ray casting and OctoMap log-odds updates.
-/// Threading: Integrate() casts the rays of a batch on `config.threads` threads, each into its
-/// own key sets, merged afterwards, and updates the root's octants in parallel; the resulting
-/// map is identical for any thread count. A Mapper
-/// is not safe to call from several threads at once.
+/// The production mapper: detection, beam volumes (each beam's exact wedge, or ray casts:
+/// `config.integration`) and OctoMap log-odds updates. Threading: Integrate() finds the cells of
+/// a batch's beams on `config.threads` threads, each into its own key sets, merged afterwards,
+/// and updates the root's octants in parallel; the resulting map is identical for any thread
+/// count. A Mapper is not safe to call from several threads at once.
 class Mapper {
  public:
   Mapper(const MapperConfig& config, const SensorGeometry& sensor);

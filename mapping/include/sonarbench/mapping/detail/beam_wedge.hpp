@@ -51,10 +51,11 @@ class BeamWedge {
 };
 
 /// What one beam marks under the exact semantics, for a beam whose detections lie at
-/// `obstacle_ranges_m` (increasing) and which clears out to `free_range_m` without one (0: none).
-/// With S(C) = the ranges of cell C's part inside K, [near, far]:
+/// `obstacle_ranges_m` (nearest first) and which clears out to `free_range_m` without one (0:
+/// clears nothing). With [near, far] = the ranges of cell C's part inside K:
 ///   occupied  if some detection range r lies in [near, far] (C meets that range's shell in K);
-///   free      otherwise, if far < r_1 (the first detection, or free_range_m without one);
+///   free      otherwise, if far < r_1 (C's part in K lies wholly before the first detection), or,
+///             without a detection, if near < free_range_m (the beam saw water there);
 ///   untouched otherwise (beyond the first detection, between shells, or outside K).
 /// Appends packed keys (PackKey) to `free_keys` and `occupied_keys`, each cell once, and returns
 /// the cells examined. Cells outside the tree's key range are left out.

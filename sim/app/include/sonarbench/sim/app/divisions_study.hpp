@@ -11,16 +11,17 @@
 
 namespace sonarbench::sim {
 
-/// One setting of the study: the mapper's horizontal and vertical ray divisions per beam.
+/// One setting of the study: the mapper's horizontal and vertical ray divisions per beam, or its
+/// exact mode (group "exact", divisions 0).
 struct StudyItem {
-  std::string group;  ///< "horizontal", "vertical" or "grid"
+  std::string group;  ///< "horizontal", "vertical", "grid" or "exact"
   int rays_horizontal = 0;
   int rays_vertical = 0;
 };
 
 /// The study's work items, always in this order (item i is items()[i]): horizontal divisions
 /// 1..64 (powers of two) at 64 vertical; vertical 1..128 at 32 horizontal; and the grid
-/// {4..64} x {8..128}.
+/// {4..64} x {8..128}; then the exact mode.
 [[nodiscard]] std::vector<StudyItem> DivisionsStudyItems();
 
 struct StudyOptions {
