@@ -218,6 +218,33 @@ double ReplaySetStreams(const std::vector<SetStreams>& streams, std::uint64_t& c
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// The counts and stages of the last run of the ray row whose totals were kept (unless null) and
+// of the exact row.
+void PrintCounts(const BatchStats* rays, const std::string& rays_name, const BatchStats& exact,
+                 const std::string& exact_name) {
+  if (rays != nullptr) {
+    const BatchStats& totals = *rays;
+    const double updated = static_cast<double>(totals.free_cells + totals.occupied_cells);
+    std::printf(
+        "rays: cell visits %zu, cells updated (per sweep, summed) %.0f: %.1f visits per "
+        "updated cell\n",
+        totals.cell_visits, updated, static_cast<double>(totals.cell_visits) / updated);
+    std::printf(
+        "rays: distinct free cells per beam, summed: %zu (%.1f visits each)\n",
+        totals.beam_free_cells,
+        static_cast<double>(totals.cell_visits) / static_cast<double>(totals.beam_free_cells));
+    std::printf("stages of '%s' (last run): cast %.2f s, split %.2f s, update %.2f s\n",
+                rays_name.c_str(), totals.cast_s, totals.split_s, totals.update_s);
+  }
+  const double exact_updated = static_cast<double>(exact.free_cells + exact.occupied_cells);
+  std::printf(
+      "exact: cells examined %zu (%zu decided by clipping), distinct free cells per beam, "
+      "summed %zu, cells updated (per sweep, summed) %.0f\n",
+      exact.cell_visits, exact.clipped_cells, exact.beam_free_cells, exact_updated);
+  std::printf("stages of '%s' (last run): cast %.2f s, split %.2f s, update %.2f s\n",
+              exact_name.c_str(), exact.cast_s, exact.split_s, exact.update_s);
+}
+
 // The whole mapper with each key set, and in exact mode, against the naive pipeline (Table 1).
 int PipelineTable(const MatLog& log, const SensorGeometry& sensor, const MapperConfig& config,
                   int cores, int repeats, bool exact_only) {
@@ -279,29 +306,8 @@ int PipelineTable(const MatLog& log, const SensorGeometry& sensor, const MapperC
     }
   }
   std::printf("\nthe mapper variants of each mode built the identical map\n");
-  if (!exact_only) {
-    const double updated = static_cast<double>(totals.free_cells + totals.occupied_cells);
-    std::printf(
-        "rays: cell visits %zu, cells updated (per sweep, summed) %.0f: %.1f visits per "
-        "updated cell\n",
-        totals.cell_visits, updated, static_cast<double>(totals.cell_visits) / updated);
-    std::printf(
-        "rays: distinct free cells per beam, summed: %zu (%.1f visits each)\n",
-        totals.beam_free_cells,
-        static_cast<double>(totals.cell_visits) / static_cast<double>(totals.beam_free_cells));
-    std::printf("stages of '%s' (last run): cast %.2f s, split %.2f s, update %.2f s\n",
-                all_variants[kRays].name.c_str(), totals.cast_s, totals.split_s, totals.update_s);
-  }
-  const double exact_updated =
-      static_cast<double>(exact_totals.free_cells + exact_totals.occupied_cells);
-  std::printf(
-      "exact: cells examined %zu (%zu decided by clipping), distinct free cells per beam, "
-      "summed %zu, cells updated (per sweep, summed) %.0f\n",
-      exact_totals.cell_visits, exact_totals.clipped_cells, exact_totals.beam_free_cells,
-      exact_updated);
-  std::printf("stages of '%s' (last run): cast %.2f s, split %.2f s, update %.2f s\n",
-              all_variants[kExact].name.c_str(), exact_totals.cast_s, exact_totals.split_s,
-              exact_totals.update_s);
+  PrintCounts(exact_only ? nullptr : &totals, all_variants[kRays].name, exact_totals,
+              all_variants[kExact].name);
   return 0;
 }
 

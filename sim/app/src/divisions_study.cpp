@@ -175,6 +175,9 @@ json RunItem(const Scene& scene, const StudyInputs& in, const StudyItem& item, i
           {"map_s", map_s}};
 }
 
+void WritePlots(const fs::path& root, const std::vector<json>& items);
+
+// divisions.csv, the plots and study.json.
 void WriteOutputs(const fs::path& root, const std::vector<json>& items, const json& header) {
   std::ostringstream csv;
   const char* columns[] = {"group",         "rays_horizontal",     "rays_vertical",
@@ -192,7 +195,13 @@ void WriteOutputs(const fs::path& root, const std::vector<json>& items, const js
     csv << "\n";
   }
   WriteFileAtomically((root / "divisions.csv").string(), [&](std::ostream& o) { o << csv.str(); });
+  WritePlots(root, items);
+  json study = header;
+  study["items"] = items;
+  WriteJson((root / "study.json").string(), study);
+}
 
+void WritePlots(const fs::path& root, const std::vector<json>& items) {
   auto series = [&](const std::string& group, const char* axis, const char* value,
                     const std::string& name, cv::Scalar colour) {
     PlotSeries s{name, colour, {}, {}};
@@ -247,9 +256,6 @@ void WriteOutputs(const fs::path& root, const std::vector<json>& items, const js
            RenderLinePlot("Mapping time against rays per beam (H x V)", "rays per beam", "seconds",
                           Plus(exact_line("map_s", "exact", grey, fewest_rays, most_rays), {time}),
                           true, 0.0));
-  json study = header;
-  study["items"] = items;
-  WriteJson((root / "study.json").string(), study);
 }
 
 }  // namespace
