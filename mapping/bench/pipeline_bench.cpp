@@ -66,7 +66,8 @@ MapTree MakeTree(const MapperConfig& config) {
 }
 
 // The production pipeline with key set `Set` on `threads` threads, sweep by sweep, its sets
-// kept in `workspace`.
+// kept in `workspace`; the beams' cells from their ray casts or, with `integration: exact`,
+// their wedges.
 template <typename Set>
 std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sensor,
                       const MapperConfig& config, int threads, BatchStats* totals,
@@ -79,8 +80,11 @@ std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sens
   for (std::size_t first = 0; first < all.size(); first += per_sweep) {
     const auto sweep = all.subspan(first, std::min(per_sweep, all.size() - first));
     const auto obstacles = DetectObstacles(sweep, sensor, config.detection);
-    const BatchStats stats =
-        IntegrateBatch(tree, sweep, obstacles, directions, sensor.MaxRangeM(), threads, workspace);
+    const BatchStats stats = config.integration == Integration::kExact
+                                 ? IntegrateExactBatch(tree, sweep, obstacles, sensor,
+                                                       sensor.MaxRangeM(), threads, workspace)
+                                 : IntegrateBatch(tree, sweep, obstacles, directions,
+                                                  sensor.MaxRangeM(), threads, workspace);
     if (totals != nullptr) *totals += stats;
   }
   FinishUpdates(tree);
@@ -90,20 +94,10 @@ std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sens
 // The production pipeline in exact mode (every cell of each beam's wedge once).
 std::string RunExact(const std::vector<Beam>& beams, const SensorGeometry& sensor,
                      const MapperConfig& config, int threads, BatchStats* totals) {
-  if (totals != nullptr) *totals = BatchStats{};
-  MapTree tree = MakeTree(config);
+  MapperConfig exact = config;
+  exact.integration = Integration::kExact;
   BatchWorkspace<KeyOpenSet> workspace;
-  const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
-  const std::span<const Beam> all(beams);
-  for (std::size_t first = 0; first < all.size(); first += per_sweep) {
-    const auto sweep = all.subspan(first, std::min(per_sweep, all.size() - first));
-    const auto obstacles = DetectObstacles(sweep, sensor, config.detection);
-    const BatchStats stats =
-        IntegrateExactBatch(tree, sweep, obstacles, sensor, sensor.MaxRangeM(), threads, workspace);
-    if (totals != nullptr) *totals += stats;
-  }
-  FinishUpdates(tree);
-  return Bytes(tree);
+  return RunMapper(beams, sensor, exact, threads, totals, workspace);
 }
 
 template <typename Set>
@@ -365,6 +359,7 @@ int Main(int argc, char** argv) {
   bool sets_only = false;
   bool exact_only = false;
   MapperConfig config;
+  config.integration = Integration::kRays;  // Table 1's rows; the exact ones set their own
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--repeats") == 0 && i + 1 < argc) {
       repeats = std::max(1, std::atoi(argv[++i]));

@@ -192,8 +192,7 @@ TEST(ExactBeamCells, EveryCellIsMarkedAsItsClippedSpanDecides) {
   std::mt19937_64 rng(13);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int trial = 0; trial < 40; ++trial) {
-    const Beam beam = BeamAt({unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5},
-                             6.283 * unit(rng),
+    const Beam beam = BeamAt({unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5}, 6.283 * unit(rng),
                              {unit(rng) - 0.5, unit(rng) - 0.5, 6.283 * unit(rng)});
     std::vector<double> obstacles;
     for (int k = 0; k < trial % 4; ++k) obstacles.push_back(0.1 + 2.9 * unit(rng));

@@ -9,7 +9,6 @@
 
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/detail/beam_wedge.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
@@ -88,43 +87,6 @@ StudyInputs PrepareInputs(const Scene& scene, const std::vector<TriangleMesh>& m
   return in;
 }
 
-// What the exact mode marks of one coverage beam, as MeasureBeamCoverage counts ray casts.
-BeamCoverage MeasureExactCoverage(const StudyInputs::CoverageBeam& b,
-                                  const mapping::SensorGeometry& sensor,
-                                  const octomap::OcTree& key_space) {
-  std::vector<std::uint64_t> free, occupied;
-  const double obstacle[] = {b.range_m};
-  const auto counts = mapping::ExactBeamCells(key_space, mapping::BeamWedge(sensor, b.beam),
-                                              obstacle, 0.0, free, occupied);
-  BeamCoverage c;
-  c.wedge_cells = b.wedge.inside.size();
-  c.undecided_cells = b.wedge.undecided.size();
-  c.visited_cells = free.size() + occupied.size();
-  c.visits = counts.examined;
-  std::size_t visited_undecided = 0;
-  for (const auto* keys : {&free, &occupied}) {
-    for (const std::uint64_t packed : *keys) {
-      const octomap::OcTreeKey key = mapping::UnpackKey(packed);
-      if (b.wedge.inside.contains(key)) {
-        ++c.covered_cells;
-      } else if (b.wedge.undecided.contains(key)) {
-        ++visited_undecided;
-      } else {
-        ++c.visited_outside;
-      }
-    }
-  }
-  auto ratio = [](std::size_t n, std::size_t d) {
-    return d == 0 ? 0.0 : static_cast<double>(n) / static_cast<double>(d);
-  };
-  c.coverage = ratio(c.covered_cells, c.wedge_cells);
-  c.coverage_lower =
-      ratio(c.covered_cells, c.wedge_cells + (c.undecided_cells - visited_undecided));
-  c.coverage_upper = ratio(c.covered_cells + visited_undecided, c.wedge_cells + visited_undecided);
-  c.visits_per_cell = ratio(c.visits, c.visited_cells);
-  return c;
-}
-
 json RunItem(const Scene& scene, const StudyInputs& in, const StudyItem& item, int threads) {
   const bool exact = item.group == "exact";
   mapping::MapperConfig config = scene.mapping;
@@ -143,7 +105,8 @@ json RunItem(const Scene& scene, const StudyInputs& in, const StudyItem& item, i
   double lower_num = 0, upper_num = 0;
   for (const auto& b : in.coverage_beams) {
     const BeamCoverage c =
-        exact ? MeasureExactCoverage(b, scene.sensor.geometry, mapper.tree())
+        exact ? MeasureExactBeamCoverage(b.beam, scene.sensor.geometry, b.range_m, mapper.tree(),
+                                         b.wedge)
               : MeasureBeamCoverage(b.beam, scene.sensor.geometry, b.range_m, item.rays_horizontal,
                                     item.rays_vertical, mapper.tree(), b.wedge);
     wedge += c.wedge_cells;

@@ -6,6 +6,8 @@
 #include <optional>
 #include <utility>
 
+#include "sonarbench/mapping/detail/beam_wedge.hpp"
+
 namespace sonarbench::sim {
 namespace {
 
@@ -171,21 +173,16 @@ BeamCoverage MeasureBeamCoverage(const mapping::Beam& beam, const mapping::Senso
                              ExactWedgeCells(beam, sensor, range_m, key_space));
 }
 
-BeamCoverage MeasureBeamCoverage(const mapping::Beam& beam, const mapping::SensorGeometry& sensor,
-                                 double range_m, int rays_horizontal, int rays_vertical,
-                                 const octomap::OcTree& key_space, const WedgeCells& wedge) {
-  const auto directions = mapping::BeamRayDirections(sensor, rays_horizontal, rays_vertical);
-  mapping::BeamCells cells;
-  const double obstacle[] = {range_m};
-  mapping::CastBeam(key_space, beam, directions, obstacle, 0.0, cells);
-  mapping::KeySet visited = cells.free;
-  visited.insert(cells.occupied.begin(), cells.occupied.end());
+namespace {
 
+// The coverage of `wedge` by the cells a beam marked (`visited`, after `visits` cell visits).
+BeamCoverage CoverageOf(const mapping::KeySet& visited, std::size_t visits,
+                        const WedgeCells& wedge) {
   BeamCoverage c;
   c.wedge_cells = wedge.inside.size();
   c.undecided_cells = wedge.undecided.size();
   c.visited_cells = visited.size();
-  c.visits = cells.visits;
+  c.visits = visits;
   std::size_t visited_undecided = 0;
   for (const auto& key : visited) {
     if (wedge.inside.contains(key)) {
@@ -207,6 +204,34 @@ BeamCoverage MeasureBeamCoverage(const mapping::Beam& beam, const mapping::Senso
   c.coverage_upper = ratio(c.covered_cells + visited_undecided, c.wedge_cells + visited_undecided);
   c.visits_per_cell = ratio(c.visits, c.visited_cells);
   return c;
+}
+
+}  // namespace
+
+BeamCoverage MeasureBeamCoverage(const mapping::Beam& beam, const mapping::SensorGeometry& sensor,
+                                 double range_m, int rays_horizontal, int rays_vertical,
+                                 const octomap::OcTree& key_space, const WedgeCells& wedge) {
+  const auto directions = mapping::BeamRayDirections(sensor, rays_horizontal, rays_vertical);
+  mapping::BeamCells cells;
+  const double obstacle[] = {range_m};
+  mapping::CastBeam(key_space, beam, directions, obstacle, 0.0, cells);
+  mapping::KeySet visited = cells.free;
+  visited.insert(cells.occupied.begin(), cells.occupied.end());
+  return CoverageOf(visited, cells.visits, wedge);
+}
+
+BeamCoverage MeasureExactBeamCoverage(const mapping::Beam& beam,
+                                      const mapping::SensorGeometry& sensor, double range_m,
+                                      const octomap::OcTree& key_space, const WedgeCells& wedge) {
+  std::vector<std::uint64_t> free, occupied;
+  const double obstacle[] = {range_m};
+  const auto counts = mapping::ExactBeamCells(key_space, mapping::BeamWedge(sensor, beam), obstacle,
+                                              0.0, free, occupied);
+  mapping::KeySet visited;
+  for (const auto* keys : {&free, &occupied}) {
+    for (const std::uint64_t packed : *keys) visited.insert(mapping::UnpackKey(packed));
+  }
+  return CoverageOf(visited, counts.examined, wedge);
 }
 
 }  // namespace sonarbench::sim

@@ -38,9 +38,9 @@ TEST(YamlReader, IntegrationIsExactUnlessRaysAreAskedFor) {
   EXPECT_EQ(ReadMapping("resolution_m: 0.1\n").integration, mapping::Integration::kExact);
   EXPECT_EQ(ReadMapping("integration: rays\n").integration, mapping::Integration::kRays);
   EXPECT_EQ(ReadMapping("integration: exact\n").integration, mapping::Integration::kExact);
-  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("integration: dense\n"); },
-                                   {"scene.yaml:1:14", "'integration'", "rays", "exact",
-                                    "got 'dense'"}));
+  EXPECT_TRUE(
+      ThrowsInputErrorWith([] { (void)ReadMapping("integration: dense\n"); },
+                           {"scene.yaml:1:14", "'integration'", "rays", "exact", "got 'dense'"}));
 }
 
 TEST(YamlReader, UnknownKeyNamesFileLineAndKey) {

@@ -56,5 +56,12 @@ struct BeamCoverage {
                                                double range_m, int rays_horizontal,
                                                int rays_vertical, const octomap::OcTree& key_space,
                                                const WedgeCells& wedge);
+/// The same for the mapper's exact mode (ExactBeamCells with a detection at `range_m`): visits
+/// are the cells it examined.
+[[nodiscard]] BeamCoverage MeasureExactBeamCoverage(const mapping::Beam& beam,
+                                                    const mapping::SensorGeometry& sensor,
+                                                    double range_m,
+                                                    const octomap::OcTree& key_space,
+                                                    const WedgeCells& wedge);
 
 }  // namespace sonarbench::sim
