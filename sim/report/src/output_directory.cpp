@@ -348,11 +348,10 @@ void OutputDirectory::RemoveFiles(const std::vector<std::string>& files) const {
 void OutputDirectory::RemoveTemporaries(const std::vector<std::string>& files) const {
   // "NAME.tmp.PID" beside a listed or given NAME: WriteFileAtomically's, of a writer that died.
   const auto listed = OwnedFiles(root_).value_or(std::vector<std::string>{});
-  const std::set<std::string> names(listed.begin(), listed.end());
+  const std::vector<std::string> all = SortedUnion(files, listed);
+  const std::set<std::string> names(all.begin(), all.end());
   std::set<fs::path> folders;
-  for (const std::string& file : SortedUnion(files, listed)) {
-    folders.insert(fs::path(file).parent_path());
-  }
+  for (const std::string& file : all) folders.insert(fs::path(file).parent_path());
   for (const fs::path& folder : folders) {
     std::error_code error;
     for (fs::directory_iterator it(root_ / folder, error), end; !error && it != end;

@@ -102,6 +102,26 @@ TEST(OutputDirectory, AnUncommittedRunLeavesTheEarlierOutputsWhole) {
   EXPECT_FALSE(fs::exists(dir.path() / OutputDirectory::kStageDir));
 }
 
+// A run killed while writing a staged file leaves "NAME.tmp.PID" in the stage (the release
+// that removes staged files never ran); the next run removes it with the stage's files and
+// commits. A file of the same pattern beside a name the command does not claim stays.
+TEST(OutputDirectory, AKilledRunsStagedTemporaryIsRemovedByTheNext) {
+  test::TempDir dir;
+  const OutputClaim claim = Claim(OutputMode::kReplace);
+  const fs::path stage = dir.path() / OutputDirectory::kStageDir;
+  Put(stage / "map.bt.tmp.4242", "half of a map");
+  Put(stage / "sub" / "item.json.tmp.17", "half of an item");
+  Put(stage / "notes.txt.tmp.5", "not a claimed name");
+  OutputDirectory out(dir.path().string(), claim);
+  EXPECT_FALSE(fs::exists(stage / "map.bt.tmp.4242"));
+  EXPECT_FALSE(fs::exists(stage / "sub" / "item.json.tmp.17"));
+  EXPECT_EQ(Bytes(stage / "notes.txt.tmp.5"), "not a claimed name");
+  fs::remove(stage / "notes.txt.tmp.5");
+  WriteAll(out, claim, "second");
+  out.Commit();
+  for (const std::string& file : claim.files) EXPECT_EQ(Bytes(dir.path() / file), "second");
+}
+
 TEST(OutputDirectory, ACommitLeavesNoFileOfTheEarlierRun) {
   test::TempDir dir;
   const OutputClaim claim = Claim(OutputMode::kReplace);
