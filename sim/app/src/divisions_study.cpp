@@ -138,32 +138,7 @@ json RunItem(const Scene& scene, const StudyInputs& in, const StudyItem& item, i
           {"map_s", map_s}};
 }
 
-void WritePlots(const fs::path& root, const std::vector<json>& items);
-
-// divisions.csv, the plots and study.json.
-void WriteOutputs(const fs::path& root, const std::vector<json>& items, const json& header) {
-  std::ostringstream csv;
-  const char* columns[] = {"group",         "rays_horizontal",     "rays_vertical",
-                           "beam_coverage", "beam_coverage_lower", "beam_coverage_upper",
-                           "wedge_cells",   "undecided_cells",     "visits_per_cell",
-                           "map_precision", "map_recall",          "map_coverage",
-                           "ray_casts",     "cell_visits",         "map_s"};
-  for (std::size_t c = 0; c < std::size(columns); ++c) csv << (c ? "," : "") << columns[c];
-  csv << "\n";
-  for (const json& item : items) {
-    for (std::size_t c = 0; c < std::size(columns); ++c) {
-      const json& v = item.at(columns[c]);
-      csv << (c ? "," : "") << (v.is_string() ? v.get<std::string>() : v.dump());
-    }
-    csv << "\n";
-  }
-  WriteFileAtomically((root / "divisions.csv").string(), [&](std::ostream& o) { o << csv.str(); });
-  WritePlots(root, items);
-  json study = header;
-  study["items"] = items;
-  WriteJson((root / "study.json").string(), study);
-}
-
+// coverage_vs_divisions.png and time_vs_divisions.png.
 void WritePlots(const fs::path& root, const std::vector<json>& items) {
   auto series = [&](const std::string& group, const char* axis, const char* value,
                     const std::string& name, cv::Scalar colour) {
@@ -219,6 +194,30 @@ void WritePlots(const fs::path& root, const std::vector<json>& items) {
            RenderLinePlot("Mapping time against rays per beam (H x V)", "rays per beam", "seconds",
                           Plus(exact_line("map_s", "exact", grey, fewest_rays, most_rays), {time}),
                           true, 0.0));
+}
+
+// divisions.csv, the plots and study.json.
+void WriteOutputs(const fs::path& root, const std::vector<json>& items, const json& header) {
+  std::ostringstream csv;
+  const char* columns[] = {"group",         "rays_horizontal",     "rays_vertical",
+                           "beam_coverage", "beam_coverage_lower", "beam_coverage_upper",
+                           "wedge_cells",   "undecided_cells",     "visits_per_cell",
+                           "map_precision", "map_recall",          "map_coverage",
+                           "ray_casts",     "cell_visits",         "map_s"};
+  for (std::size_t c = 0; c < std::size(columns); ++c) csv << (c ? "," : "") << columns[c];
+  csv << "\n";
+  for (const json& item : items) {
+    for (std::size_t c = 0; c < std::size(columns); ++c) {
+      const json& v = item.at(columns[c]);
+      csv << (c ? "," : "") << (v.is_string() ? v.get<std::string>() : v.dump());
+    }
+    csv << "\n";
+  }
+  WriteFileAtomically((root / "divisions.csv").string(), [&](std::ostream& o) { o << csv.str(); });
+  WritePlots(root, items);
+  json study = header;
+  study["items"] = items;
+  WriteJson((root / "study.json").string(), study);
 }
 
 }  // namespace

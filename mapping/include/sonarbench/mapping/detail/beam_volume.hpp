@@ -155,14 +155,15 @@ void CastBeamExact(const octomap::OcTree& tree, const SensorGeometry& sensor, co
   cells.visits += counts.examined;
   cells.clipped += counts.clipped;
   cells.beam_free_cells += cells.beam_free.size();
-  for (auto [keys, recent, set] :
-       {std::tuple(&cells.beam_free, &cells.recent_free, &cells.free),
-        std::tuple(&cells.beam_occupied, &cells.recent_occupied, &cells.occupied)}) {
-    cells.fresh_free.clear();
+  for (auto [keys, recent, fresh, set] :
+       {std::tuple(&cells.beam_free, &cells.recent_free, &cells.fresh_free, &cells.free),
+        std::tuple(&cells.beam_occupied, &cells.recent_occupied, &cells.fresh_occupied,
+                   &cells.occupied)}) {
+    fresh->clear();
     for (const std::uint64_t packed : *keys) {
-      if (!recent->CheckAndRemember(packed)) cells.fresh_free.push_back(packed);
+      if (!recent->CheckAndRemember(packed)) fresh->push_back(packed);
     }
-    cells.Insert(*set, cells.fresh_free);
+    cells.Insert(*set, *fresh);
   }
 }
 
