@@ -1,6 +1,9 @@
 #include "sonarbench/mapping/detection.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <numeric>
 #include <opencv2/imgproc.hpp>
 
 namespace sonarbench::mapping {
@@ -31,10 +34,9 @@ std::vector<double> ChooseEchoes(std::vector<Echo> echoes, const Beam& beam, int
   return ranges;
 }
 
-}  // namespace
-
-std::vector<double> DetectThreshold(const Beam& beam, const SensorGeometry& sensor,
-                                    const DetectionConfig& config) {
+// The threshold detector's candidate echoes of one beam, nearest first.
+std::vector<Echo> ThresholdEchoes(const Beam& beam, const SensorGeometry& sensor,
+                                  const DetectionConfig& config) {
   const int n = static_cast<int>(beam.intensities.size());
   const int first = std::min(sensor.FirstUsableBin(), n);
   const int half = config.smoothing_bins / 2;
@@ -62,17 +64,18 @@ std::vector<double> DetectThreshold(const Beam& beam, const SensorGeometry& sens
       run_start = -1;
     }
   }
-  return ChooseEchoes(std::move(runs), beam, config.max_obstacles);
+  return runs;
 }
 
-std::vector<std::vector<double>> DetectCanny(std::span<const Beam> beams,
-                                             const SensorGeometry& sensor,
-                                             const DetectionConfig& config) {
-  std::vector<std::vector<double>> ranges(beams.size());
+// The Canny detector's candidate echoes of every beam of a batch, nearest first.
+std::vector<std::vector<Echo>> CannyEchoes(std::span<const Beam> beams,
+                                           const SensorGeometry& sensor,
+                                           const DetectionConfig& config) {
+  std::vector<std::vector<Echo>> candidates(beams.size());
   std::size_t bins = 0;
   for (const Beam& beam : beams) bins = std::max(bins, beam.intensities.size());
   const int first = sensor.FirstUsableBin();
-  if (beams.empty() || static_cast<int>(bins) <= first) return ranges;
+  if (beams.empty() || static_cast<int>(bins) <= first) return candidates;
 
   cv::Mat image(static_cast<int>(beams.size()), static_cast<int>(bins), CV_8UC1, cv::Scalar(0));
   for (std::size_t r = 0; r < beams.size(); ++r) {
@@ -119,10 +122,84 @@ std::vector<std::vector<double>> DetectCanny(std::span<const Beam> beams,
       for (int j = k; j < std::min(n, k + 5); ++j) peak = std::max<double>(peak, intensity[j]);
       echoes.push_back({k, peak});
     }
-    ranges[static_cast<std::size_t>(r)] =
-        ChooseEchoes(std::move(echoes), beams[static_cast<std::size_t>(r)], config.max_obstacles);
+    candidates[static_cast<std::size_t>(r)] = std::move(echoes);
   }
+  return candidates;
+}
+
+// Removes each beam's later echoes (all but its first) that no other beam within
+// `support_window_deg` of head angle hears first within `support_range_m` of their range.
+void DropUnsupportedLaterEchoes(std::vector<std::vector<Echo>>& candidates,
+                                std::span<const Beam> beams, const DetectionConfig& config) {
+  const double window = config.support_window_deg * std::numbers::pi / 180.0;
+  std::vector<double> first_range(beams.size(), -1.0);
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    if (!candidates[b].empty())
+      first_range[b] = beams[b].BinCentreRange(static_cast<std::size_t>(candidates[b][0].bin));
+  }
+  // Beams in order of head angle, so that each one's neighbours are a contiguous (circular) run.
+  const std::size_t n = beams.size();
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  auto angle = [&](std::size_t b) {
+    const double a = std::fmod(beams[b].head_angle_rad, 2.0 * std::numbers::pi);
+    return a < 0.0 ? a + 2.0 * std::numbers::pi : a;
+  };
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return angle(a) < angle(b); });
+  auto supported = [&](std::size_t at, double range) {
+    const std::size_t b = order[at];
+    for (std::size_t step = 1; step <= n / 2; ++step) {
+      bool within = false;
+      for (const std::size_t other : {order[(at + step) % n], order[(at + n - step) % n]}) {
+        const double gap = std::abs(std::remainder(
+            beams[other].head_angle_rad - beams[b].head_angle_rad, 2.0 * std::numbers::pi));
+        if (gap > window) continue;
+        within = true;
+        if (first_range[other] >= 0.0 &&
+            std::abs(first_range[other] - range) <= config.support_range_m)
+          return true;
+      }
+      if (!within) return false;
+    }
+    return false;
+  };
+  for (std::size_t at = 0; at < n; ++at) {
+    std::vector<Echo>& echoes = candidates[order[at]];
+    if (echoes.size() < 2) continue;
+    const Beam& beam = beams[order[at]];
+    std::vector<Echo> kept{echoes.front()};
+    for (std::size_t e = 1; e < echoes.size(); ++e) {
+      if (supported(at, beam.BinCentreRange(static_cast<std::size_t>(echoes[e].bin))))
+        kept.push_back(echoes[e]);
+    }
+    echoes = std::move(kept);
+  }
+}
+
+// The ranges a batch's beams report, from their candidate echoes.
+std::vector<std::vector<double>> ChooseAll(std::vector<std::vector<Echo>> candidates,
+                                           std::span<const Beam> beams,
+                                           const DetectionConfig& config) {
+  if (config.later_echoes == DetectionConfig::LaterEchoes::kSupported)
+    DropUnsupportedLaterEchoes(candidates, beams, config);
+  std::vector<std::vector<double>> ranges(beams.size());
+  for (std::size_t b = 0; b < beams.size(); ++b)
+    ranges[b] = ChooseEchoes(std::move(candidates[b]), beams[b], config.max_obstacles);
   return ranges;
+}
+
+}  // namespace
+
+std::vector<double> DetectThreshold(const Beam& beam, const SensorGeometry& sensor,
+                                    const DetectionConfig& config) {
+  return ChooseEchoes(ThresholdEchoes(beam, sensor, config), beam, config.max_obstacles);
+}
+
+std::vector<std::vector<double>> DetectCanny(std::span<const Beam> beams,
+                                             const SensorGeometry& sensor,
+                                             const DetectionConfig& config) {
+  return ChooseAll(CannyEchoes(beams, sensor, config), beams, config);
 }
 
 std::vector<std::vector<double>> DetectObstacles(std::span<const Beam> beams,
@@ -130,10 +207,10 @@ std::vector<std::vector<double>> DetectObstacles(std::span<const Beam> beams,
                                                  const DetectionConfig& config) {
   if (config.method != DetectionConfig::Method::kThreshold)
     return DetectCanny(beams, sensor, config);
-  std::vector<std::vector<double>> ranges(beams.size());
+  std::vector<std::vector<Echo>> candidates(beams.size());
   for (std::size_t b = 0; b < beams.size(); ++b)
-    ranges[b] = DetectThreshold(beams[b], sensor, config);
-  return ranges;
+    candidates[b] = ThresholdEchoes(beams[b], sensor, config);
+  return ChooseAll(std::move(candidates), beams, config);
 }
 
 }  // namespace sonarbench::mapping

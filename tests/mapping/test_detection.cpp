@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numbers>
 
 #include "sonarbench/mapping/detection.hpp"
 
@@ -294,6 +295,77 @@ TEST(DetectCanny, FlatSweepHasNoEchoes) {
   DetectionConfig config;
   config.method = DetectionConfig::Method::kCanny;
   for (const auto& r : DetectObstacles(sweep, sensor, config)) EXPECT_TRUE(r.empty());
+}
+
+// A full revolution, one beam every step: every beam hears a wall at bin `wall` and an echo at
+// twice its range (a round trip); beam `shadowed` hears a box at bin 60 first.
+std::vector<Beam> WallSweep(const SensorGeometry& sensor, int wall, std::size_t shadowed) {
+  std::vector<Beam> sweep;
+  for (int b = 0; b < sensor.BeamsPerSweep(); ++b) {
+    Beam beam = MakeBeam(sensor);
+    beam.head_angle_rad = b * sensor.step_angle_rad;
+    Fill(beam, wall, wall + 5, 150);
+    Fill(beam, 2 * wall, 2 * wall + 5, 200);
+    if (static_cast<std::size_t>(b) == shadowed) Fill(beam, 60, 65, 120);
+    sweep.push_back(beam);
+  }
+  return sweep;
+}
+
+// Supported later echoes: the wall behind the box is kept (its neighbours hear the wall first);
+// the round trip, which no beam hears first, is dropped. The paper's rule keeps the strongest.
+TEST(DetectObstacles, ALaterEchoNeedsANeighbourThatHearsItFirst) {
+  const SensorGeometry sensor;
+  const std::vector<Beam> sweep = WallSweep(sensor, 150, 7);
+  DetectionConfig config;
+  config.smoothing_bins = 1;
+  config.threshold = 100;
+  config.max_obstacles = 2;
+  auto strongest = DetectObstacles(sweep, sensor, config);
+  config.later_echoes = DetectionConfig::LaterEchoes::kSupported;
+  auto supported = DetectObstacles(sweep, sensor, config);
+  const Beam& beam = sweep[7];
+  EXPECT_EQ(strongest[7], (std::vector<double>{beam.BinCentreRange(60), beam.BinCentreRange(300)}));
+  EXPECT_EQ(supported[7], (std::vector<double>{beam.BinCentreRange(60), beam.BinCentreRange(150)}));
+  for (std::size_t b : {0u, 6u, 8u, 199u}) {
+    EXPECT_EQ(strongest[b],
+              (std::vector<double>{beam.BinCentreRange(150), beam.BinCentreRange(300)}));
+    EXPECT_EQ(supported[b], std::vector<double>{beam.BinCentreRange(150)}) << "beam " << b;
+  }
+  config.method = DetectionConfig::Method::kCanny;  // the rule follows either detector
+  for (const auto& ranges : DetectObstacles(sweep, sensor, config)) EXPECT_EQ(ranges.size(), 1u);
+}
+
+// The window is in head angle, across 0 and 2π: a beam whose only support is k steps away, 8 bins
+// further, keeps its later echo exactly when the window reaches k steps and the tolerance 8 bins.
+TEST(DetectObstacles, SupportComesFromWithinTheWindowAndTolerance) {
+  const SensorGeometry sensor;
+  const double step_deg = sensor.step_angle_rad * 180.0 / std::numbers::pi;
+  for (const std::size_t beam_at : {0u, 100u}) {
+    for (int steps = 1; steps <= 4; ++steps) {
+      std::vector<Beam> sweep;
+      for (int b = 0; b < sensor.BeamsPerSweep(); ++b) {
+        Beam beam = MakeBeam(sensor);
+        beam.head_angle_rad = b * sensor.step_angle_rad;
+        sweep.push_back(beam);
+      }
+      Fill(sweep[beam_at], 60, 65, 120);
+      Fill(sweep[beam_at], 150, 155, 150);
+      const std::size_t n = sweep.size();
+      Fill(sweep[(beam_at + n - static_cast<std::size_t>(steps)) % n], 158, 163, 150);
+      DetectionConfig config;
+      config.smoothing_bins = 1;
+      config.threshold = 100;
+      config.later_echoes = DetectionConfig::LaterEchoes::kSupported;
+      config.support_range_m = 8.25 * sensor.bin_size_m;
+      config.support_window_deg = (steps - 0.5) * step_deg;
+      EXPECT_EQ(DetectObstacles(sweep, sensor, config)[beam_at].size(), 1u) << beam_at << steps;
+      config.support_window_deg = (steps + 0.5) * step_deg;
+      EXPECT_EQ(DetectObstacles(sweep, sensor, config)[beam_at].size(), 2u) << beam_at << steps;
+      config.support_range_m = 7.75 * sensor.bin_size_m;
+      EXPECT_EQ(DetectObstacles(sweep, sensor, config)[beam_at].size(), 1u) << beam_at << steps;
+    }
+  }
 }
 
 }  // namespace

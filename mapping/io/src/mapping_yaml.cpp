@@ -26,6 +26,13 @@ MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
     detection->Optional("smoothing_bins", d.smoothing_bins, IntInRange(1, 99));
     detection->Optional("min_run_bins", d.min_run_bins, IntInRange(1, 1000));
     detection->Optional("max_obstacles", d.max_obstacles, IntInRange(1, 100));
+    std::string later =
+        d.later_echoes == DetectionConfig::LaterEchoes::kSupported ? "supported" : "strongest";
+    detection->Optional("later_echoes", later, OneOf({"strongest", "supported"}));
+    d.later_echoes = later == "supported" ? DetectionConfig::LaterEchoes::kSupported
+                                          : DetectionConfig::LaterEchoes::kStrongest;
+    detection->Optional("support_window_deg", d.support_window_deg, InRange(0.0, 180.0));
+    detection->Optional("support_range_m", d.support_range_m, InRange(0.0, 100.0));
     detection->Optional("canny_low", d.canny_low, InRange(0.0, 2000.0));
     detection->Optional("canny_high", d.canny_high, InRange(0.0, 2000.0));
     detection->Optional("canny_blur_sigma", d.canny_blur_sigma, InRange(0.1, 10.0));

@@ -224,7 +224,11 @@ nlohmann::json LogMapReportJson(const LogMapResult& result, const MapCells& cell
          {"rays_horizontal", c.rays_horizontal},
          {"rays_vertical", c.rays_vertical},
          {"threshold", c.detection.threshold},
-         {"max_obstacles", c.detection.max_obstacles}}},
+         {"max_obstacles", c.detection.max_obstacles},
+         {"later_echoes",
+          c.detection.later_echoes == mapping::DetectionConfig::LaterEchoes::kSupported
+              ? "supported"
+              : "strongest"}}},
        {"map",
         {{"occupied_cells", cells.occupied.size()},
          {"free_cells", cells.free.size()},

@@ -32,6 +32,10 @@ const char* DetectionMethodName(mapping::DetectionConfig::Method method) {
   return "?";
 }
 
+std::string LaterEchoesName(mapping::DetectionConfig::LaterEchoes e) {
+  return e == mapping::DetectionConfig::LaterEchoes::kSupported ? "supported" : "strongest";
+}
+
 nlohmann::json MappingJson(const mapping::MapperConfig& c) {
   return {{"resolution_m", c.resolution_m},
           {"integration", c.integration == mapping::Integration::kExact ? "exact" : "rays"},
@@ -43,6 +47,9 @@ nlohmann::json MappingJson(const mapping::MapperConfig& c) {
             {"smoothing_bins", c.detection.smoothing_bins},
             {"min_run_bins", c.detection.min_run_bins},
             {"max_obstacles", c.detection.max_obstacles},
+            {"later_echoes", LaterEchoesName(c.detection.later_echoes)},
+            {"support_window_deg", c.detection.support_window_deg},
+            {"support_range_m", c.detection.support_range_m},
             {"canny_low", c.detection.canny_low},
             {"canny_high", c.detection.canny_high},
             {"canny_blur_sigma", c.detection.canny_blur_sigma},

@@ -43,6 +43,24 @@ TEST(YamlReader, IntegrationIsExactUnlessRaysAreAskedFor) {
                            {"scene.yaml:1:14", "'integration'", "rays", "exact", "got 'dense'"}));
 }
 
+TEST(YamlReader, LaterEchoesAreTheStrongestUnlessSupportIsAskedFor) {
+  using LaterEchoes = mapping::DetectionConfig::LaterEchoes;
+  EXPECT_EQ(ReadMapping("resolution_m: 0.1\n").detection.later_echoes, LaterEchoes::kStrongest);
+  const mapping::DetectionConfig d = ReadMapping(
+                                         "detection:\n  later_echoes: supported\n  "
+                                         "support_window_deg: 5\n  support_range_m: 0.2\n")
+                                         .detection;
+  EXPECT_EQ(d.later_echoes, LaterEchoes::kSupported);
+  EXPECT_DOUBLE_EQ(d.support_window_deg, 5.0);
+  EXPECT_DOUBLE_EQ(d.support_range_m, 0.2);
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [] { (void)ReadMapping("detection:\n  later_echoes: all\n"); },
+      {"scene.yaml:2:17", "'detection.later_echoes'", "strongest", "supported", "got 'all'"}));
+  EXPECT_TRUE(
+      ThrowsInputErrorWith([] { (void)ReadMapping("detection:\n  support_window_deg: -1\n"); },
+                           {"'detection.support_window_deg'", "got '-1'"}));
+}
+
 TEST(YamlReader, UnknownKeyNamesFileLineAndKey) {
   EXPECT_TRUE(
       ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nray_horizontal: 3\n"); },

@@ -14,7 +14,8 @@ namespace sonarbench::mapping {
 /// `min_run_bins` bins at or above `threshold` is an echo whose range [m] is the centre of the
 /// run's first bin (the echo of a surface starts at its range; the pulse extends it behind).
 /// Returns up to `max_obstacles` ranges, nearest first: the first run, then the runs with the
-/// highest peaks. Empty if the beam saw nothing.
+/// highest peaks. Empty if the beam saw nothing. One beam has no neighbours: `later_echoes` is
+/// applied by DetectObstacles only.
 [[nodiscard]] std::vector<double> DetectThreshold(const Beam& beam, const SensorGeometry& sensor,
                                                   const DetectionConfig& config);
 
@@ -27,7 +28,9 @@ namespace sonarbench::mapping {
                                                            const SensorGeometry& sensor,
                                                            const DetectionConfig& config);
 
-/// The obstacle ranges [m] of every beam of a batch, by the configured method.
+/// The obstacle ranges [m] of every beam of a batch, by the configured method. With
+/// `later_echoes` kSupported a later echo is kept only if another beam of the batch within
+/// `support_window_deg` of head angle has its first echo within `support_range_m` of it.
 [[nodiscard]] std::vector<std::vector<double>> DetectObstacles(std::span<const Beam> beams,
                                                                const SensorGeometry& sensor,
                                                                const DetectionConfig& config);

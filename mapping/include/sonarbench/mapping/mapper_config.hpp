@@ -23,6 +23,17 @@ struct DetectionConfig {
   /// Obstacles reported per beam: 1 is the paper's "first obstacle"; more add the strongest of
   /// the later echoes (by peak intensity). 2 maps a wall behind a weaker object or the floor.
   int max_obstacles = 2;
+  /// Which later echoes (after a beam's first) may be reported.
+  enum class LaterEchoes {
+    kStrongest,  ///< any: the strongest (the paper)
+    kSupported,  ///< only those that a beam within `support_window_deg` hears as its first echo
+                 ///< within `support_range_m`: a surface seen directly around a nearer object
+  };
+  LaterEchoes later_echoes = LaterEchoes::kStrongest;
+  /// kSupported: head-angle distance [deg] within which a beam supports another's later echo.
+  double support_window_deg = 9.0;
+  /// kSupported: how close [m] the supporting beam's first echo must be to the later echo.
+  double support_range_m = 0.1;
   /// kCanny: hysteresis thresholds on the gradient magnitude (L2, 3×3 Sobel) [intensity/pixel].
   double canny_low = 60.0;
   double canny_high = 150.0;
