@@ -41,6 +41,7 @@ Command AddScoreCommand(CLI::App& app);
 Command AddFidelityCommand(CLI::App& app);
 Command AddSimulateCommand(CLI::App& app);
 Command AddSweepCommand(CLI::App& app);
+Command AddDetectorsCommand(CLI::App& app);
 Command AddImportCommand(CLI::App& app);
 Command AddExportCommand(CLI::App& app);
 

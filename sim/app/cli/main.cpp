@@ -18,9 +18,9 @@ int main(int argc, char** argv) {
   cli.require_subcommand(1);
   cli.set_version_flag("--version", std::string("sonarbench ") + sonarbench::sim::kVersion);
   const std::vector<app::Command> commands = {
-      app::AddRunCommand(cli),      app::AddMapCommand(cli),      app::AddScoreCommand(cli),
-      app::AddFidelityCommand(cli), app::AddSimulateCommand(cli), app::AddSweepCommand(cli),
-      app::AddImportCommand(cli),   app::AddExportCommand(cli)};
+      app::AddRunCommand(cli),       app::AddMapCommand(cli),      app::AddScoreCommand(cli),
+      app::AddFidelityCommand(cli),  app::AddSimulateCommand(cli), app::AddSweepCommand(cli),
+      app::AddDetectorsCommand(cli), app::AddImportCommand(cli),   app::AddExportCommand(cli)};
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -450,7 +450,7 @@ TEST(Cli, VersionAndUnknownCommands) {
   EXPECT_EQ(output, "sonarbench " + std::string(kVersion) + "\n");
   EXPECT_EQ(RunCli("frobnicate scenes", &output), 2);
   EXPECT_NE(output.find("unknown command 'frobnicate'; the commands are run, map, score, fidelity, "
-                        "simulate, sweep, import"),
+                        "simulate, sweep, detectors, import, export"),
             std::string::npos)
       << output;
   EXPECT_EQ(RunCli("", &output), 2);

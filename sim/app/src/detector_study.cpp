@@ -1,0 +1,220 @@
+#include "sonarbench/sim/app/detector_study.hpp"
+
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/mapper.hpp"
+#include "sonarbench/sim/app/map_log.hpp"
+#include "sonarbench/sim/eval/ground_truth.hpp"
+#include "sonarbench/sim/report/images.hpp"
+#include "sonarbench/sim/report/report.hpp"
+#include "sonarbench/sim/sonar/simulation.hpp"
+#include "sonarbench/sim/world/mesh.hpp"
+#include "sonarbench/sim/world/ray_tracer.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+using nlohmann::json;
+using Detection = mapping::DetectionConfig;
+
+const char* MethodName(Detection::Method method) {
+  switch (method) {
+    case Detection::Method::kThreshold:
+      return "threshold";
+    case Detection::Method::kCanny:
+      return "canny";
+    case Detection::Method::kAutoCanny:
+      return "auto_canny";
+  }
+  return "?";
+}
+
+const char* LaterName(Detection::LaterEchoes later) {
+  return later == Detection::LaterEchoes::kSupported ? "supported" : "strongest";
+}
+
+// The echo rule of a setting, as the CSV, the plot's legend and the item's name give it.
+std::string EchoRule(const Detection& d) {
+  if (d.max_obstacles == 1) return "first echo";
+  return std::to_string(d.max_obstacles) + " echoes, " + LaterName(d.later_echoes);
+}
+
+// A map of `beams` with `detection`, scored against the truth and what a perfect sensor sees.
+MapMetrics MapAndScore(const mapping::MapperConfig& base, const Detection& detection,
+                       const mapping::SensorGeometry& sensor, std::span<const mapping::Beam> beams,
+                       const mapping::KeySet& truth, const mapping::KeySet& observable) {
+  mapping::MapperConfig config = base;
+  config.detection = detection;
+  mapping::Mapper mapper(config, sensor);
+  (void)mapper.IntegrateSweeps(beams);
+  return ScoreMap(mapper.tree(), truth, observable);
+}
+
+json MetricsJson(const MapMetrics& m) {
+  return {{"precision", m.occupied_precision},
+          {"recall", m.occupied_recall},
+          {"precision_1", m.precision_within[1]},
+          {"recall_1", m.recall_within[1]},
+          {"f1_1", m.f1_within[1]},
+          {"ghost_share", m.ghost_share},
+          {"column_precision", m.column_precision},
+          {"column_recall", m.column_recall},
+          {"coverage", m.coverage},
+          {"occupied_cells", m.occupied_cells}};
+}
+
+const std::vector<std::string> kMetricColumns = {
+    "precision",   "recall",           "precision_1",   "recall_1", "f1_1",
+    "ghost_share", "column_precision", "column_recall", "coverage", "occupied_cells"};
+
+void WriteCsv(const std::string& path, const std::vector<DetectorRow>& rows, bool with_log) {
+  std::ostringstream csv;
+  csv << "item,method,threshold,max_obstacles,later_echoes";
+  for (const char* source : {"scene", "log"}) {
+    if (std::string(source) == "log" && !with_log) continue;
+    for (const std::string& c : kMetricColumns) csv << "," << source << "_" << c;
+  }
+  csv << "\n";
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const Detection& d = rows[i].item.detection;
+    csv << i << "," << MethodName(d.method) << ","
+        << (d.method == Detection::Method::kThreshold ? std::to_string(d.threshold) : "") << ","
+        << d.max_obstacles << "," << LaterName(d.later_echoes);
+    for (const MapMetrics* m : {&rows[i].scene, rows[i].log ? &*rows[i].log : nullptr}) {
+      if (!m) continue;
+      const json values = MetricsJson(*m);
+      for (const std::string& c : kMetricColumns) csv << "," << values.at(c).dump();
+    }
+    csv << "\n";
+  }
+  WriteFileAtomically(path, [&](std::ostream& o) { o << csv.str(); });
+}
+
+// Precision against recall at one cell of tolerance, of the scene's maps or the log's: the
+// threshold detector a series per echo rule (its thresholds' points), Canny and automatic Canny a
+// series each (a point per echo rule).
+void WritePlot(const std::string& path, const std::vector<DetectorRow>& rows, bool log) {
+  const std::vector<cv::Scalar> colours = {
+      {200, 80, 0}, {30, 30, 220}, {40, 160, 40}, {160, 40, 160}, {0, 140, 200}};
+  std::map<std::string, std::size_t> order;
+  std::vector<PlotSeries> series;
+  for (const DetectorRow& row : rows) {
+    const Detection& d = row.item.detection;
+    const std::string name = d.method == Detection::Method::kThreshold
+                                 ? "threshold, " + EchoRule(d)
+                                 : std::string(MethodName(d.method)) + ", each echo rule";
+    auto [it, added] = order.emplace(name, series.size());
+    if (added) series.push_back({name, colours[series.size() % colours.size()], {}, {}});
+    const MapMetrics& m = log ? *row.log : row.scene;
+    series[it->second].x.push_back(m.recall_within[1]);
+    series[it->second].y.push_back(m.precision_within[1]);
+  }
+  WritePng(path,
+           RenderLinePlot(std::string("Detectors on the ") + (log ? "log" : "simulated scene") +
+                              ": precision against recall, 1 cell of tolerance",
+                          "recall (1 cell)", "precision (1 cell)", series, false, 0.0, 1.0));
+}
+
+}  // namespace
+
+std::vector<DetectorItem> DetectorStudyItems(const Detection& base) {
+  std::vector<DetectorItem> items;
+  auto add = [&](Detection d) {
+    for (const int rule : {0, 1, 2}) {
+      d.max_obstacles = rule == 0 ? 1 : 2;
+      d.later_echoes =
+          rule == 2 ? Detection::LaterEchoes::kSupported : Detection::LaterEchoes::kStrongest;
+      std::ostringstream name;
+      name << MethodName(d.method);
+      if (d.method == Detection::Method::kThreshold) name << ' ' << d.threshold;
+      name << ", " << EchoRule(d);
+      items.push_back({name.str(), d});
+    }
+  };
+  for (int threshold = 70; threshold <= 150; threshold += 20) {
+    Detection d = base;
+    d.method = Detection::Method::kThreshold;
+    d.threshold = threshold;
+    add(d);
+  }
+  for (const auto method : {Detection::Method::kCanny, Detection::Method::kAutoCanny}) {
+    Detection d = base;
+    d.method = method;
+    add(d);
+  }
+  return items;
+}
+
+std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStudyOptions& options) {
+  const std::vector<DetectorItem> items =
+      options.items.empty() ? DetectorStudyItems(scene.mapping.detection) : options.items;
+  mapping::MapperConfig base = scene.mapping;
+  base.threads = options.threads;
+  // The log first (bad input fails before the simulation): read and placed once as `map --score`
+  // does, its truth and observable cells kept.
+  std::optional<LogMapResult> log;
+  mapping::KeySet log_truth, log_observable;
+  if (!options.log.empty()) {
+    log = MapLog(options.log, scene.sensor.geometry, base, &scene, scene.budgets);
+    (void)ScoreLogMap(*log, scene, &log_truth, &log_observable);
+  }
+  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
+  const RayTracer tracer(meshes);
+  const auto synthesized =
+      SimulateScene(scene, tracer, options.seed.value_or(scene.seed), options.threads);
+  const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
+  const octomap::OcTree key_space(base.resolution_m);
+  const mapping::KeySet truth = VoxelizeMeshes(meshes, key_space);
+  std::vector<BeamPose> poses;
+  for (std::size_t b = 0; b < synthesized.size(); ++b) poses.push_back(ScheduleBeam(scene, b).pose);
+  const mapping::KeySet observable =
+      PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics, key_space);
+
+  std::vector<DetectorRow> rows;
+  for (const DetectorItem& item : items) {
+    DetectorRow row{
+        item, MapAndScore(base, item.detection, scene.sensor.geometry, beams, truth, observable),
+        std::nullopt};
+    if (log) {
+      row.log =
+          MapAndScore(base, item.detection, log->sensor, log->mapped, log_truth, log_observable);
+    }
+    rows.push_back(std::move(row));
+    if (options.progress) options.progress(rows.size(), items.size());
+  }
+  return rows;
+}
+
+void WriteDetectorStudy(const std::string& dir, const Scene& scene,
+                        const DetectorStudyOptions& options, const std::vector<DetectorRow>& rows) {
+  const std::filesystem::path root(dir);
+  const bool with_log = !rows.empty() && rows.front().log.has_value();
+  WriteCsv((root / "detectors.csv").string(), rows, with_log);
+  WritePlot((root / "precision_vs_recall_scene.png").string(), rows, false);
+  if (with_log) WritePlot((root / "precision_vs_recall_log.png").string(), rows, true);
+  json items = json::array();
+  for (const DetectorRow& row : rows) {
+    const Detection& d = row.item.detection;
+    json item = {{"name", row.item.name},
+                 {"method", MethodName(d.method)},
+                 {"threshold", d.threshold},
+                 {"max_obstacles", d.max_obstacles},
+                 {"later_echoes", LaterName(d.later_echoes)},
+                 {"scene", MetricsJson(row.scene)}};
+    if (row.log) item["log"] = MetricsJson(*row.log);
+    items.push_back(item);
+  }
+  json study = ReportHeader();
+  study.update({{"scene", {{"name", scene.name}, {"file", scene.file}}},
+                {"seed", options.seed.value_or(scene.seed)},
+                {"log", options.log.empty() ? json() : json(options.log)},
+                {"resolution_m", scene.mapping.resolution_m},
+                {"items", items}});
+  WriteJson((root / "study.json").string(), study);
+}
+
+}  // namespace sonarbench::sim
