@@ -5,6 +5,22 @@
 
 namespace sonarbench::mapping {
 
+const char* DetectionMethodName(DetectionConfig::Method method) {
+  switch (method) {
+    case DetectionConfig::Method::kThreshold:
+      return "threshold";
+    case DetectionConfig::Method::kCanny:
+      return "canny";
+    case DetectionConfig::Method::kAutoCanny:
+      return "auto_canny";
+  }
+  return "?";
+}
+
+const char* LaterEchoesName(DetectionConfig::LaterEchoes rule) {
+  return rule == DetectionConfig::LaterEchoes::kSupported ? "supported" : "strongest";
+}
+
 MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
   MapperConfig c = std::move(base);
   node.Optional("resolution_m", c.resolution_m, InRange(0.001, 10.0));
@@ -15,9 +31,7 @@ MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
   node.Optional("rays_vertical", c.rays_vertical, IntInRange(1, 4096));
   if (auto detection = node.OptionalChild("detection")) {
     DetectionConfig& d = c.detection;
-    std::string method = d.method == DetectionConfig::Method::kThreshold ? "threshold"
-                         : d.method == DetectionConfig::Method::kCanny   ? "canny"
-                                                                         : "auto_canny";
+    std::string method = DetectionMethodName(d.method);
     detection->Optional("method", method, OneOf({"threshold", "canny", "auto_canny"}));
     d.method = method == "threshold" ? DetectionConfig::Method::kThreshold
                : method == "canny"   ? DetectionConfig::Method::kCanny
@@ -26,8 +40,7 @@ MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
     detection->Optional("smoothing_bins", d.smoothing_bins, IntInRange(1, 99));
     detection->Optional("min_run_bins", d.min_run_bins, IntInRange(1, 1000));
     detection->Optional("max_obstacles", d.max_obstacles, IntInRange(1, 100));
-    std::string later =
-        d.later_echoes == DetectionConfig::LaterEchoes::kSupported ? "supported" : "strongest";
+    std::string later = LaterEchoesName(d.later_echoes);
     detection->Optional("later_echoes", later, OneOf({"strongest", "supported"}));
     d.later_echoes = later == "supported" ? DetectionConfig::LaterEchoes::kSupported
                                           : DetectionConfig::LaterEchoes::kStrongest;

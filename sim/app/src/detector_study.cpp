@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/app/map_log.hpp"
@@ -21,26 +22,10 @@ namespace {
 using nlohmann::json;
 using Detection = mapping::DetectionConfig;
 
-const char* MethodName(Detection::Method method) {
-  switch (method) {
-    case Detection::Method::kThreshold:
-      return "threshold";
-    case Detection::Method::kCanny:
-      return "canny";
-    case Detection::Method::kAutoCanny:
-      return "auto_canny";
-  }
-  return "?";
-}
-
-const char* LaterName(Detection::LaterEchoes later) {
-  return later == Detection::LaterEchoes::kSupported ? "supported" : "strongest";
-}
-
 // The echo rule of a setting, as the CSV, the plot's legend and the item's name give it.
 std::string EchoRule(const Detection& d) {
   if (d.max_obstacles == 1) return "first echo";
-  return std::to_string(d.max_obstacles) + " echoes, " + LaterName(d.later_echoes);
+  return std::to_string(d.max_obstacles) + " echoes, " + mapping::LaterEchoesName(d.later_echoes);
 }
 
 // A map of `beams` with `detection`, scored against the truth and what a perfect sensor sees.
@@ -81,9 +66,9 @@ void WriteCsv(const std::string& path, const std::vector<DetectorRow>& rows, boo
   csv << "\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Detection& d = rows[i].item.detection;
-    csv << i << "," << MethodName(d.method) << ","
+    csv << i << "," << mapping::DetectionMethodName(d.method) << ","
         << (d.method == Detection::Method::kThreshold ? std::to_string(d.threshold) : "") << ","
-        << d.max_obstacles << "," << LaterName(d.later_echoes);
+        << d.max_obstacles << "," << mapping::LaterEchoesName(d.later_echoes);
     for (const MapMetrics* m : {&rows[i].scene, rows[i].log ? &*rows[i].log : nullptr}) {
       if (!m) continue;
       const json values = MetricsJson(*m);
@@ -104,9 +89,10 @@ void WritePlot(const std::string& path, const std::vector<DetectorRow>& rows, bo
   std::vector<PlotSeries> series;
   for (const DetectorRow& row : rows) {
     const Detection& d = row.item.detection;
-    const std::string name = d.method == Detection::Method::kThreshold
-                                 ? "threshold, " + EchoRule(d)
-                                 : std::string(MethodName(d.method)) + ", each echo rule";
+    const std::string name =
+        d.method == Detection::Method::kThreshold
+            ? "threshold, " + EchoRule(d)
+            : std::string(mapping::DetectionMethodName(d.method)) + ", each echo rule";
     auto [it, added] = order.emplace(name, series.size());
     if (added) series.push_back({name, colours[series.size() % colours.size()], {}, {}});
     const MapMetrics& m = log ? *row.log : row.scene;
@@ -129,7 +115,7 @@ std::vector<DetectorItem> DetectorStudyItems(const Detection& base) {
       d.later_echoes =
           rule == 2 ? Detection::LaterEchoes::kSupported : Detection::LaterEchoes::kStrongest;
       std::ostringstream name;
-      name << MethodName(d.method);
+      name << mapping::DetectionMethodName(d.method);
       if (d.method == Detection::Method::kThreshold) name << ' ' << d.threshold;
       name << ", " << EchoRule(d);
       items.push_back({name.str(), d});
@@ -200,10 +186,10 @@ void WriteDetectorStudy(const std::string& dir, const Scene& scene,
   for (const DetectorRow& row : rows) {
     const Detection& d = row.item.detection;
     json item = {{"name", row.item.name},
-                 {"method", MethodName(d.method)},
+                 {"method", mapping::DetectionMethodName(d.method)},
                  {"threshold", d.threshold},
                  {"max_obstacles", d.max_obstacles},
-                 {"later_echoes", LaterName(d.later_echoes)},
+                 {"later_echoes", mapping::LaterEchoesName(d.later_echoes)},
                  {"scene", MetricsJson(row.scene)}};
     if (row.log) item["log"] = MetricsJson(*row.log);
     items.push_back(item);

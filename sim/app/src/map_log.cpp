@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/io/mat_log.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
@@ -225,10 +226,7 @@ nlohmann::json LogMapReportJson(const LogMapResult& result, const MapCells& cell
          {"rays_vertical", c.rays_vertical},
          {"threshold", c.detection.threshold},
          {"max_obstacles", c.detection.max_obstacles},
-         {"later_echoes",
-          c.detection.later_echoes == mapping::DetectionConfig::LaterEchoes::kSupported
-              ? "supported"
-              : "strongest"}}},
+         {"later_echoes", mapping::LaterEchoesName(c.detection.later_echoes)}}},
        {"map",
         {{"occupied_cells", cells.occupied.size()},
          {"free_cells", cells.free.size()},

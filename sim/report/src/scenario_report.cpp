@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/report.hpp"
@@ -20,34 +21,18 @@ nlohmann::json DistanceJson(const DistanceStats& d) {
   return {{"count", d.count}, {"mean_m", d.mean_m}, {"p95_m", d.p95_m}, {"max_m", d.max_m}};
 }
 
-const char* DetectionMethodName(mapping::DetectionConfig::Method method) {
-  switch (method) {
-    case mapping::DetectionConfig::Method::kThreshold:
-      return "threshold";
-    case mapping::DetectionConfig::Method::kCanny:
-      return "canny";
-    case mapping::DetectionConfig::Method::kAutoCanny:
-      return "auto_canny";
-  }
-  return "?";
-}
-
-std::string LaterEchoesName(mapping::DetectionConfig::LaterEchoes e) {
-  return e == mapping::DetectionConfig::LaterEchoes::kSupported ? "supported" : "strongest";
-}
-
 nlohmann::json MappingJson(const mapping::MapperConfig& c) {
   return {{"resolution_m", c.resolution_m},
           {"integration", c.integration == mapping::Integration::kExact ? "exact" : "rays"},
           {"rays_horizontal", c.rays_horizontal},
           {"rays_vertical", c.rays_vertical},
           {"detection",
-           {{"method", DetectionMethodName(c.detection.method)},
+           {{"method", mapping::DetectionMethodName(c.detection.method)},
             {"threshold", c.detection.threshold},
             {"smoothing_bins", c.detection.smoothing_bins},
             {"min_run_bins", c.detection.min_run_bins},
             {"max_obstacles", c.detection.max_obstacles},
-            {"later_echoes", LaterEchoesName(c.detection.later_echoes)},
+            {"later_echoes", mapping::LaterEchoesName(c.detection.later_echoes)},
             {"support_window_deg", c.detection.support_window_deg},
             {"support_range_m", c.detection.support_range_m},
             {"canny_low", c.detection.canny_low},

@@ -10,6 +10,10 @@ namespace sonarbench::mapping {
 /// the struct's defaults).
 [[nodiscard]] MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base = {});
 
+/// The names `detection.method` and `detection.later_echoes` take in YAML (and reports).
+[[nodiscard]] const char* DetectionMethodName(DetectionConfig::Method method);
+[[nodiscard]] const char* LaterEchoesName(DetectionConfig::LaterEchoes rule);
+
 /// Reads a sensor model's `geometry` mapping (keys carry their units: `..._deg`, `..._m`).
 [[nodiscard]] SensorGeometry ReadSensorGeometry(YamlReader& node);
 
