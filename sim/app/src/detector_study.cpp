@@ -9,6 +9,7 @@
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/app/map_log.hpp"
+#include "sonarbench/sim/app/simulated_scene.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/report.hpp"
@@ -150,21 +151,15 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
   }
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
-  const auto synthesized =
-      SimulateScene(scene, tracer, options.seed.value_or(scene.seed), options.threads);
-  const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
-  const octomap::OcTree key_space(base.resolution_m);
-  const mapping::KeySet truth = VoxelizeMeshes(meshes, key_space);
-  std::vector<BeamPose> poses;
-  for (std::size_t b = 0; b < synthesized.size(); ++b) poses.push_back(ScheduleBeam(scene, b).pose);
-  const mapping::KeySet observable =
-      PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics, key_space);
+  const SimulatedScene simulated =
+      SimulateForScoring(scene, meshes, tracer, options.seed.value_or(scene.seed), options.threads);
 
   std::vector<DetectorRow> rows;
   for (const DetectorItem& item : items) {
-    DetectorRow row{
-        item, MapAndScore(base, item.detection, scene.sensor.geometry, beams, truth, observable),
-        std::nullopt};
+    DetectorRow row{item,
+                    MapAndScore(base, item.detection, scene.sensor.geometry, simulated.beams,
+                                simulated.truth, simulated.observable),
+                    std::nullopt};
     if (log) {
       row.log =
           MapAndScore(base, item.detection, log->sensor, log->mapped, log_truth, log_observable);

@@ -12,6 +12,7 @@
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
+#include "sonarbench/sim/app/simulated_scene.hpp"
 #include "sonarbench/sim/eval/beam_coverage.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
 #include "sonarbench/sim/eval/score.hpp"
@@ -52,9 +53,7 @@ std::optional<json> ReadItem(const fs::path& path) {
 // Everything the items share: the simulated beams, the truth, and the beams whose exact volume
 // is measured with their true axis ranges.
 struct StudyInputs {
-  std::vector<mapping::Beam> beams;
-  mapping::KeySet truth;
-  mapping::KeySet observable;
+  SimulatedScene simulated;
   struct CoverageBeam {
     mapping::Beam beam;
     double range_m = 0.0;
@@ -67,14 +66,9 @@ StudyInputs PrepareInputs(const Scene& scene, const std::vector<TriangleMesh>& m
                           std::uint64_t seed, int coverage_beams, int threads) {
   StudyInputs in;
   const RayTracer tracer(meshes);
-  const auto synthesized = SimulateScene(scene, tracer, seed, threads);
-  in.beams = BeamsOf(synthesized);
+  in.simulated = SimulateForScoring(scene, meshes, tracer, seed, threads);
+  const std::vector<SynthesizedBeam>& synthesized = in.simulated.synthesized;
   const octomap::OcTree key_space(scene.mapping.resolution_m);
-  in.truth = VoxelizeMeshes(meshes, key_space);
-  std::vector<BeamPose> poses;
-  for (std::size_t b = 0; b < synthesized.size(); ++b) poses.push_back(ScheduleBeam(scene, b).pose);
-  in.observable =
-      PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics, key_space);
   const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
   const std::size_t n = std::min<std::size_t>(static_cast<std::size_t>(coverage_beams),
                                               std::min(per_sweep, synthesized.size()));
@@ -96,10 +90,10 @@ json RunItem(const Scene& scene, const StudyInputs& in, const StudyItem& item, i
   config.threads = threads;
   const auto start = std::chrono::steady_clock::now();
   mapping::Mapper mapper(config, scene.sensor.geometry);
-  const mapping::BatchStats totals = mapper.IntegrateSweeps(in.beams);
+  const mapping::BatchStats totals = mapper.IntegrateSweeps(in.simulated.beams);
   const double map_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const MapMetrics m = ScoreMap(mapper.tree(), in.truth, in.observable);
+  const MapMetrics m = ScoreMap(mapper.tree(), in.simulated.truth, in.simulated.observable);
 
   std::size_t wedge = 0, undecided = 0, covered = 0, visited = 0, visits = 0, outside = 0;
   double lower_num = 0, upper_num = 0;

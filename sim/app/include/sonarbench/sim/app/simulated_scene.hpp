@@ -1,0 +1,30 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "sonarbench/sim/eval/ground_truth.hpp"
+#include "sonarbench/sim/sonar/simulation.hpp"
+#include "sonarbench/sim/world/ray_tracer.hpp"
+#include "sonarbench/sim/world/scene.hpp"
+
+namespace sonarbench::sim {
+
+/// A scene simulated once, with what every map of it is scored against (the studies' shared
+/// inputs): the beams, the cells its surfaces cross and those a perfect sensor sees from the
+/// beams' poses, on the scene's mapping resolution.
+struct SimulatedScene {
+  std::vector<SynthesizedBeam> synthesized;
+  std::vector<mapping::Beam> beams;
+  mapping::KeySet truth;
+  mapping::KeySet observable;
+};
+
+/// Simulates `scene` with `seed` on `tracer` (built from `meshes`, the scene's) and voxelises its
+/// truth and observable cells.
+[[nodiscard]] SimulatedScene SimulateForScoring(const Scene& scene,
+                                                const std::vector<TriangleMesh>& meshes,
+                                                const RayTracer& tracer, std::uint64_t seed,
+                                                int threads);
+
+}  // namespace sonarbench::sim

@@ -1,0 +1,20 @@
+#include "sonarbench/sim/app/simulated_scene.hpp"
+
+namespace sonarbench::sim {
+
+SimulatedScene SimulateForScoring(const Scene& scene, const std::vector<TriangleMesh>& meshes,
+                                  const RayTracer& tracer, std::uint64_t seed, int threads) {
+  SimulatedScene s;
+  s.synthesized = SimulateScene(scene, tracer, seed, threads);
+  s.beams = BeamsOf(s.synthesized);
+  const octomap::OcTree key_space(scene.mapping.resolution_m);
+  s.truth = VoxelizeMeshes(meshes, key_space);
+  std::vector<BeamPose> poses;
+  for (std::size_t b = 0; b < s.synthesized.size(); ++b)
+    poses.push_back(ScheduleBeam(scene, b).pose);
+  s.observable =
+      PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics, key_space);
+  return s;
+}
+
+}  // namespace sonarbench::sim
