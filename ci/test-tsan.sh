@@ -17,5 +17,5 @@ cd build-tsan
 export OMP_TOOL_LIBRARIES=/usr/lib/llvm-14/lib/libarcher.so
 export TSAN_OPTIONS="halt_on_error=1 ignore_noninstrumented_modules=1 suppressions=$PWD/../ci/tsan.supp"
 ctest --output-on-failure -j "$(nproc)" \
-  -R '^(IntegrateBatch|ExactBeamCells|MapTree|BeamRaster|Simulation|DivisionsStudy)\.'
+  -R '^(IntegrateBatch|ExactBeamCells|ArcEvidence|MapTree|BeamRaster|Simulation|DivisionsStudy)\.'
 ./tests/test_scenario --gtest_filter='Scenario.MapIsIdenticalForOneAndTwoThreads'

@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/detail/beam_volume.hpp"
@@ -16,6 +17,7 @@ namespace sonarbench::mapping {
 struct Mapper::State {
   double free_range_m = 0.0;
   int threads = 1;
+  ArcEvidence evidence;
   std::vector<Eigen::Vector3d> directions;
   MapTree tree;
   /// The key sets and buffers of the batches, kept between them (the one of config.key_set).
@@ -33,6 +35,11 @@ Mapper::Mapper(const MapperConfig& config, const SensorGeometry& sensor)
                          : config.free_range_m > 0.0    ? config.free_range_m
                                                         : sensor.MaxRangeM();
   state_->threads = config.threads > 0 ? config.threads : omp_get_max_threads();
+  if (config.occupancy == Occupancy::kArcEvidence) {
+    // The two-way pattern's -3 dB points at the wedge's elevation limits (docs/physics.md).
+    const double w = sensor.beam_width_vertical_rad;
+    state_->evidence.pattern_k = 4.0 * std::log(2.0) / (w * w);
+  }
   state_->directions = BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical);
   MapTree& tree = state_->tree;
   tree.setProbHit(config.prob_hit);
@@ -79,17 +86,17 @@ BatchStats Mapper::Integrate(std::span<const Beam> beams,
   if (config_.integration == Integration::kExact) {
     if (config_.key_set == KeySetKind::kStd) {
       return IntegrateExactBatch(s.tree, beams, obstacles, sensor_, s.free_range_m, s.threads,
-                                 s.std_workspace);
+                                 s.std_workspace, s.evidence);
     }
     return IntegrateExactBatch(s.tree, beams, obstacles, sensor_, s.free_range_m, s.threads,
-                               s.open_workspace);
+                               s.open_workspace, s.evidence);
   }
   if (config_.key_set == KeySetKind::kStd) {
     return IntegrateBatch(s.tree, beams, obstacles, s.directions, s.free_range_m, s.threads,
-                          s.std_workspace);
+                          s.std_workspace, s.evidence);
   }
   return IntegrateBatch(s.tree, beams, obstacles, s.directions, s.free_range_m, s.threads,
-                        s.open_workspace);
+                        s.open_workspace, s.evidence);
 }
 
 void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out) {

@@ -21,6 +21,10 @@ const char* LaterEchoesName(DetectionConfig::LaterEchoes rule) {
   return rule == DetectionConfig::LaterEchoes::kSupported ? "supported" : "strongest";
 }
 
+const char* OccupancyName(Occupancy occupancy) {
+  return occupancy == Occupancy::kArcEvidence ? "arc_evidence" : "arc_marking";
+}
+
 MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
   MapperConfig c = std::move(base);
   node.Optional("resolution_m", c.resolution_m, InRange(0.001, 10.0));
@@ -58,6 +62,9 @@ MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
       detection->Fail("canny_low", "a value no greater than canny_high");
     }
   }
+  std::string occupancy = OccupancyName(c.occupancy);
+  node.Optional("occupancy", occupancy, OneOf({"arc_marking", "arc_evidence"}));
+  c.occupancy = occupancy == "arc_evidence" ? Occupancy::kArcEvidence : Occupancy::kArcMarking;
   std::string key_set = c.key_set == KeySetKind::kStd ? "std" : "open_addressing";
   node.Optional("key_set", key_set, OneOf({"open_addressing", "std"}));
   c.key_set = key_set == "std" ? KeySetKind::kStd : KeySetKind::kOpenAddressing;

@@ -213,40 +213,32 @@ nlohmann::json LogMapReportJson(const LogMapResult& result, const MapCells& cell
   const auto& t = result.totals;
   const auto& c = result.mapper->config();
   nlohmann::json report = ReportHeader();
-  report.update(
-      {{"input", result.input},
-       {"input_kind", result.source},
-       {"beams", result.beams},
-       {"sweeps", result.sweeps},
-       {"truncated_beams", result.truncated_beams},
-       {"mapping",
-        {{"resolution_m", c.resolution_m},
-         {"integration", c.integration == mapping::Integration::kExact ? "exact" : "rays"},
-         {"rays_horizontal", c.rays_horizontal},
-         {"rays_vertical", c.rays_vertical},
-         {"threshold", c.detection.threshold},
-         {"max_obstacles", c.detection.max_obstacles},
-         {"later_echoes", mapping::LaterEchoesName(c.detection.later_echoes)}}},
-       {"map",
-        {{"occupied_cells", cells.occupied.size()},
-         {"free_cells", cells.free.size()},
-         {"beams_with_obstacle", t.beams_with_obstacle},
-         {"ray_casts", t.ray_casts},
-         {"cell_visits", t.cell_visits},
-         {"cell_updates", t.free_cells + t.occupied_cells},
-         {"visits_per_updated_cell",
-          t.free_cells + t.occupied_cells == 0
-              ? 0.0
-              : static_cast<double>(t.cell_visits) /
-                    static_cast<double>(t.free_cells + t.occupied_cells)}}},
-       {"timing", {{"import_s", result.import_s}, {"map_s", result.map_s}}},
-       {"outputs",
-        {{"map", "map.bt"},
-         {"map_full", "map.ot"},
-         {"map_top", "map_top.png"},
-         {"polar", "polar.png"},
-         {"fan", "fan.png"},
-         {"html", "report.html"}}}});
+  report.update({{"input", result.input},
+                 {"input_kind", result.source},
+                 {"beams", result.beams},
+                 {"sweeps", result.sweeps},
+                 {"truncated_beams", result.truncated_beams},
+                 {"mapping", MapperConfigJson(c)},
+                 {"map",
+                  {{"occupied_cells", cells.occupied.size()},
+                   {"free_cells", cells.free.size()},
+                   {"beams_with_obstacle", t.beams_with_obstacle},
+                   {"ray_casts", t.ray_casts},
+                   {"cell_visits", t.cell_visits},
+                   {"cell_updates", t.free_cells + t.occupied_cells},
+                   {"visits_per_updated_cell",
+                    t.free_cells + t.occupied_cells == 0
+                        ? 0.0
+                        : static_cast<double>(t.cell_visits) /
+                              static_cast<double>(t.free_cells + t.occupied_cells)}}},
+                 {"timing", {{"import_s", result.import_s}, {"map_s", result.map_s}}},
+                 {"outputs",
+                  {{"map", "map.bt"},
+                   {"map_full", "map.ot"},
+                   {"map_top", "map_top.png"},
+                   {"polar", "polar.png"},
+                   {"fan", "fan.png"},
+                   {"html", "report.html"}}}});
   return report;
 }
 

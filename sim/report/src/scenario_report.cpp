@@ -21,7 +21,9 @@ nlohmann::json DistanceJson(const DistanceStats& d) {
   return {{"count", d.count}, {"mean_m", d.mean_m}, {"p95_m", d.p95_m}, {"max_m", d.max_m}};
 }
 
-nlohmann::json MappingJson(const mapping::MapperConfig& c) {
+}  // namespace
+
+nlohmann::json MapperConfigJson(const mapping::MapperConfig& c) {
   return {{"resolution_m", c.resolution_m},
           {"integration", c.integration == mapping::Integration::kExact ? "exact" : "rays"},
           {"rays_horizontal", c.rays_horizontal},
@@ -39,6 +41,7 @@ nlohmann::json MappingJson(const mapping::MapperConfig& c) {
             {"canny_high", c.detection.canny_high},
             {"canny_blur_sigma", c.detection.canny_blur_sigma},
             {"auto_canny_sigma", c.detection.auto_canny_sigma}}},
+          {"occupancy", mapping::OccupancyName(c.occupancy)},
           {"key_set", c.key_set == mapping::KeySetKind::kStd ? "std" : "open_addressing"},
           {"prob_hit", c.prob_hit},
           {"prob_miss", c.prob_miss},
@@ -47,6 +50,8 @@ nlohmann::json MappingJson(const mapping::MapperConfig& c) {
           {"clear_without_obstacle", c.clear_without_obstacle},
           {"free_range_m", c.free_range_m}};
 }
+
+namespace {
 
 nlohmann::json SensorJson(const SensorModel& s) {
   const auto& g = s.geometry;
@@ -259,7 +264,7 @@ nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& resu
                    {"beams", result.beams},
                    {"start_head_angle_deg", scene.start_head_angle_rad * kRadToDeg},
                    {"sensor", SensorJson(scene.sensor)},
-                   {"mapping", MappingJson(result.mapper->config())}}},
+                   {"mapping", MapperConfigJson(result.mapper->config())}}},
                  {"metrics", MetricsJson(m)},
                  {"mapping_totals",
                   {{"beams", result.mapping_totals.beams},

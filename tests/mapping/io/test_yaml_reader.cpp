@@ -61,6 +61,16 @@ TEST(YamlReader, LaterEchoesAreTheStrongestUnlessSupportIsAskedFor) {
                            {"'detection.support_window_deg'", "got '-1'"}));
 }
 
+TEST(YamlReader, OccupancyIsArcMarkingUnlessArcEvidenceIsAskedFor) {
+  using mapping::Occupancy;
+  EXPECT_EQ(ReadMapping("resolution_m: 0.1\n").occupancy, Occupancy::kArcMarking);
+  EXPECT_EQ(ReadMapping("occupancy: arc_evidence\n").occupancy, Occupancy::kArcEvidence);
+  EXPECT_EQ(ReadMapping("occupancy: arc_marking\n").occupancy, Occupancy::kArcMarking);
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [] { (void)ReadMapping("occupancy: shares\n"); },
+      {"scene.yaml:1:12", "'occupancy'", "arc_marking", "arc_evidence", "got 'shares'"}));
+}
+
 TEST(YamlReader, UnknownKeyNamesFileLineAndKey) {
   EXPECT_TRUE(
       ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nray_horizontal: 3\n"); },

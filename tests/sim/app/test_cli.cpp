@@ -212,7 +212,8 @@ TEST(Cli, SimulateWritesADatasetThatMapReads) {
 }
 
 // `map --score` scores a log's map against a scene as `run` scores its own simulation: a dataset
-// of the scene, mapped from its own poses, gets the metrics `run` reports, count for count. A
+// of the scene, mapped from its own poses, gets the metrics `run` reports, count for count, and
+// reports the same mapper settings. A
 // .mat log is static, so it can be placed only at a scene's static sonar (rocks-slope's moves;
 // the check comes before the log is read); --score needs the scene.
 TEST(Cli, MapScoresALogAgainstASceneAsRunScoresItsSimulation) {
@@ -235,6 +236,9 @@ TEST(Cli, MapScoresALogAgainstASceneAsRunScoresItsSimulation) {
   const auto simulated = nlohmann::json::parse(ReadFile(run / "report.json"))["metrics"];
   EXPECT_GT(scored["counts"]["true_positive_cells"].get<std::size_t>(), 0u);
   EXPECT_EQ(scored, simulated);
+  // And the mapper's settings the same way: every one, by its YAML name.
+  EXPECT_EQ(nlohmann::json::parse(ReadFile(map / "report.json"))["mapping"],
+            nlohmann::json::parse(ReadFile(run / "report.json"))["parameters"]["mapping"]);
   EXPECT_NE(output.find("PASS cras-tank: 0/0 criteria met"), std::string::npos) << output;
   EXPECT_NE(ReadFile(map / "report.html").find("<p class=\"verdict pass\">PASS"),
             std::string::npos);

@@ -57,6 +57,12 @@ enum class Integration {
   kExact,  ///< every cell that meets the beam's wedge, examined once (BeamWedge)
 };
 
+/// How a detection's shell becomes occupancy (docs/mapper.md, "Arc evidence").
+enum class Occupancy {
+  kArcMarking,   ///< every cell of the shell in the wedge gets the full hit (the seed paper)
+  kArcEvidence,  ///< each gets a share, by the vertical beam pattern and what the map knows
+};
+
 /// Parameters of the production mapper. In-class defaults are the seed paper's choices, but for
 /// `integration`.
 struct MapperConfig {
@@ -70,6 +76,7 @@ struct MapperConfig {
   /// Ray casts across the beam's vertical width (the paper's V; 64 by its study).
   int rays_vertical = 64;
   DetectionConfig detection;
+  Occupancy occupancy = Occupancy::kArcMarking;
   /// OctoMap hit / miss probabilities and clamping thresholds.
   double prob_hit = 0.7;
   double prob_miss = 0.4;

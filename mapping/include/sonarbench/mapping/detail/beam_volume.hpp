@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <tuple>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "sonarbench/mapping/beam.hpp"
+#include "sonarbench/mapping/detail/arc_evidence.hpp"
 #include "sonarbench/mapping/detail/beam_raster.hpp"
 #include "sonarbench/mapping/detail/beam_wedge.hpp"
 #include "sonarbench/mapping/detail/key_set.hpp"
@@ -52,6 +54,10 @@ struct BasicBeamCells {
   /// What was inserted into `free` and `occupied` lately: inserts these catch are skipped.
   RecentKeys recent_free;
   RecentKeys recent_occupied;
+  /// With arc evidence, the occupied cells go here instead of `occupied`, each with its share
+  /// (packed << kShareBits | level, AppendArcShares), a cell once per beam.
+  std::vector<std::uint64_t> occupied_shares;
+  std::vector<ShellWeight> share_scratch;
 
   /// Empties the sets and zeroes the counts, for the next batch. Each set keeps room for as
   /// many keys as it held (abseil's clear() frees a large table; the reserve gets it back).
@@ -64,6 +70,7 @@ struct BasicBeamCells {
     occupied.reserve(occupied_keys);
     recent_free.clear();
     recent_occupied.clear();
+    occupied_shares.clear();
     visits = 0;
     beam_free_cells = 0;
     clipped = 0;
@@ -97,11 +104,12 @@ using BeamCells = BasicBeamCells<KeySet>;
 /// out to `free_range_m` without one (0 = clear nothing): OctoMap's computeRayKeys cells for
 /// each ray, each distinct cell of the beam inserted into the set once. `directions` are from
 /// BeamRayDirections. Occupied does not yet win over free here: IntegrateBatch resolves that.
+/// With `evidence` on, the occupied cells go to `cells.occupied_shares` with their shares.
 template <typename Set>
 void CastBeam(const octomap::OcTree& tree, const Beam& beam,
               std::span<const Eigen::Vector3d> directions,
               std::span<const double> obstacle_ranges_m, double free_range_m,
-              BasicBeamCells<Set>& cells) {
+              BasicBeamCells<Set>& cells, const ArcEvidence& evidence = {}) {
   const double free_end_m = obstacle_ranges_m.empty() ? free_range_m : obstacle_ranges_m.front();
   if (obstacle_ranges_m.empty() && free_end_m <= 0.0) return;
   const Eigen::Matrix3d R_world_beam =
@@ -124,13 +132,22 @@ void CastBeam(const octomap::OcTree& tree, const Beam& beam,
       if (tree.coordToKeyChecked(to_point(origin + obstacle_ranges_m[k] * d_world), key)) {
         ++cells.visits;
         // Neighbouring rays mostly end in the same cell.
-        if (!cells.recent_occupied.CheckAndRemember(PackKey(key))) {
+        if (evidence.on() || !cells.recent_occupied.CheckAndRemember(PackKey(key))) {
           cells.fresh_occupied.push_back(PackKey(key));
         }
       }
     }
   }
-  cells.Insert(cells.occupied, cells.fresh_occupied);
+  if (evidence.on()) {
+    std::sort(cells.fresh_occupied.begin(), cells.fresh_occupied.end());
+    cells.fresh_occupied.erase(
+        std::unique(cells.fresh_occupied.begin(), cells.fresh_occupied.end()),
+        cells.fresh_occupied.end());
+    AppendArcShares(tree, evidence, origin, R_world_beam.col(2), obstacle_ranges_m,
+                    cells.fresh_occupied, cells.share_scratch, cells.occupied_shares);
+  } else {
+    cells.Insert(cells.occupied, cells.fresh_occupied);
+  }
   cells.beam_free.clear();
   cells.visits += cells.raster.Trace(tree, to_point(origin), cells.ends, cells.beam_free);
   cells.beam_free_cells += cells.beam_free.size();
@@ -143,18 +160,25 @@ void CastBeam(const octomap::OcTree& tree, const Beam& beam,
 
 /// Adds to `cells` the keys of one beam under the exact semantics (ExactBeamCells): every cell
 /// of the wedge examined once, free before the first obstacle, occupied on each obstacle's shell,
-/// clearing out to `free_range_m` without an obstacle (0 = clear nothing).
+/// clearing out to `free_range_m` without an obstacle (0 = clear nothing). With `evidence` on,
+/// the occupied cells go to `cells.occupied_shares` with their shares.
 template <typename Set>
 void CastBeamExact(const octomap::OcTree& tree, const SensorGeometry& sensor, const Beam& beam,
                    std::span<const double> obstacle_ranges_m, double free_range_m,
-                   BasicBeamCells<Set>& cells) {
+                   BasicBeamCells<Set>& cells, const ArcEvidence& evidence = {}) {
   cells.beam_free.clear();
   cells.beam_occupied.clear();
-  const WedgeCellCounts counts = ExactBeamCells(tree, BeamWedge(sensor, beam), obstacle_ranges_m,
-                                                free_range_m, cells.beam_free, cells.beam_occupied);
+  const BeamWedge wedge(sensor, beam);
+  const WedgeCellCounts counts = ExactBeamCells(tree, wedge, obstacle_ranges_m, free_range_m,
+                                                cells.beam_free, cells.beam_occupied);
   cells.visits += counts.examined;
   cells.clipped += counts.clipped;
   cells.beam_free_cells += cells.beam_free.size();
+  if (evidence.on()) {
+    AppendArcShares(tree, evidence, wedge.origin(), wedge.up(), obstacle_ranges_m,
+                    cells.beam_occupied, cells.share_scratch, cells.occupied_shares);
+    cells.beam_occupied.clear();
+  }
   for (auto [keys, recent, fresh, set] :
        {std::tuple(&cells.beam_free, &cells.recent_free, &cells.fresh_free, &cells.free),
         std::tuple(&cells.beam_occupied, &cells.recent_occupied, &cells.fresh_occupied,

@@ -101,33 +101,40 @@ namespace integrate_detail {
 // The threads' cells are merged without a lock: split by the root's eight octants (disjoint
 // subtrees), then one thread per octant sorts its cells in Morton order, keeps one copy per cell
 // (occupied winning) and applies the updates (docs/mapper.md). An update is a cell's Morton code
-// << 1 | occupied.
+// << bits | level: `bits` 1 and level 1 for arc marking, kShareBits and the cell's share level
+// for arc evidence; level 0 is free.
 // Each thread's cells split by the root's octant, as updates.
 template <typename Set>
-void SplitByOctant(BatchWorkspace<Set>& workspace, int threads) {
+void SplitByOctant(BatchWorkspace<Set>& workspace, int threads, unsigned bits) {
   auto& per_thread = workspace.per_thread;
   auto& split = workspace.split;
+  const std::uint64_t full = (std::uint64_t{1} << bits) - 1;
 #pragma omp parallel for num_threads(threads) schedule(static, 1)
   for (int t = 0; t < threads; ++t) {
     auto& octants = split[static_cast<std::size_t>(t)];
     const auto& cells = per_thread[static_cast<std::size_t>(t)];
     for (auto& part : octants) part.clear();
     using Cells = BasicBeamCells<Set>;
-    for (const std::uint64_t occupied : {0u, 1u}) {
-      Cells::ForEach(occupied != 0 ? cells.occupied : cells.free,
-                     [&octants, occupied](std::uint64_t packed) {
+    for (const std::uint64_t level : {std::uint64_t{0}, full}) {
+      Cells::ForEach(level != 0 ? cells.occupied : cells.free,
+                     [&octants, level, bits](std::uint64_t packed) {
                        const std::uint64_t code = MortonCode(UnpackKey(packed));
-                       octants[code >> 45].push_back((code << 1) | occupied);
+                       octants[code >> 45].push_back((code << bits) | level);
                      });
+    }
+    for (const std::uint64_t share : cells.occupied_shares) {
+      const std::uint64_t code = MortonCode(UnpackKey(share >> kShareBits));
+      octants[code >> 45].push_back((code << bits) | (share & kShareLevelMax));
     }
   }
 }
 
-// Octant o's updates from all threads, sorted, a cell's copies merged (occupied winning), applied
-// to `tree`. Returns {free cells, occupied cells, nodes created}.
+// Octant o's updates from all threads, sorted, a cell's copies merged (the highest level wins:
+// occupied over free), applied to `tree` with log_odds[level]. Returns {free cells, occupied
+// cells, nodes created}.
 template <typename Set>
 std::array<std::size_t, 3> UpdateOctant(MapTree& tree, BatchWorkspace<Set>& workspace, int o,
-                                        const float (&log_odds)[2]) {
+                                        unsigned bits, std::span<const float> log_odds) {
   const auto& split = workspace.split;
   std::array<std::size_t, 3> counts{};
   auto& updates = workspace.updates[static_cast<std::size_t>(o)];
@@ -137,21 +144,23 @@ std::array<std::size_t, 3> UpdateOctant(MapTree& tree, BatchWorkspace<Set>& work
     updates.insert(updates.end(), part.begin(), part.end());
   }
   RadixSort(updates, workspace.scratch[static_cast<std::size_t>(o)]);
-  // A cell's copies are adjacent, free (0) before occupied (1): the last one is kept.
+  // A cell's copies are adjacent, in increasing level: the last one is kept.
+  const std::uint64_t full = (std::uint64_t{1} << bits) - 1;
   std::size_t kept = 0;
   for (const std::uint64_t u : updates) {
-    if (kept > 0 && (updates[kept - 1] >> 1) == (u >> 1)) {
+    if (kept > 0 && (updates[kept - 1] >> bits) == (u >> bits)) {
       updates[kept - 1] = u;
     } else {
       updates[kept++] = u;
     }
   }
   updates.resize(kept);
-  for (const std::uint64_t u : updates) counts[u & 1] += 1;
+  for (const std::uint64_t u : updates) counts[(u & full) != 0 ? 1 : 0] += 1;
   // Octant o's subtree hangs below the root's child o, made above: threads share no node.
   counts[2] = tree.UpdateLeavesUncounted(
-      updates.size(), [&updates](std::size_t i) { return KeyFromMortonCode(updates[i] >> 1); },
-      [&updates, &log_odds](std::size_t i) { return log_odds[updates[i] & 1]; });
+      updates.size(),
+      [&updates, bits](std::size_t i) { return KeyFromMortonCode(updates[i] >> bits); },
+      [&updates, &log_odds, full](std::size_t i) { return log_odds[updates[i] & full]; });
   return counts;
 }
 
@@ -161,11 +170,14 @@ std::array<std::size_t, 3> UpdateOctant(MapTree& tree, BatchWorkspace<Set>& work
 /// occupied cells to one thread's BasicBeamCells. The threads' cells are merged (no lock per
 /// key), occupied wins over free, and each cell gets one log-odds update. The result does not
 /// depend on `threads` or on `Set`: a set's content does not depend on insertion order, and each
-/// cell gets exactly one update. Call FinishUpdates before reading the tree.
+/// cell gets exactly one update. With `evidence` on, occupied cells come with share levels
+/// (`occupied_shares`) and the highest share a cell gets in the batch is its update (ShareLogOdds).
+/// Call FinishUpdates before reading the tree.
 template <typename Set, typename Cast>
 BatchStats IntegrateCells(MapTree& tree, std::span<const Beam> beams,
                           std::span<const std::vector<double>> obstacles, int threads,
-                          BatchWorkspace<Set>& workspace, Cast&& cast) {
+                          BatchWorkspace<Set>& workspace, const ArcEvidence& evidence,
+                          Cast&& cast) {
   const double start = omp_get_wtime();
   workspace.Reset(threads);
   auto& per_thread = workspace.per_thread;
@@ -175,21 +187,27 @@ BatchStats IntegrateCells(MapTree& tree, std::span<const Beam> beams,
     cast(static_cast<std::size_t>(b), per_thread[static_cast<std::size_t>(omp_get_thread_num())]);
   }
   const double cast_done = omp_get_wtime();
-  integrate_detail::SplitByOctant(workspace, threads);
+  const unsigned bits = evidence.on() ? kShareBits : 1;
+  integrate_detail::SplitByOctant(workspace, threads, bits);
   const double split_done = omp_get_wtime();
   for (unsigned o = 0; o < 8; ++o) {
     for (const auto& octants : workspace.split) {
       if (octants[o].empty()) continue;
-      tree.CreatePath(KeyFromMortonCode(octants[o].front() >> 1));
+      tree.CreatePath(KeyFromMortonCode(octants[o].front() >> bits));
       break;
     }
   }
-  const float log_odds[2] = {tree.getProbMissLog(), tree.getProbHitLog()};
+  std::vector<float> log_odds(std::size_t{1} << bits);
+  log_odds[0] = tree.getProbMissLog();
+  for (std::size_t level = 1; level < log_odds.size(); ++level) {
+    log_odds[level] = evidence.on() ? ShareLogOdds(tree.getProbHit(), tree.getProbHitLog(), level)
+                                    : tree.getProbHitLog();
+  }
   std::array<std::array<std::size_t, 3>, 8> counts{};
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
   for (int o = 0; o < 8; ++o) {
     counts[static_cast<std::size_t>(o)] =
-        integrate_detail::UpdateOctant(tree, workspace, o, log_odds);
+        integrate_detail::UpdateOctant(tree, workspace, o, bits, std::span<const float>(log_odds));
   }
   BatchStats stats;
   for (const auto& c : counts) {
@@ -215,11 +233,13 @@ template <typename Set>
 BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
                           std::span<const std::vector<double>> obstacles,
                           std::span<const Eigen::Vector3d> directions, double free_range_m,
-                          int threads, BatchWorkspace<Set>& workspace) {
-  BatchStats stats = IntegrateCells(
-      tree, beams, obstacles, threads, workspace, [&](std::size_t i, BasicBeamCells<Set>& cells) {
-        CastBeam(tree, beams[i], directions, obstacles[i], free_range_m, cells);
-      });
+                          int threads, BatchWorkspace<Set>& workspace,
+                          const ArcEvidence& evidence = {}) {
+  BatchStats stats = IntegrateCells(tree, beams, obstacles, threads, workspace, evidence,
+                                    [&](std::size_t i, BasicBeamCells<Set>& cells) {
+                                      CastBeam(tree, beams[i], directions, obstacles[i],
+                                               free_range_m, cells, evidence);
+                                    });
   stats.ray_casts = beams.size() * directions.size();
   return stats;
 }
@@ -229,10 +249,11 @@ template <typename Set>
 BatchStats IntegrateExactBatch(MapTree& tree, std::span<const Beam> beams,
                                std::span<const std::vector<double>> obstacles,
                                const SensorGeometry& sensor, double free_range_m, int threads,
-                               BatchWorkspace<Set>& workspace) {
-  return IntegrateCells(tree, beams, obstacles, threads, workspace,
+                               BatchWorkspace<Set>& workspace, const ArcEvidence& evidence = {}) {
+  return IntegrateCells(tree, beams, obstacles, threads, workspace, evidence,
                         [&](std::size_t i, BasicBeamCells<Set>& cells) {
-                          CastBeamExact(tree, sensor, beams[i], obstacles[i], free_range_m, cells);
+                          CastBeamExact(tree, sensor, beams[i], obstacles[i], free_range_m, cells,
+                                        evidence);
                         });
 }
 

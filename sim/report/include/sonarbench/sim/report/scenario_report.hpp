@@ -17,6 +17,10 @@ inline constexpr int kScenarioReportSchema = 2;
 /// free accuracy, per mesh, surface distances and the counts behind each.
 [[nodiscard]] nlohmann::json MetricsJson(const MapMetrics& m);
 
+/// A mapper's settings as report.json holds them ("mapping"): every MapperConfig field, by its
+/// YAML name.
+[[nodiscard]] nlohmann::json MapperConfigJson(const mapping::MapperConfig& c);
+
 /// report.json's "scene": its name, file, the file it extends and its sensor model's file.
 [[nodiscard]] nlohmann::json SceneJson(const Scene& scene);
 
