@@ -10,10 +10,11 @@ namespace sonarbench::mapping {
 void AppendArcShares(const octomap::OcTree& tree, const ArcEvidence& evidence,
                      const Eigen::Vector3d& origin, const Eigen::Vector3d& up,
                      std::span<const double> ranges_m, std::span<const std::uint64_t> keys,
-                     std::vector<ShellWeight>& scratch, std::vector<std::uint64_t>& out) {
+                     ArcShareScratch& scratch, std::vector<std::uint64_t>& out) {
   if (keys.empty() || ranges_m.empty()) return;
-  scratch.resize(keys.size());
-  std::vector<double> shell_max(ranges_m.size(), 0.0);
+  scratch.cells.resize(keys.size());
+  std::vector<double>& shell_max = scratch.shell_max;
+  shell_max.assign(ranges_m.size(), 0.0);
   for (std::size_t i = 0; i < keys.size(); ++i) {
     const octomap::OcTreeKey key = UnpackKey(keys[i]);
     const octomap::point3d c = tree.keyToCoord(key);
@@ -28,12 +29,12 @@ void AppendArcShares(const octomap::OcTree& tree, const ArcEvidence& evidence,
     const octomap::OcTreeNode* node = tree.search(key);
     const double occupancy = node != nullptr ? node->getOccupancy() : 0.5;
     const double weight = std::exp(-evidence.pattern_k * elevation * elevation) * occupancy;
-    scratch[i] = {weight, shell};
+    scratch.cells[i] = {weight, shell};
     shell_max[shell] = std::max(shell_max[shell], weight);
   }
   for (std::size_t i = 0; i < keys.size(); ++i) {
-    const double top = shell_max[scratch[i].shell];
-    const double share = top > 0.0 ? scratch[i].weight / top : 1.0;
+    const double top = shell_max[scratch.cells[i].shell];
+    const double share = top > 0.0 ? scratch.cells[i].weight / top : 1.0;
     const auto level = std::clamp<std::uint64_t>(
         static_cast<std::uint64_t>(std::lround(share * static_cast<double>(kShareLevelMax))), 1,
         kShareLevelMax);

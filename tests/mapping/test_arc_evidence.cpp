@@ -38,7 +38,7 @@ TEST(ArcEvidence, AShellCellsShareFollowsTheVerticalPattern) {
       KeyAt(tree, range, 0.0, 0.0),
       KeyAt(tree, range * std::cos(edge / 2), 0.0, range * std::sin(edge / 2)),
       KeyAt(tree, range * std::cos(edge), 0.0, range * std::sin(edge))};
-  std::vector<ShellWeight> scratch;
+  ArcShareScratch scratch;
   std::vector<std::uint64_t> out;
   const ArcEvidence evidence{kPatternK};
   const std::vector<double> ranges{range};
@@ -61,7 +61,7 @@ TEST(ArcEvidence, KnownFreeCellsGetLessAndEachShellIsItsOwn) {
   tree.updateNode(octomap::point3d(2.0F, 0.0F, static_cast<float>(up)), false);
   const std::vector<std::uint64_t> keys{KeyAt(tree, 2.0, 0.0, 0.0), KeyAt(tree, 2.0, 0.0, up),
                                         KeyAt(tree, 3.5, 0.0, 0.0), KeyAt(tree, 3.5, 0.0, up)};
-  std::vector<ShellWeight> scratch;
+  ArcShareScratch scratch;
   std::vector<std::uint64_t> out;
   const std::vector<double> ranges{2.0, 3.5};
   AppendArcShares(tree, ArcEvidence{kPatternK}, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(),

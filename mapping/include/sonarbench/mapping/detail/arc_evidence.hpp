@@ -22,10 +22,15 @@ struct ArcEvidence {
 inline constexpr unsigned kShareBits = 8;
 inline constexpr std::uint64_t kShareLevelMax = (std::uint64_t{1} << kShareBits) - 1;
 
-/// A shell cell's w·P and its shell's index (AppendArcShares' scratch).
-struct ShellWeight {
-  double weight = 0.0;
-  std::size_t shell = 0;
+/// AppendArcShares' scratch, reused from beam to beam: each shell cell's w·P and its shell's
+/// index, and each shell's largest w·P.
+struct ArcShareScratch {
+  struct Cell {
+    double weight = 0.0;
+    std::size_t shell = 0;
+  };
+  std::vector<Cell> cells;
+  std::vector<double> shell_max;
 };
 
 /// Appends, for each of one beam's occupied `keys` (packed, PackKey), `packed << kShareBits |
@@ -37,7 +42,7 @@ struct ShellWeight {
 void AppendArcShares(const octomap::OcTree& tree, const ArcEvidence& evidence,
                      const Eigen::Vector3d& origin, const Eigen::Vector3d& up,
                      std::span<const double> ranges_m, std::span<const std::uint64_t> keys,
-                     std::vector<ShellWeight>& scratch, std::vector<std::uint64_t>& out);
+                     ArcShareScratch& scratch, std::vector<std::uint64_t>& out);
 
 /// The log-odds update of share level `level` (1..kShareLevelMax): logit(0.5 + (p_hit - 0.5) ·
 /// level / kShareLevelMax); the full level is `hit_log_odds` itself.

@@ -57,7 +57,7 @@ struct BasicBeamCells {
   /// With arc evidence, the occupied cells go here instead of `occupied`, each with its share
   /// (packed << kShareBits | level, AppendArcShares), a cell once per beam.
   std::vector<std::uint64_t> occupied_shares;
-  std::vector<ShellWeight> share_scratch;
+  ArcShareScratch share_scratch;
 
   /// Empties the sets and zeroes the counts, for the next batch. Each set keeps room for as
   /// many keys as it held (abseil's clear() frees a large table; the reserve gets it back).
