@@ -239,6 +239,24 @@ void PrintCounts(const BatchStats* rays, const std::string& rays_name, const Bat
               exact_name.c_str(), exact.cast_s, exact.split_s, exact.update_s);
 }
 
+// The variants' median times, as ratios to the naive pipeline (row 0) and, unless `exact_only`,
+// to the std::unordered_set mapper (row 1).
+void PrintTimes(const std::vector<Variant>& variants, const std::vector<double>& times,
+                bool exact_only) {
+  std::printf("\n%-62s %7s %9s %9s %9s\n", "variant", "threads", "median s", "vs naive",
+              exact_only ? "" : "vs std");
+  for (std::size_t v = 0; v < variants.size(); ++v) {
+    std::printf("%-62s %7d %9.2f %8.2fx", variants[v].name.c_str(), variants[v].threads, times[v],
+                times[0] / times[v]);
+    if (exact_only) {
+      std::printf("\n");
+    } else {
+      std::printf(" %8.2fx\n", times[1] / times[v]);
+    }
+  }
+  std::printf("\nthe mapper variants of each mode built the identical map\n");
+}
+
 // The whole mapper with each key set, and in exact mode, against the naive pipeline (Table 1).
 int PipelineTable(const MatLog& log, const SensorGeometry& sensor, const MapperConfig& config,
                   int cores, int repeats, bool exact_only) {
@@ -288,18 +306,7 @@ int PipelineTable(const MatLog& log, const SensorGeometry& sensor, const MapperC
       return 1;
     }
   }
-  std::printf("\n%-62s %7s %9s %9s %9s\n", "variant", "threads", "median s", "vs naive",
-              exact_only ? "" : "vs std");
-  for (std::size_t v = 0; v < variants.size(); ++v) {
-    std::printf("%-62s %7d %9.2f %8.2fx", variants[v].name.c_str(), variants[v].threads, times[v],
-                times[0] / times[v]);
-    if (exact_only) {
-      std::printf("\n");
-    } else {
-      std::printf(" %8.2fx\n", times[1] / times[v]);
-    }
-  }
-  std::printf("\nthe mapper variants of each mode built the identical map\n");
+  PrintTimes(variants, times, exact_only);
   PrintCounts(exact_only ? nullptr : &totals, all_variants[kRays].name, exact_totals,
               all_variants[kExact].name);
   return 0;

@@ -261,29 +261,11 @@ std::optional<std::vector<json>> CollectItems(const fs::path& root, std::size_t 
   return results;
 }
 
-}  // namespace
-
-StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
-                               const StudyOptions& options) {
-  Scene scene = original;
-  if (options.sweeps) scene.sweeps = *options.sweeps;
-  const std::uint64_t seed = options.seed.value_or(scene.seed);
-  const std::string config =
-      mapping::Sha256(SceneConfigHash(scene, seed) + "/sweeps " + std::to_string(scene.sweeps) +
-                      "/coverage_beams " + std::to_string(options.coverage_beams) + "/items " +
-                      std::to_string(options.items.size()));
-  CheckOutputDirectory(dir);
-  // The meshes' preflight before the directory is made: bad input leaves none.
-  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
-  const std::vector<StudyItem> items =
-      options.items.empty() ? DivisionsStudyItems() : options.items;
-  const OutputClaim claim = StudyClaim(scene, config, items.size(), options.force);
-  const OutputDirectory out(dir, claim);
-  const fs::path& root = out.root();
-  fs::create_directories(root / "items");
-
-  StudySummary summary;
-  summary.items_total = items.size();
+// Runs this shard's items that `root/items/` does not hold yet, each written as it finishes;
+// an item file of another configuration is refused. Counts them in `summary`.
+void RunShardItems(const Scene& scene, const std::vector<TriangleMesh>& meshes, std::uint64_t seed,
+                   const std::vector<StudyItem>& items, const std::string& config,
+                   const fs::path& root, const StudyOptions& options, StudySummary& summary) {
   std::vector<std::size_t> mine;
   for (std::size_t i = static_cast<std::size_t>(options.shard.index); i < items.size();
        i += static_cast<std::size_t>(options.shard.count))
@@ -311,6 +293,32 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
     }
     if (options.progress) options.progress(++done, mine.size());
   }
+}
+
+}  // namespace
+
+StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
+                               const StudyOptions& options) {
+  Scene scene = original;
+  if (options.sweeps) scene.sweeps = *options.sweeps;
+  const std::uint64_t seed = options.seed.value_or(scene.seed);
+  const std::string config =
+      mapping::Sha256(SceneConfigHash(scene, seed) + "/sweeps " + std::to_string(scene.sweeps) +
+                      "/coverage_beams " + std::to_string(options.coverage_beams) + "/items " +
+                      std::to_string(options.items.size()));
+  CheckOutputDirectory(dir);
+  // The meshes' preflight before the directory is made: bad input leaves none.
+  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
+  const std::vector<StudyItem> items =
+      options.items.empty() ? DivisionsStudyItems() : options.items;
+  const OutputClaim claim = StudyClaim(scene, config, items.size(), options.force);
+  const OutputDirectory out(dir, claim);
+  const fs::path& root = out.root();
+  fs::create_directories(root / "items");
+
+  StudySummary summary;
+  summary.items_total = items.size();
+  RunShardItems(scene, meshes, seed, items, config, root, options, summary);
 
   const std::optional<std::vector<json>> results = CollectItems(root, items.size(), config);
   if (!results) return summary;
