@@ -5,6 +5,10 @@
 
 namespace sonarbench::mapping {
 
+const char* IntegrationName(Integration integration) {
+  return integration == Integration::kExact ? "exact" : "rays";
+}
+
 const char* DetectionMethodName(DetectionConfig::Method method) {
   switch (method) {
     case DetectionConfig::Method::kThreshold:
@@ -25,10 +29,14 @@ const char* OccupancyName(Occupancy occupancy) {
   return occupancy == Occupancy::kArcEvidence ? "arc_evidence" : "arc_marking";
 }
 
+const char* KeySetName(KeySetKind kind) {
+  return kind == KeySetKind::kStd ? "std" : "open_addressing";
+}
+
 MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
   MapperConfig c = std::move(base);
   node.Optional("resolution_m", c.resolution_m, InRange(0.001, 10.0));
-  std::string integration = c.integration == Integration::kExact ? "exact" : "rays";
+  std::string integration = IntegrationName(c.integration);
   node.Optional("integration", integration, OneOf({"rays", "exact"}));
   c.integration = integration == "exact" ? Integration::kExact : Integration::kRays;
   node.Optional("rays_horizontal", c.rays_horizontal, IntInRange(1, 4096));
@@ -65,7 +73,7 @@ MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
   std::string occupancy = OccupancyName(c.occupancy);
   node.Optional("occupancy", occupancy, OneOf({"arc_marking", "arc_evidence"}));
   c.occupancy = occupancy == "arc_evidence" ? Occupancy::kArcEvidence : Occupancy::kArcMarking;
-  std::string key_set = c.key_set == KeySetKind::kStd ? "std" : "open_addressing";
+  std::string key_set = KeySetName(c.key_set);
   node.Optional("key_set", key_set, OneOf({"open_addressing", "std"}));
   c.key_set = key_set == "std" ? KeySetKind::kStd : KeySetKind::kOpenAddressing;
   node.Optional("prob_hit", c.prob_hit, InRange(0.5, 1.0));

@@ -25,7 +25,7 @@ nlohmann::json DistanceJson(const DistanceStats& d) {
 
 nlohmann::json MapperConfigJson(const mapping::MapperConfig& c) {
   return {{"resolution_m", c.resolution_m},
-          {"integration", c.integration == mapping::Integration::kExact ? "exact" : "rays"},
+          {"integration", mapping::IntegrationName(c.integration)},
           {"rays_horizontal", c.rays_horizontal},
           {"rays_vertical", c.rays_vertical},
           {"detection",
@@ -42,7 +42,7 @@ nlohmann::json MapperConfigJson(const mapping::MapperConfig& c) {
             {"canny_blur_sigma", c.detection.canny_blur_sigma},
             {"auto_canny_sigma", c.detection.auto_canny_sigma}}},
           {"occupancy", mapping::OccupancyName(c.occupancy)},
-          {"key_set", c.key_set == mapping::KeySetKind::kStd ? "std" : "open_addressing"},
+          {"key_set", mapping::KeySetName(c.key_set)},
           {"prob_hit", c.prob_hit},
           {"prob_miss", c.prob_miss},
           {"clamp_min", c.clamp_min},

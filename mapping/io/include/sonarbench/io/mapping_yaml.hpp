@@ -10,11 +10,13 @@ namespace sonarbench::mapping {
 /// the struct's defaults).
 [[nodiscard]] MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base = {});
 
-/// The names `detection.method`, `detection.later_echoes` and `occupancy` take in YAML (and
-/// reports).
+/// The names `integration`, `detection.method`, `detection.later_echoes`, `occupancy` and
+/// `key_set` take in YAML (and reports).
+[[nodiscard]] const char* IntegrationName(Integration integration);
 [[nodiscard]] const char* DetectionMethodName(DetectionConfig::Method method);
 [[nodiscard]] const char* LaterEchoesName(DetectionConfig::LaterEchoes rule);
 [[nodiscard]] const char* OccupancyName(Occupancy occupancy);
+[[nodiscard]] const char* KeySetName(KeySetKind kind);
 
 /// Reads a sensor model's `geometry` mapping (keys carry their units: `..._deg`, `..._m`).
 [[nodiscard]] SensorGeometry ReadSensorGeometry(YamlReader& node);
