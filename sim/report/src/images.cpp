@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
@@ -11,12 +10,6 @@
 #include "sonarbench/mapping/atomic_file.hpp"
 
 namespace sonarbench::sim {
-std::vector<unsigned char> EncodePng(const cv::Mat& image) {
-  std::vector<uchar> bytes;
-  if (!cv::imencode(".png", image, bytes)) throw std::runtime_error("PNG encoding failed");
-  return bytes;
-}
-
 void WritePng(const std::string& path, const cv::Mat& image) {
   const std::vector<uchar> bytes = EncodePng(image);
   WriteFileAtomically(path, [&](std::ostream& out) {
@@ -136,10 +129,13 @@ cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m,
     }
     return &sweep[best];
   };
+  // Rows are independent: the same pixels whatever the threads.
+#pragma omp parallel for schedule(static)
   for (int row = 0; row < gray.rows; ++row) {
     for (int col = 0; col < gray.cols; ++col) {
       const double x = (col - half) * pixel_m;
       const double y = (half - row) * pixel_m;
+      if (std::hypot(x, y) >= max_range) continue;  // beyond every beam's last bin
       const mapping::Beam* nearest = nearest_beam(std::atan2(y, x));
       const auto bin = static_cast<std::size_t>(std::hypot(x, y) / nearest->bin_size_m);
       if (bin < nearest->intensities.size()) gray.at<uchar>(row, col) = nearest->intensities[bin];

@@ -1,0 +1,44 @@
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <numbers>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "sonarbench/sim/report/images.hpp"
+
+namespace sonarbench::sim {
+namespace {
+
+// A sweep of 200 beams, 1.8 deg apart, of 120 bins of 2 cm whose intensities vary with both.
+std::vector<mapping::Beam> Sweep() {
+  std::vector<mapping::Beam> sweep(200);
+  for (std::size_t b = 0; b < sweep.size(); ++b) {
+    sweep[b].head_angle_rad = static_cast<double>(b) * 1.8 * std::numbers::pi / 180.0;
+    sweep[b].bin_size_m = 0.02;
+    for (std::size_t k = 0; k < 120; ++k)
+      sweep[b].intensities.push_back(static_cast<std::uint8_t>((7 * k + 13 * b) % 256));
+  }
+  return sweep;
+}
+
+TEST(RenderFanImage, TheSameImageOnOneThreadAsOnTwo) {
+  const std::vector<mapping::Beam> sweep = Sweep();
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const cv::Mat one = RenderFanImage(sweep, 0.01, "fan");
+  omp_set_num_threads(2);
+  const cv::Mat two = RenderFanImage(sweep, 0.01, "fan");
+  omp_set_num_threads(threads);
+  ASSERT_EQ(one.size(), two.size());
+  ASSERT_EQ(one.type(), two.type());
+  EXPECT_EQ(cv::norm(one, two, cv::NORM_INF), 0.0);
+  // Not blank: the fan spans 2.4 m at 1 cm a pixel, and its colours vary.
+  EXPECT_GT(one.rows, 480);
+  cv::Scalar mean, spread;
+  cv::meanStdDev(one, mean, spread);
+  EXPECT_GT(spread[0] + spread[1] + spread[2], 10.0);
+}
+
+}  // namespace
+}  // namespace sonarbench::sim
