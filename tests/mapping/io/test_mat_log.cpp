@@ -133,6 +133,127 @@ TEST(MatLog, WhatLibmatioWritesIsRead) {
   }
 }
 
+// A v5 log is read without libmatio: every beam as libmatio reads it from the real log.
+TEST(MatLog, TheRealLogReadsAsLibmatioReadsIt) {
+  REQUIRE_REAL_LOG();
+  const mapping::MatLog log = mapping::ReadMatLog(RealLogPath());
+  mat_t* mat = Mat_Open(RealLogPath().c_str(), MAT_ACC_RDONLY);
+  ASSERT_NE(mat, nullptr);
+  matvar_t* data = Mat_VarRead(mat, "parsedData");
+  ASSERT_NE(data, nullptr);
+  const std::size_t count = data->dims[0] * data->dims[1];
+  ASSERT_EQ(log.beams.size(), count);
+  auto number = [&](std::size_t i, const char* field) {
+    const matvar_t* var = Mat_VarGetStructFieldByName(data, field, i);
+    switch (var->class_type) {  // the classes the log holds
+      case MAT_C_DOUBLE:
+        return *static_cast<const double*>(var->data);
+      case MAT_C_SINGLE:
+        return static_cast<double>(*static_cast<const float*>(var->data));
+      case MAT_C_UINT32:
+        return static_cast<double>(*static_cast<const std::uint32_t*>(var->data));
+      default:
+        ADD_FAILURE() << field << " of class " << var->class_type;
+        return 0.0;
+    }
+  };
+  for (std::size_t i = 0; i < count; ++i) {
+    const matvar_t* bins = Mat_VarGetStructFieldByName(data, "intensities", i);
+    ASSERT_EQ(bins->class_type, MAT_C_DOUBLE);
+    const auto* values = static_cast<const double*>(bins->data);
+    const std::vector<std::uint8_t> expected(values, values + bins->nbytes / sizeof(double));
+    ASSERT_EQ(log.beams[i].intensities, expected) << "beam " << i;
+    ASSERT_EQ(log.beams[i].time_s, number(i, "time")) << "beam " << i;
+    ASSERT_EQ(log.beams[i].head_angle_rad, number(i, "angle") * kDegToRad) << "beam " << i;
+    ASSERT_EQ(log.beams[i].bin_size_m, number(i, "step_dist")) << "beam " << i;
+  }
+  Mat_VarFree(data);
+  Mat_Close(mat);
+}
+
+// Writes a v5 log of one beam per entry of `intensities` (a class each), with the fields named.
+void WriteLog(const std::string& path, const std::vector<matvar_t*>& intensities,
+              std::vector<const char*> fields = {"time", "angle", "step_dist", "intensities"}) {
+  mat_t* mat = Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT5);
+  std::size_t beams[2] = {1, intensities.size()};
+  matvar_t* data = Mat_VarCreateStruct("parsedData", 2, beams, fields.data(), fields.size());
+  for (std::size_t i = 0; i < intensities.size(); ++i) {
+    std::size_t one[2] = {1, 1};
+    float time = 0.25F * static_cast<float>(i);  // a single
+    std::int16_t angle = static_cast<std::int16_t>(-90 + 45 * static_cast<int>(i));
+    double step = 0.0125;
+    for (const char* field : fields) {
+      const std::string name = field;
+      matvar_t* value =
+          name == "time"    ? Mat_VarCreate(nullptr, MAT_C_SINGLE, MAT_T_SINGLE, 2, one, &time, 0)
+          : name == "angle" ? Mat_VarCreate(nullptr, MAT_C_INT16, MAT_T_INT16, 2, one, &angle, 0)
+          : name == "step_dist"
+              ? Mat_VarCreate(nullptr, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, one, &step, 0)
+              : Mat_VarDuplicate(intensities[i], 1);
+      Mat_VarSetStructFieldByName(data, field, i, value);
+    }
+  }
+  Mat_VarWrite(mat, data, MAT_COMPRESSION_ZLIB);
+  Mat_VarFree(data);
+  Mat_Close(mat);
+  for (matvar_t* var : intensities) Mat_VarFree(var);
+}
+
+TEST(MatLog, FieldsOfAnyRealNumericClassAreRead) {
+  test::TempDir dir;
+  const std::string path = (dir.path() / "classes.mat").string();
+  std::size_t three[2] = {1, 3};
+  std::uint8_t u8[3] = {0, 128, 255};
+  std::int16_t i16[3] = {1, 2, 255};
+  float single[3] = {3, 4, 5};
+  WriteLog(path, {Mat_VarCreate(nullptr, MAT_C_UINT8, MAT_T_UINT8, 2, three, u8, 0),
+                  Mat_VarCreate(nullptr, MAT_C_INT16, MAT_T_INT16, 2, three, i16, 0),
+                  Mat_VarCreate(nullptr, MAT_C_SINGLE, MAT_T_SINGLE, 2, three, single, 0)});
+  const mapping::MatLog log = mapping::ReadMatLog(path);
+  ASSERT_EQ(log.beams.size(), 3u);
+  EXPECT_EQ(log.beams[0].intensities, (std::vector<std::uint8_t>{0, 128, 255}));
+  EXPECT_EQ(log.beams[1].intensities, (std::vector<std::uint8_t>{1, 2, 255}));
+  EXPECT_EQ(log.beams[2].intensities, (std::vector<std::uint8_t>{3, 4, 5}));
+  EXPECT_EQ(log.beams[2].time_s, 0.5);
+  EXPECT_DOUBLE_EQ(log.beams[0].head_angle_rad, -std::numbers::pi / 2.0);
+  EXPECT_DOUBLE_EQ(log.beams[1].head_angle_rad, -std::numbers::pi / 4.0);
+}
+
+TEST(MatLog, AFieldMissingOrOutOfRangeIsNamedWithItsBeam) {
+  test::TempDir dir;
+  const std::string path = (dir.path() / "bad.mat").string();
+  std::size_t two[2] = {1, 2};
+  std::uint16_t high[2] = {255, 256};
+  std::int64_t wide[2] = {1, 2};
+  double low[2] = {1.0, 2.0};
+  auto u16 = [&] { return Mat_VarCreate(nullptr, MAT_C_UINT16, MAT_T_UINT16, 2, two, high, 0); };
+  WriteLog(path, {Mat_VarCreate(nullptr, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, two, low, 0), u16()});
+  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+            path + ": beam 1, field 'intensities', bin 1: expected an integer in 0..255");
+  WriteLog(path, {Mat_VarCreate(nullptr, MAT_C_INT64, MAT_T_INT64, 2, two, wide, 0)});
+  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+            path + ": beam 0, field 'intensities', bin 0: expected an integer in 0..255");
+  WriteLog(path, {u16()}, {"time", "step_dist", "intensities"});
+  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+            path + ": beam 0, field 'angle': missing");
+}
+
+// A struct array without fields holds no values whatever its dimensions say: refused before the
+// beams are sized by them (a fuzzer's input asked for 2e11 bytes).
+TEST(MatLog, AStructArrayWithoutFieldsIsRefused) {
+  test::TempDir dir;
+  const std::string path = (dir.path() / "fieldless.mat").string();
+  mat_t* mat = Mat_CreateVer(path.c_str(), nullptr, MAT_FT_MAT5);
+  std::size_t beams[2] = {1, 2000000000};
+  matvar_t* data = Mat_VarCreateStruct("parsedData", 2, beams, nullptr, 0);
+  Mat_VarWrite(mat, data, MAT_COMPRESSION_ZLIB);
+  Mat_VarFree(data);
+  Mat_Close(mat);
+  EXPECT_EQ(
+      test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+      path + ": 'parsedData' has no fields (expected time, angle, step_dist and intensities)");
+}
+
 // Only a little-endian v5 or v7.3 header reaches libmatio: it read a v4 variable's name length
 // from the first bytes of this file (the start of a v5 header moved 18 bytes) and asked for 1 GB.
 TEST(MatLog, AFileWithoutAV5OrV73HeaderNeverReachesLibmatio) {

@@ -1,0 +1,60 @@
+#pragma once
+
+// MAT v5 files read without libmatio: their elements' layout checked against the bytes they hold,
+// and a struct array's values read in place. Internal to sonarbench::io (the .mat log reader).
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sonarbench/mapping/error.hpp"
+
+namespace sonarbench::mapping::mat_v5 {
+
+using Fail = std::function<InputError(const std::string&)>;
+
+/// An array's values as stored: the array's class (MAT's numbering: 6 double, 7 single, 8-13
+/// int8..uint32), its element count, and its real part's data type (1-7, 9, 12, 13) and bytes.
+struct ArrayView {
+  std::uint32_t array_class = 0;
+  bool complex = false;
+  std::size_t count = 0;
+  std::uint32_t data_type = 0;
+  const char* data = nullptr;
+  std::size_t data_bytes = 0;
+
+  /// Element k of a real array of class double, single or (u)int8..32, as the class holds it;
+  /// nullopt for other classes, complex arrays and k out of range.
+  [[nodiscard]] std::optional<double> NumericAt(std::size_t k) const;
+};
+
+/// A struct array: its element count, field names and each element's fields.
+struct StructArray {
+  std::string bytes;  // the element the views point into
+  std::size_t count = 0;
+  std::vector<std::string> fields;
+  std::vector<ArrayView> values;  // element-major: values[i * fields.size() + f]
+
+  /// Element i's field `name`, or nullptr when the struct has no such field.
+  [[nodiscard]] const ArrayView* Field(std::size_t i, std::string_view name) const;
+};
+
+/// Whether `bytes` start with a little-endian MAT v5 header.
+[[nodiscard]] bool IsV5(const std::string& bytes);
+
+/// Checks every element of a MAT v5 file against the bytes it holds (throws fail(what) for the
+/// first that does not fit: libmatio sizes arrays by what a file states) and returns the first
+/// top-level variable called `name`, inflated, if there is one.
+[[nodiscard]] std::optional<std::string> CheckFile(const std::string& bytes, std::string_view name,
+                                                   const Fail& fail);
+
+/// The variable's class (MAT's numbering; 2 for a struct array).
+[[nodiscard]] std::uint32_t ArrayClass(const std::string& variable, const Fail& fail);
+
+/// A struct array variable (one CheckFile returned) read in place.
+[[nodiscard]] StructArray ReadStructArray(std::string variable, const Fail& fail);
+
+}  // namespace sonarbench::mapping::mat_v5
