@@ -199,6 +199,10 @@ class BeamSynthesizer::BeamJob {
   // back along the mirrors, the straight returns collected; those not occluded heard.
   void MirrorPaths();
   void HearMirrorPaths(const OneWayPattern& one_way_pattern);
+  // Queues the straight return from a mirror path's hit to the sonar, unless it is out of range
+  // or too weak to count: its ray (checked for occlusion later) and its range and weights.
+  void QueueStraightReturn(const MirrorPath& was, const Hit& hit, const Material& m, double path,
+                           double cos_in, const OneWayPattern& one_way_pattern);
   void HearStraightReturns();
   // The two-way pattern of the way out and back along a mirror path ending at p's hit.
   [[nodiscard]] double ReturnPattern(const MirrorPath& p,

@@ -124,19 +124,15 @@ void BeamSynthesizer::BeamJob::MirrorPaths() {
 }
 
 void BeamSynthesizer::BeamJob::HearMirrorPaths(const OneWayPattern& one_way_pattern) {
-  const Eigen::Vector3d sonar = T_world_sonar_.translation();
-  const double spreading_db = a_.spreading_db_per_decade;
   const double max_range = max_range_;
   EchoDeposit deposit = Deposit();
   EchoDeposit glint_deposit = GlintDeposit();
   std::vector<MirrorPath>& paths = scratch_.paths;
   const std::vector<MirrorPath>& next_paths = scratch_.next_paths;
   const std::vector<std::optional<Hit>>& hits = scratch_.hits;
-  std::vector<Ray>& stream = scratch_.rays;
-  std::vector<StraightReturn>& returns = scratch_.returns;
   paths.clear();
-  stream.clear();
-  returns.clear();
+  scratch_.rays.clear();
+  scratch_.returns.clear();
   for (std::size_t q = 0; q < next_paths.size(); ++q) {
     if (!hits[q]) continue;
     const MirrorPath& was = next_paths[q];
@@ -154,39 +150,47 @@ void BeamSynthesizer::BeamJob::HearMirrorPaths(const OneWayPattern& one_way_patt
         glint_deposit(path, glint);
       }
     }
-    const Eigen::Vector3f at = was.from + hit.distance * was.direction;
-    const Eigen::Vector3d back = sonar - at.cast<double>();
-    const double d = back.norm();
-    const double range = 0.5 * (path + d);
-    if (range > max_range || d < g_.bin_size_m) continue;
-    // Culled on the largest its law can give: ρ for the diffuse part, g for the glint. First
-    // on a bound of the receive pattern, which spares most returns from ahead its
-    // trigonometry and culls only what the pattern itself would (0.999 leaves rounding a
-    // margin); the weight keeps its own order of products, so its bits do not change.
-    const Eigen::Vector3d u = one_way_pattern.R_beam_world * (-back / d);
-    const double way_out = 2.0 * std::sqrt(was.pattern);  // both ways round the path
-    const double largest = std::max(m.reflectivity, m.glint);
-    if (way_out * was.specular * s_.pattern_.OneWayPatternBound(u) * largest <
-        0.999 * kNegligibleWeight) {
-      continue;
-    }
-    const double weight = way_out * s_.pattern_.OneWayPatternTowards(u) * was.specular;
-    if (weight * largest < kNegligibleWeight) continue;
-    const Eigen::Vector3f to_sonar = (back / d).cast<float>();
-    const double cos_out = std::abs(hit.normal.dot(to_sonar));
-    double glint = 0.0;  // towards the sonar from the mirror direction, if m glints
-    if (m.glint > 0.0) {
-      const Eigen::Vector3f mirror =
-          was.direction - 2.0f * was.direction.dot(hit.normal) * hit.normal;
-      glint = Glint(m, static_cast<double>(mirror.dot(to_sonar)));
-    }
-    stream.push_back({at + 1e-4f * to_sonar, to_sonar, static_cast<float>(d) - 2e-4f});
-    const double last_leg = std::pow(range / d, spreading_db / 10.0);
-    returns.push_back({range,
-                       weight * m.reflectivity *
-                           CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) * last_leg,
-                       weight * glint * last_leg});
+    QueueStraightReturn(was, hit, m, path, cos_in, one_way_pattern);
   }
+}
+
+void BeamSynthesizer::BeamJob::QueueStraightReturn(const MirrorPath& was, const Hit& hit,
+                                                   const Material& m, double path, double cos_in,
+                                                   const OneWayPattern& one_way_pattern) {
+  const Eigen::Vector3d sonar = T_world_sonar_.translation();
+  const Eigen::Vector3f at = was.from + hit.distance * was.direction;
+  const Eigen::Vector3d back = sonar - at.cast<double>();
+  const double d = back.norm();
+  const double range = 0.5 * (path + d);
+  if (range > max_range_ || d < g_.bin_size_m) return;
+  // Culled on the largest its law can give: ρ for the diffuse part, g for the glint. First
+  // on a bound of the receive pattern, which spares most returns from ahead its
+  // trigonometry and culls only what the pattern itself would (0.999 leaves rounding a
+  // margin); the weight keeps its own order of products, so its bits do not change.
+  const Eigen::Vector3d u = one_way_pattern.R_beam_world * (-back / d);
+  const double way_out = 2.0 * std::sqrt(was.pattern);  // both ways round the path
+  const double largest = std::max(m.reflectivity, m.glint);
+  if (way_out * was.specular * s_.pattern_.OneWayPatternBound(u) * largest <
+      0.999 * kNegligibleWeight) {
+    return;
+  }
+  const double weight = way_out * s_.pattern_.OneWayPatternTowards(u) * was.specular;
+  if (weight * largest < kNegligibleWeight) return;
+  const Eigen::Vector3f to_sonar = (back / d).cast<float>();
+  const double cos_out = std::abs(hit.normal.dot(to_sonar));
+  double glint = 0.0;  // towards the sonar from the mirror direction, if m glints
+  if (m.glint > 0.0) {
+    const Eigen::Vector3f mirror =
+        was.direction - 2.0f * was.direction.dot(hit.normal) * hit.normal;
+    glint = Glint(m, static_cast<double>(mirror.dot(to_sonar)));
+  }
+  scratch_.rays.push_back({at + 1e-4f * to_sonar, to_sonar, static_cast<float>(d) - 2e-4f});
+  const double last_leg = std::pow(range / d, a_.spreading_db_per_decade / 10.0);
+  scratch_.returns.push_back(
+      {range,
+       weight * m.reflectivity * CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) *
+           last_leg,
+       weight * glint * last_leg});
 }
 
 void BeamSynthesizer::BeamJob::HearStraightReturns() {
