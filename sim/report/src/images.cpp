@@ -290,6 +290,14 @@ struct PlotScale {
 void DrawSeries(cv::Mat& img, const std::vector<PlotSeries>& series, const PlotScale& scale) {
   constexpr std::size_t kMaxMarkers = 64;
   int legend_y = kPlotHeight - kPlotBottom - 12 - 18 * (static_cast<int>(series.size()) - 1);
+  // The entries' text ends 8 pixels inside the plot's right edge, however long the longest.
+  int text_width = 0;
+  for (const auto& s : series) {
+    int baseline = 0;
+    text_width = std::max(
+        text_width, cv::getTextSize(s.name, cv::FONT_HERSHEY_SIMPLEX, 0.42, 1, &baseline).width);
+  }
+  const int text_x = std::max(kPlotLeft + 40, kPlotWidth - kPlotRight - 8 - text_width);
   for (const auto& s : series) {
     const bool joined = std::adjacent_find(s.x.begin(), s.x.end(),
                                            [](double a, double b) { return b <= a; }) == s.x.end();
@@ -302,12 +310,11 @@ void DrawSeries(cv::Mat& img, const std::vector<PlotSeries>& series, const PlotS
         cv::line(img, scale.At(s.x[i - 1], s.y[i - 1]), p, s.colour, 2, cv::LINE_AA);
       }
     }
-    cv::circle(img, {kPlotWidth - 238, legend_y - 4}, 3, s.colour, cv::FILLED, cv::LINE_AA);
+    cv::circle(img, {text_x - 18, legend_y - 4}, 3, s.colour, cv::FILLED, cv::LINE_AA);
     if (joined) {
-      cv::line(img, {kPlotWidth - 250, legend_y - 4}, {kPlotWidth - 225, legend_y - 4}, s.colour,
-               2);
+      cv::line(img, {text_x - 30, legend_y - 4}, {text_x - 5, legend_y - 4}, s.colour, 2);
     }
-    cv::putText(img, s.name, {kPlotWidth - 220, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.42,
+    cv::putText(img, s.name, {text_x, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.42,
                 cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
     legend_y += 18;
   }
