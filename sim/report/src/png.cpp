@@ -57,6 +57,7 @@ std::vector<unsigned char> EncodePng(const cv::Mat& image) {
     throw std::runtime_error("PNG encoding failed: expected an 8-bit image of 1, 3 or 4 channels");
   }
   const std::vector<unsigned char> rows = SubFilteredRows(image, channels);
+  if (rows.size() > 0xffffffffu) throw std::runtime_error("PNG encoding failed: over 4 GB of rows");
   z_stream stream{};
   // Fastest deflate with run-length matching: images of flat colours compress well and quickly.
   if (deflateInit2(&stream, Z_BEST_SPEED, Z_DEFLATED, 15, 8, Z_RLE) != Z_OK) {
