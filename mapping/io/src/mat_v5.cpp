@@ -251,6 +251,22 @@ class Walker {
     if (tag.type == kMatrix) Matrix(bytes, tag, depth);
   }
 
+  // The values element at `at` of an array of `elements` (a real or imaginary part): as many
+  // values as that, of a type of known size. Returns where the next element starts.
+  std::size_t Values(const std::string& bytes, std::size_t at, std::size_t end,
+                     double elements) const {
+    const Tag values = ReadTag(bytes, at, end);
+    const std::size_t size = TypeBytes(values.type);
+    if (size == 0 || static_cast<double>(values.bytes / size) != elements ||
+        values.bytes % size != 0) {
+      std::ostringstream stated;  // a product of dimensions may pass any integer type
+      stated << std::setprecision(15) << elements;
+      throw fail_("an array of " + stated.str() + " elements holds " +
+                  std::to_string(values.bytes) + " bytes of values");
+    }
+    return values.end;
+  }
+
   // An array: its flags, dimensions and name, then a char or numeric array's values, as many as
   // its dimensions say, or a struct array's fields, one array per element and field.
   void Matrix(const std::string& bytes, const Tag& matrix, int depth) const {
@@ -281,16 +297,7 @@ class Walker {
     std::size_t at = name.end;
     if (array_class == 4 || (array_class >= 6 && array_class <= 15)) {  // char; double ... uint64
       for (int part = 0; part < (complex && array_class != 4 ? 2 : 1); ++part) {
-        const Tag values = ReadTag(bytes, at, end);
-        const std::size_t size = TypeBytes(values.type);
-        if (size == 0 || static_cast<double>(values.bytes / size) != elements ||
-            values.bytes % size != 0) {
-          std::ostringstream stated;  // a product of dimensions may pass any integer type
-          stated << std::setprecision(15) << elements;
-          throw fail_("an array of " + stated.str() + " elements holds " +
-                      std::to_string(values.bytes) + " bytes of values");
-        }
-        at = values.end;
+        at = Values(bytes, at, end, elements);
       }
     } else if (array_class == 1) {  // cell: an array per element
       for (double k = 0; k < elements; ++k) {

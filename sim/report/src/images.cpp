@@ -79,6 +79,56 @@ cv::Mat FramedFan(cv::Mat colour, int half, double pixel_m, const std::string& t
 
 }  // namespace
 
+namespace {
+
+// A sweep's beams by head angle in [0, 2π): the beam nearest a bearing is in the group of equal
+// angles just below it or just above it (circularly); among those the smallest angular distance
+// wins, then the earliest beam, as a scan in sweep order would choose.
+class BeamsByAngle {
+ public:
+  explicit BeamsByAngle(std::span<const mapping::Beam> sweep) : sweep_(sweep) {
+    for (std::size_t i = 0; i < sweep.size(); ++i)
+      by_angle_.emplace_back(Wrapped(sweep[i].head_angle_rad), i);
+    std::sort(by_angle_.begin(), by_angle_.end());
+  }
+
+  // The beam nearest `bearing` [rad]; the sweep must not be empty.
+  const mapping::Beam& Nearest(double bearing) const {
+    const std::size_t n = by_angle_.size();
+    const auto first_above = std::lower_bound(by_angle_.begin(), by_angle_.end(),
+                                              std::make_pair(Wrapped(bearing), std::size_t{0}));
+    const std::size_t above = static_cast<std::size_t>(first_above - by_angle_.begin()) % n;
+    const std::size_t below = (above + n - 1) % n;
+    std::size_t best = sweep_.size();
+    double best_distance = 0.0;
+    for (const std::size_t start : {below, above}) {
+      // The whole group of beams sharing this angle.
+      const double angle = by_angle_[start].first;
+      std::size_t k = start;
+      while (by_angle_[(k + n - 1) % n].first == angle && (k + n - 1) % n != start)
+        k = (k + n - 1) % n;
+      for (std::size_t step = 0; step < n && by_angle_[k].first == angle; ++step, k = (k + 1) % n) {
+        const std::size_t i = by_angle_[k].second;
+        const double d = std::abs(std::remainder(sweep_[i].head_angle_rad - bearing, kTwoPi));
+        if (best == sweep_.size() || d < best_distance || (d == best_distance && i < best)) {
+          best = i;
+          best_distance = d;
+        }
+      }
+    }
+    return sweep_[best];
+  }
+
+ private:
+  static constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  static double Wrapped(double angle) { return angle - kTwoPi * std::floor(angle / kTwoPi); }
+
+  std::span<const mapping::Beam> sweep_;
+  std::vector<std::pair<double, std::size_t>> by_angle_;
+};
+
+}  // namespace
+
 cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m,
                        const std::string& title) {
   double max_range = 0.0;
@@ -87,58 +137,19 @@ cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m,
   }
   const int half = static_cast<int>(std::ceil(max_range / pixel_m));
   cv::Mat gray(2 * half + 1, 2 * half + 1, CV_8UC1, cv::Scalar(0));
-  if (sweep.empty()) {
-    cv::Mat colour;
-    cv::applyColorMap(gray, colour, cv::COLORMAP_INFERNO);
-    return FramedFan(colour, half, pixel_m, title);
-  }
-  // Beams sorted by head angle in [0, 2π): the beam nearest a bearing is in the group of equal
-  // angles just below it or just above it (circularly); among those the smallest angular
-  // distance wins, then the earliest beam, as a scan in sweep order would choose.
-  constexpr double kTwoPi = 2.0 * std::numbers::pi;
-  auto wrapped = [&](double angle) { return angle - kTwoPi * std::floor(angle / kTwoPi); };
-  std::vector<std::pair<double, std::size_t>> by_angle;
-  for (std::size_t i = 0; i < sweep.size(); ++i)
-    by_angle.emplace_back(wrapped(sweep[i].head_angle_rad), i);
-  std::sort(by_angle.begin(), by_angle.end());
-  const std::size_t n = by_angle.size();
-  auto nearest_beam = [&](double bearing) {
-    const double b = wrapped(bearing);
-    const std::size_t above =
-        static_cast<std::size_t>(
-            std::lower_bound(by_angle.begin(), by_angle.end(), std::make_pair(b, std::size_t{0})) -
-            by_angle.begin()) %
-        n;
-    const std::size_t below = (above + n - 1) % n;
-    std::size_t best = sweep.size();
-    double best_distance = 0.0;
-    for (const std::size_t start : {below, above}) {
-      // The whole group of beams sharing this angle.
-      std::size_t k = start;
-      while (by_angle[(k + n - 1) % n].first == by_angle[start].first && (k + n - 1) % n != start)
-        k = (k + n - 1) % n;
-      for (std::size_t step = 0; step < n && by_angle[k].first == by_angle[start].first;
-           ++step, k = (k + 1) % n) {
-        const std::size_t i = by_angle[k].second;
-        const double d = std::abs(std::remainder(sweep[i].head_angle_rad - bearing, kTwoPi));
-        if (best == sweep.size() || d < best_distance || (d == best_distance && i < best)) {
-          best = i;
-          best_distance = d;
-        }
-      }
-    }
-    return &sweep[best];
-  };
-  // Rows are independent: the same pixels whatever the threads.
+  if (!sweep.empty()) {
+    const BeamsByAngle beams(sweep);
+    // Rows are independent: the same pixels whatever the threads.
 #pragma omp parallel for schedule(static)
-  for (int row = 0; row < gray.rows; ++row) {
-    for (int col = 0; col < gray.cols; ++col) {
-      const double x = (col - half) * pixel_m;
-      const double y = (half - row) * pixel_m;
-      if (std::hypot(x, y) >= max_range) continue;  // beyond every beam's last bin
-      const mapping::Beam* nearest = nearest_beam(std::atan2(y, x));
-      const auto bin = static_cast<std::size_t>(std::hypot(x, y) / nearest->bin_size_m);
-      if (bin < nearest->intensities.size()) gray.at<uchar>(row, col) = nearest->intensities[bin];
+    for (int row = 0; row < gray.rows; ++row) {
+      for (int col = 0; col < gray.cols; ++col) {
+        const double x = (col - half) * pixel_m;
+        const double y = (half - row) * pixel_m;
+        if (std::hypot(x, y) >= max_range) continue;  // beyond every beam's last bin
+        const mapping::Beam& nearest = beams.Nearest(std::atan2(y, x));
+        const auto bin = static_cast<std::size_t>(std::hypot(x, y) / nearest.bin_size_m);
+        if (bin < nearest.intensities.size()) gray.at<uchar>(row, col) = nearest.intensities[bin];
+      }
     }
   }
   cv::Mat colour;

@@ -73,6 +73,29 @@ struct PlyHeader {
   int lines = 0;         // the header's, end_header's included
 };
 
+// A "property" line's words after the keyword: TYPE NAME, or list COUNT_TYPE ITEM_TYPE NAME.
+PlyProperty ReadPlyProperty(std::istringstream& words,
+                            const std::function<InputError(const std::string&)>& bad_line) {
+  PlyProperty property;
+  std::string type;
+  words >> type;
+  if (type == "list") {
+    std::string count_type, item_type;
+    words >> count_type >> item_type >> property.name;
+    property.list = true;
+    property.count = PlyTypeNamed(count_type);
+    property.item = PlyTypeNamed(item_type);
+    if (property.count.bytes == 0 || property.count.is_float || property.item.bytes == 0) {
+      throw bad_line("property list COUNT_TYPE ITEM_TYPE NAME, COUNT_TYPE an integer type");
+    }
+  } else {
+    words >> property.name;
+    property.item = PlyTypeNamed(type);
+    if (property.item.bytes == 0) throw bad_line("property TYPE NAME, TYPE a PLY type");
+  }
+  return property;
+}
+
 PlyHeader ReadPlyHeader(const std::string& bytes,
                         const std::function<InputError(std::string)>& fail) {
   PlyHeader header;
@@ -116,24 +139,7 @@ PlyHeader ReadPlyHeader(const std::string& bytes,
       header.elements.push_back(element);
     } else if (keyword == "property") {
       if (header.elements.empty()) throw bad_line("an element before its properties");
-      PlyProperty property;
-      std::string type;
-      words >> type;
-      if (type == "list") {
-        std::string count_type, item_type;
-        words >> count_type >> item_type >> property.name;
-        property.list = true;
-        property.count = PlyTypeNamed(count_type);
-        property.item = PlyTypeNamed(item_type);
-        if (property.count.bytes == 0 || property.count.is_float || property.item.bytes == 0) {
-          throw bad_line("property list COUNT_TYPE ITEM_TYPE NAME, COUNT_TYPE an integer type");
-        }
-      } else {
-        words >> property.name;
-        property.item = PlyTypeNamed(type);
-        if (property.item.bytes == 0) throw bad_line("property TYPE NAME, TYPE a PLY type");
-      }
-      header.elements.back().properties.push_back(property);
+      header.elements.back().properties.push_back(ReadPlyProperty(words, bad_line));
     } else {
       throw bad_line("a PLY header keyword");
     }
