@@ -166,6 +166,7 @@ class Walker {
       out.fields.push_back(field.substr(0, field.find('\0')));
     }
     out.count = array.view.count;
+    out.values.reserve(out.count * out.fields.size());  // each one an element the check walked
     std::size_t at = names.end;
     for (std::size_t k = 0; k < out.count * out.fields.size(); ++k) {
       const Array field = Read(bytes, at);

@@ -145,9 +145,10 @@ cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m,
       for (int col = 0; col < gray.cols; ++col) {
         const double x = (col - half) * pixel_m;
         const double y = (half - row) * pixel_m;
-        if (std::hypot(x, y) >= max_range) continue;  // beyond every beam's last bin
+        const double range = std::hypot(x, y);
+        if (range >= max_range) continue;  // beyond every beam's last bin
         const mapping::Beam& nearest = beams.Nearest(std::atan2(y, x));
-        const auto bin = static_cast<std::size_t>(std::hypot(x, y) / nearest.bin_size_m);
+        const auto bin = static_cast<std::size_t>(range / nearest.bin_size_m);
         if (bin < nearest.intensities.size()) gray.at<uchar>(row, col) = nearest.intensities[bin];
       }
     }
