@@ -19,6 +19,9 @@
 namespace sonarbench::mapping {
 namespace {
 
+constexpr const char* kNoParsedData =
+    "no readable variable 'parsedData' (expected the struct array of pings)";
+
 struct MatCloser {
   void operator()(mat_t* mat) const { Mat_Close(mat); }
 };
@@ -137,8 +140,7 @@ MatLog ReadV5Log(const std::string& path, const std::string& bytes) {
     return fail("a corrupt MAT file (" + what + ")");
   };
   std::optional<std::string> variable = mat_v5::CheckFile(bytes, "parsedData", corrupt);
-  if (!variable)
-    throw fail("no readable variable 'parsedData' (expected the struct array of pings)");
+  if (!variable) throw fail(kNoParsedData);
   if (mat_v5::ArrayClass(*variable, corrupt) != 2) throw fail("'parsedData' is not a struct array");
   const mat_v5::StructArray data = mat_v5::ReadStructArray(std::move(*variable), corrupt);
   if (data.count == 0) throw fail("'parsedData' holds no beams");
@@ -164,7 +166,7 @@ MatLog ReadMatLog(const std::string& path) {
   std::unique_ptr<mat_t, MatCloser> mat(Mat_Open(path.c_str(), MAT_ACC_RDONLY));
   if (!mat) throw fail("cannot open as a MATLAB .mat file (expected a v5 or v7.3 .mat log)");
   std::unique_ptr<matvar_t, VarFreer> data(Mat_VarRead(mat.get(), "parsedData"));
-  if (!data) throw fail("no readable variable 'parsedData' (expected the struct array of pings)");
+  if (!data) throw fail(kNoParsedData);
   if (data->class_type != MAT_C_STRUCT) throw fail("'parsedData' is not a struct array");
   const std::size_t count = ElementCount(data.get());
   if (count == 0) throw fail("'parsedData' holds no beams");
