@@ -141,8 +141,10 @@ MatLog ReadV5Log(const std::string& path, const std::string& bytes) {
   };
   std::optional<std::string> variable = mat_v5::CheckFile(bytes, "parsedData", corrupt);
   if (!variable) throw fail(kNoParsedData);
-  if (mat_v5::ArrayClass(*variable, corrupt) != 2) throw fail("'parsedData' is not a struct array");
-  const mat_v5::StructArray data = mat_v5::ReadStructArray(std::move(*variable), corrupt);
+  const std::optional<mat_v5::StructArray> read =
+      mat_v5::ReadStructArray(std::move(*variable), corrupt);
+  if (!read) throw fail("'parsedData' is not a struct array");
+  const mat_v5::StructArray& data = *read;
   if (data.count == 0) throw fail("'parsedData' holds no beams");
   if (data.fields.empty()) {
     throw fail("'parsedData' has no fields (expected time, angle, step_dist and intensities)");

@@ -150,12 +150,12 @@ class Walker {
   }
 
   // A struct array's field names and each element's fields.
-  StructArray Struct(std::string variable) const {
+  std::optional<StructArray> Struct(std::string variable) const {
     StructArray out;
     out.bytes = std::move(variable);  // views point into it; a moved string keeps its buffer
     const std::string& bytes = out.bytes;
     const Array array = Read(bytes);
-    if (array.view.array_class != 2) throw fail_("not a struct array");
+    if (array.view.array_class != 2) return std::nullopt;
     const Tag matrix = ReadTag(bytes, 0, bytes.size());
     const std::size_t end = matrix.data + matrix.bytes;
     const Tag length = ReadTag(bytes, array.fields_at, end);
@@ -376,11 +376,7 @@ std::optional<std::string> CheckFile(const std::string& bytes, std::string_view 
   return Walker(fail).File(bytes, name);
 }
 
-std::uint32_t ArrayClass(const std::string& variable, const Fail& fail) {
-  return Walker(fail).Read(variable).view.array_class;
-}
-
-StructArray ReadStructArray(std::string variable, const Fail& fail) {
+std::optional<StructArray> ReadStructArray(std::string variable, const Fail& fail) {
   return Walker(fail).Struct(std::move(variable));
 }
 

@@ -51,10 +51,7 @@ struct StructArray {
 [[nodiscard]] std::optional<std::string> CheckFile(const std::string& bytes, std::string_view name,
                                                    const Fail& fail);
 
-/// The variable's class (MAT's numbering; 2 for a struct array).
-[[nodiscard]] std::uint32_t ArrayClass(const std::string& variable, const Fail& fail);
-
-/// A struct array variable (one CheckFile returned) read in place.
-[[nodiscard]] StructArray ReadStructArray(std::string variable, const Fail& fail);
+/// A struct array variable (one CheckFile returned) read in place; nullopt for another class.
+[[nodiscard]] std::optional<StructArray> ReadStructArray(std::string variable, const Fail& fail);
 
 }  // namespace sonarbench::mapping::mat_v5
