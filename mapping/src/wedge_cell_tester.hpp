@@ -86,7 +86,9 @@ struct CellTester {
     bool below;  // K has points with L·p < 0
     bool above;  // K has points with L·p > 0
   };
+  // Only the axes along which K lies on one side (both sides: the axis cannot separate).
   std::array<Axis, 15> axes;
+  int axis_count = 0;
   std::span<const double> obstacles;
   double r_first;
   double r_far;
@@ -105,19 +107,20 @@ struct CellTester {
     for (int k = 0; k < 3; ++k) {
       for (int e = -1; e < 4; ++e) {
         const Vector3d l = e < 0 ? Vector3d(Vector3d::Unit(k)) : Vector3d::Unit(k).cross(w.edge(e));
-        Axis& a = axes[static_cast<std::size_t>(k * 5 + e + 1)];
-        a = {l, h * l.lpNorm<1>(), false, false};
+        Axis a = {l, h * l.lpNorm<1>(), false, false};
         for (int g = 0; g < 4; ++g) {
           a.below |= l.dot(w.edge(g)) < 0.0;
           a.above |= l.dot(w.edge(g)) > 0.0;
         }
+        if (!a.below || !a.above) axes[static_cast<std::size_t>(axis_count++)] = a;
       }
     }
   }
 
   // Whether the cell centred at `c` meets K: no separating axis (K's planes already passed).
   [[nodiscard]] bool Meets(const Vector3d& c) const {
-    for (const Axis& a : axes) {
+    for (int i = 0; i < axis_count; ++i) {
+      const Axis& a = axes[static_cast<std::size_t>(i)];
       const double d = a.l.dot(c);
       if ((!a.above && d - a.spread > 0.0) || (!a.below && d + a.spread < 0.0)) return false;
     }
