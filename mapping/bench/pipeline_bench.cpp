@@ -1,6 +1,7 @@
 // The seed paper's Table 1, measured here: a real MSIS log through the whole mapper (detection,
-// 32 × 64 ray casts per beam, key sets, OctoMap updates) with each key set, side by side in one
-// run, against a naive OctoMap pipeline. Prints a table with each variant's median time over
+// 32 × 64 ray casts per beam, key sets, OctoMap updates) with each key set, and in exact mode
+// (each beam's wedge) with two, side by side in one run, against a naive OctoMap pipeline. Prints a
+// table with each variant's median time over
 // --repeats runs and its speed-up against the naive pipeline and against std::unordered_set.
 //
 //   pipeline_bench [LOG.mat] [--repeats N] [--resolution M] [--sets-only] [--exact-only]
@@ -12,7 +13,7 @@
 //
 // A second table isolates the key sets' share: every insert and iteration the mapper's threads
 // made into their sets, recorded from a mapper run and replayed alone into each set type (the
-// issue's "within the mapper" comparison, without the ray casting around it).
+// sets' work within the mapper, without the ray casting around it).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -23,6 +24,7 @@
 
 #include "bench_sets.hpp"
 #include "sonarbench/io/mat_log.hpp"
+#include "sonarbench/mapping/detail/block_set.hpp"
 #include "sonarbench/mapping/detail/integrate.hpp"
 #include "sonarbench/mapping/detection.hpp"
 #include "sonarbench/mapping/mapper.hpp"
@@ -92,11 +94,12 @@ std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sens
 }
 
 // The production pipeline in exact mode (every cell of each beam's wedge once).
+template <typename Set>
 std::string RunExact(const std::vector<Beam>& beams, const SensorGeometry& sensor,
                      const MapperConfig& config, int threads, BatchStats* totals) {
   MapperConfig exact = config;
   exact.integration = Integration::kExact;
-  BatchWorkspace<KeyOpenSet> workspace;
+  BatchWorkspace<Set> workspace;
   return RunMapper(beams, sensor, exact, threads, totals, workspace);
 }
 
@@ -275,15 +278,24 @@ int PipelineTable(const MatLog& log, const SensorGeometry& sensor, const MapperC
        [&] { return RunMapper<Quadratic>(log.beams, sensor, config, cores, &totals); }},
       {"mapper, OpenKeySet quadratic, in-place, 1 thread", 1,
        [&] { return RunMapper<Quadratic>(log.beams, sensor, config, 1, nullptr); }},
-      {"mapper, exact wedge (integration: exact)", cores,
-       [&] { return RunExact(log.beams, sensor, config, cores, &exact_totals); }},
-      {"mapper, exact wedge, 1 thread", 1,
-       [&] { return RunExact(log.beams, sensor, config, 1, nullptr); }},
+      {"mapper, BlockKeySet (key_set: blocks)", cores,
+       [&] { return RunMapper<BlockKeySet>(log.beams, sensor, config, cores, nullptr); }},
+      {"mapper, exact wedge, BlockKeySet (the defaults)", cores,
+       [&] { return RunExact<BlockKeySet>(log.beams, sensor, config, cores, &exact_totals); }},
+      {"mapper, exact wedge, BlockKeySet, 1 thread", 1,
+       [&] { return RunExact<BlockKeySet>(log.beams, sensor, config, 1, nullptr); }},
+      {"mapper, exact wedge, OpenKeySet", cores,
+       [&] { return RunExact<KeyOpenSet>(log.beams, sensor, config, cores, nullptr); }},
+      {"mapper, exact wedge, OpenKeySet, 1 thread", 1,
+       [&] { return RunExact<KeyOpenSet>(log.beams, sensor, config, 1, nullptr); }},
   };
   constexpr std::size_t kRays = 4;   // the ray row whose stages are printed
-  constexpr std::size_t kExact = 6;  // the first exact row
+  constexpr std::size_t kExact = 7;  // the first exact row
   std::vector<Variant> variants = all_variants;
-  if (exact_only) variants = {all_variants[0], all_variants[kExact], all_variants[kExact + 1]};
+  if (exact_only) {
+    variants = {all_variants[0]};
+    variants.insert(variants.end(), all_variants.begin() + kExact, all_variants.end());
+  }
   const std::size_t exact_row = exact_only ? 1 : kExact;
   std::vector<double> times;
   std::string ray_map, exact_map;

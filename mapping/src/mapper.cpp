@@ -7,6 +7,7 @@
 
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/detail/block_set.hpp"
 #include "sonarbench/mapping/detail/integrate.hpp"
 #include "sonarbench/mapping/detail/key_set.hpp"
 #include "sonarbench/mapping/detail/map_tree.hpp"
@@ -23,6 +24,7 @@ struct Mapper::State {
   /// The key sets and buffers of the batches, kept between them (the one of config.key_set).
   BatchWorkspace<KeySet> std_workspace;
   BatchWorkspace<KeyOpenSet> open_workspace;
+  BatchWorkspace<BlockKeySet> block_workspace;
   /// Whether the tree's inner nodes lag its leaves (see FinishUpdates).
   bool stale = false;
 
@@ -83,20 +85,23 @@ BatchStats Mapper::Integrate(std::span<const Beam> beams,
                              std::span<const std::vector<double>> obstacles) {
   State& s = *state_;
   s.stale = true;
-  if (config_.integration == Integration::kExact) {
-    if (config_.key_set == KeySetKind::kStd) {
+  auto integrate = [&](auto& workspace) {
+    if (config_.integration == Integration::kExact) {
       return IntegrateExactBatch(s.tree, beams, obstacles, sensor_, s.free_range_m, s.threads,
-                                 s.std_workspace, s.evidence);
+                                 workspace, s.evidence);
     }
-    return IntegrateExactBatch(s.tree, beams, obstacles, sensor_, s.free_range_m, s.threads,
-                               s.open_workspace, s.evidence);
-  }
-  if (config_.key_set == KeySetKind::kStd) {
     return IntegrateBatch(s.tree, beams, obstacles, s.directions, s.free_range_m, s.threads,
-                          s.std_workspace, s.evidence);
+                          workspace, s.evidence);
+  };
+  switch (config_.key_set) {
+    case KeySetKind::kStd:
+      return integrate(s.std_workspace);
+    case KeySetKind::kOpenAddressing:
+      return integrate(s.open_workspace);
+    case KeySetKind::kBlocks:
+      break;
   }
-  return IntegrateBatch(s.tree, beams, obstacles, s.directions, s.free_range_m, s.threads,
-                        s.open_workspace, s.evidence);
+  return integrate(s.block_workspace);
 }
 
 void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out) {

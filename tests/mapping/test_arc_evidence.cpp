@@ -121,9 +121,12 @@ struct WallMap {
 // evidence loses once its share falls under about half. The wall's cells (x 2.95-3.0) lie on
 // the high view's arc over 0.06-1.14 m and in no view's water.
 WallMap MapWallFromTwoHeights(Occupancy occupancy, int threads, std::string* bytes = nullptr,
-                              Integration integration = Integration::kExact) {
+                              Integration integration = Integration::kExact,
+                              KeySetKind key_set = MapperConfig{}.key_set) {
   const SensorGeometry sensor;
-  Mapper mapper(Config(occupancy, threads, integration), sensor);
+  MapperConfig config = Config(occupancy, threads, integration);
+  config.key_set = key_set;
+  Mapper mapper(config, sensor);
   std::vector<std::vector<double>> echoes;
   for (int k = -2; k <= 2; ++k) {
     const double off_deg = std::max(0.0, std::abs(1.8 * k) - 1.5);
@@ -176,12 +179,19 @@ TEST(ArcEvidence, TheRayCastsCarveToo) {
   EXPECT_EQ(evidence.wall_cells, 12);
 }
 
-TEST(ArcEvidence, TheMapIsTheSameOnAnyThreadCount) {
-  std::string one;
-  std::string two;
-  (void)MapWallFromTwoHeights(Occupancy::kArcEvidence, 1, &one);
-  (void)MapWallFromTwoHeights(Occupancy::kArcEvidence, 2, &two);
-  EXPECT_EQ(one, two);
+// Shares and free cells merge alike whatever collects them: any thread count, any key set, both
+// integrations.
+TEST(ArcEvidence, TheMapIsTheSameOnAnyThreadCountAndKeySet) {
+  for (const Integration integration : {Integration::kExact, Integration::kRays}) {
+    std::string one;
+    (void)MapWallFromTwoHeights(Occupancy::kArcEvidence, 1, &one, integration);
+    for (const KeySetKind set :
+         {KeySetKind::kBlocks, KeySetKind::kOpenAddressing, KeySetKind::kStd}) {
+      std::string two;
+      (void)MapWallFromTwoHeights(Occupancy::kArcEvidence, 2, &two, integration, set);
+      EXPECT_EQ(one, two) << static_cast<int>(set);
+    }
+  }
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include "sonarbench/mapping/detail/beam_raster.hpp"
 #include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/detail/block_set.hpp"
 #include "sonarbench/mapping/detail/integrate.hpp"
 #include "sonarbench/mapping/detail/map_tree.hpp"
 #include "sonarbench/mapping/detail/ray_keys.hpp"
@@ -101,6 +102,14 @@ TEST(IntegrateBatch, BuildsTheMapOfOneUpdateNodePerCell) {
   }
   FinishUpdates(ours_std);
   check(ours_std, "one workspace, std::unordered_set");
+  MapTree ours_blocks(0.05);
+  BatchWorkspace<BlockKeySet> block_workspace;
+  for (int batch = 0; batch < 3; ++batch) {
+    IntegrateBatch(ours_blocks, beams, obstacles, directions, free_range_m, 2 - batch % 2,
+                   block_workspace);
+  }
+  FinishUpdates(ours_blocks);
+  check(ours_blocks, "one workspace, BlockKeySet");
 }
 
 // The radix sort sorts as std::sort does: random codes, codes that share their high bits (one

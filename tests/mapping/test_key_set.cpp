@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <span>
@@ -7,6 +8,8 @@
 #include <vector>
 
 #include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/detail/block_set.hpp"
+#include "sonarbench/mapping/detail/integrate.hpp"
 #include "sonarbench/mapping/detail/key_set.hpp"
 
 namespace sonarbench::mapping {
@@ -209,6 +212,62 @@ TEST(RecentKeys, OnlyRemembersKeysItWasGiven) {
   }
   recent.clear();
   for (const std::uint64_t packed : given) ASSERT_FALSE(recent.CheckAndRemember(packed));
+}
+
+// A block set holds exactly the keys given it, from one cube or the whole key range (its edges
+// included), reports new keys as new, walks each key once, block by block in Morton order, and
+// holds nothing of a batch after clear() (it is reused from batch to batch).
+TEST(BlockKeySet, HoldsWhatAReferenceSetHoldsAndWalksBlocksInMortonOrder) {
+  std::mt19937_64 rng(8);
+  BlockKeySet set;
+  for (const bool clustered : {true, false, true}) {
+    set.clear();
+    Reference reference;
+    for (int i = 0; i < 40000; ++i) {
+      octomap::OcTreeKey key = RandomKey(rng, clustered);
+      if (i % 97 == 0) key = {0, 65535, static_cast<octomap::key_type>(i % 2 == 0 ? 0 : 65535)};
+      ASSERT_EQ(set.insert(key), reference.insert(key).second) << i;
+    }
+    ASSERT_EQ(set.size(), reference.size());
+    for (int i = 0; i < 20000; ++i) {
+      const octomap::OcTreeKey key = RandomKey(rng, clustered);
+      ASSERT_EQ(set.contains(key), reference.contains(key)) << i;
+    }
+    std::vector<std::uint64_t> walked;
+    set.for_each_packed([&walked](std::uint64_t packed) { walked.push_back(packed); });
+    ASSERT_EQ(walked.size(), reference.size());
+    for (std::size_t i = 0; i < walked.size(); ++i) {
+      ASSERT_TRUE(reference.contains(UnpackKey(walked[i])));
+      const bool same_block =
+          i > 0 && ((walked[i] ^ walked[i - 1]) & BlockKeySet::kOriginMask) == 0;
+      if (same_block) {
+        ASSERT_LT(MortonCode(UnpackKey(walked[i - 1])), MortonCode(UnpackKey(walked[i])));
+      }
+    }
+    for (const BlockKeySet::Block& block : set.blocks()) {
+      const std::uint64_t first = BlockKeySet::FirstKey(block);
+      std::uint64_t least = ~std::uint64_t{0};
+      BlockKeySet::ForEachInBlock(block, [&](std::uint64_t packed) {
+        least = std::min(least, MortonCode(UnpackKey(packed)));
+      });
+      ASSERT_EQ(MortonCode(UnpackKey(first)), least);
+    }
+  }
+  set.clear();
+  EXPECT_EQ(set.size(), 0u);
+  EXPECT_TRUE(set.empty());
+  EXPECT_FALSE(set.contains({32768, 32768, 32768}));
+}
+
+// A cell's index in its block is its Morton code's low nine bits, and back.
+TEST(BlockKeySet, IndexInBlockIsTheLowBitsOfTheMortonCode) {
+  const std::uint64_t origin = PackKey({800, 1608, 65528});
+  for (unsigned index = 0; index < 512; ++index) {
+    const std::uint64_t packed = BlockKeySet::KeyInBlock(origin, index);
+    ASSERT_EQ(packed & BlockKeySet::kOriginMask, origin);
+    ASSERT_EQ(BlockKeySet::IndexInBlock(packed), index);
+    ASSERT_EQ(MortonCode(UnpackKey(packed)) & 511u, index);
+  }
 }
 
 // The cells a beam marks do not depend on the set that collects them.

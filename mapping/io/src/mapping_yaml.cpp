@@ -30,7 +30,15 @@ const char* OccupancyName(Occupancy occupancy) {
 }
 
 const char* KeySetName(KeySetKind kind) {
-  return kind == KeySetKind::kStd ? "std" : "open_addressing";
+  switch (kind) {
+    case KeySetKind::kStd:
+      return "std";
+    case KeySetKind::kOpenAddressing:
+      return "open_addressing";
+    case KeySetKind::kBlocks:
+      break;
+  }
+  return "blocks";
 }
 
 MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
@@ -74,8 +82,10 @@ MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
   node.Optional("occupancy", occupancy, OneOf({"arc_marking", "arc_evidence"}));
   c.occupancy = occupancy == "arc_evidence" ? Occupancy::kArcEvidence : Occupancy::kArcMarking;
   std::string key_set = KeySetName(c.key_set);
-  node.Optional("key_set", key_set, OneOf({"open_addressing", "std"}));
-  c.key_set = key_set == "std" ? KeySetKind::kStd : KeySetKind::kOpenAddressing;
+  node.Optional("key_set", key_set, OneOf({"blocks", "open_addressing", "std"}));
+  c.key_set = key_set == "std"               ? KeySetKind::kStd
+              : key_set == "open_addressing" ? KeySetKind::kOpenAddressing
+                                             : KeySetKind::kBlocks;
   node.Optional("prob_hit", c.prob_hit, InRange(0.5, 1.0));
   node.Optional("prob_miss", c.prob_miss, InRange(0.0, 0.5));
   node.Optional("clamp_min", c.clamp_min, InRange(0.0, 0.5));

@@ -71,6 +71,18 @@ TEST(YamlReader, OccupancyIsArcMarkingUnlessArcEvidenceIsAskedFor) {
       {"scene.yaml:1:12", "'occupancy'", "arc_marking", "arc_evidence", "got 'shares'"}));
 }
 
+TEST(YamlReader, KeySetIsBlocksUnlessAnotherIsAskedFor) {
+  using mapping::KeySetKind;
+  EXPECT_EQ(ReadMapping("resolution_m: 0.1\n").key_set, KeySetKind::kBlocks);
+  EXPECT_EQ(ReadMapping("key_set: blocks\n").key_set, KeySetKind::kBlocks);
+  EXPECT_EQ(ReadMapping("key_set: open_addressing\n").key_set, KeySetKind::kOpenAddressing);
+  EXPECT_EQ(ReadMapping("key_set: std\n").key_set, KeySetKind::kStd);
+  EXPECT_STREQ(mapping::KeySetName(KeySetKind::kBlocks), "blocks");
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [] { (void)ReadMapping("key_set: bonxai\n"); },
+      {"scene.yaml:1:10", "'key_set'", "blocks", "open_addressing", "std", "got 'bonxai'"}));
+}
+
 TEST(YamlReader, UnknownKeyNamesFileLineAndKey) {
   EXPECT_TRUE(
       ThrowsInputErrorWith([] { (void)ReadMapping("resolution_m: 0.1\nray_horizontal: 3\n"); },

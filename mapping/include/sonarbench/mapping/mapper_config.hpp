@@ -47,6 +47,7 @@ struct DetectionConfig {
 
 /// The key set the mapper collects cells in; the map does not depend on it.
 enum class KeySetKind {
+  kBlocks,          ///< BlockKeySet: 8³-cell bit blocks, merged block by block
   kOpenAddressing,  ///< sonarbench's OpenKeySet (quadratic probing, in-place resize)
   kStd,             ///< std::unordered_set with OctoMap's KeyHash (OctoMap's KeySet)
 };
@@ -88,7 +89,7 @@ struct MapperConfig {
   double free_range_m = 0.0;
   /// Worker threads for ray casting; 0 means all hardware threads. The map does not depend on it.
   int threads = 0;
-  KeySetKind key_set = KeySetKind::kOpenAddressing;
+  KeySetKind key_set = KeySetKind::kBlocks;
 };
 
 }  // namespace sonarbench::mapping

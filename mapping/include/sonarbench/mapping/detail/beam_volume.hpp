@@ -54,6 +54,9 @@ struct BasicBeamCells {
   /// What was inserted into `free` and `occupied` lately: inserts these catch are skipped.
   RecentKeys recent_free;
   RecentKeys recent_occupied;
+  /// Whether inserting a key already held costs what a new one does (BlockKeySet): then the
+  /// recent-key filters only add work, and are skipped.
+  static constexpr bool kNoRepeatFilter = requires(const Set& set) { set.blocks(); };
   /// With arc evidence, the occupied cells go here instead of `occupied`, each with its share
   /// (packed << kShareBits | level, AppendArcShares), a cell once per beam.
   std::vector<std::uint64_t> occupied_shares;
@@ -151,6 +154,10 @@ void CastBeam(const octomap::OcTree& tree, const Beam& beam,
   cells.beam_free.clear();
   cells.visits += cells.raster.Trace(tree, to_point(origin), cells.ends, cells.beam_free);
   cells.beam_free_cells += cells.beam_free.size();
+  if constexpr (BasicBeamCells<Set>::kNoRepeatFilter) {
+    cells.Insert(cells.free, cells.beam_free);
+    return;
+  }
   cells.fresh_free.clear();
   for (const std::uint64_t packed : cells.beam_free) {
     if (!cells.recent_free.CheckAndRemember(packed)) cells.fresh_free.push_back(packed);
@@ -183,6 +190,10 @@ void CastBeamExact(const octomap::OcTree& tree, const SensorGeometry& sensor, co
        {std::tuple(&cells.beam_free, &cells.recent_free, &cells.fresh_free, &cells.free),
         std::tuple(&cells.beam_occupied, &cells.recent_occupied, &cells.fresh_occupied,
                    &cells.occupied)}) {
+    if constexpr (BasicBeamCells<Set>::kNoRepeatFilter) {
+      cells.Insert(*set, *keys);
+      continue;
+    }
     fresh->clear();
     for (const std::uint64_t packed : *keys) {
       if (!recent->CheckAndRemember(packed)) fresh->push_back(packed);

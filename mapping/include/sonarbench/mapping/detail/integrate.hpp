@@ -8,11 +8,13 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "sonarbench/mapping/batch_stats.hpp"
 #include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/detail/block_set.hpp"
 #include "sonarbench/mapping/detail/map_tree.hpp"
 
 namespace sonarbench::mapping {
@@ -87,12 +89,21 @@ struct BatchWorkspace {
   /// Per octant: the threads' updates together, and a radix sort's scratch.
   std::array<std::vector<std::uint64_t>, 8> updates;
   std::array<std::vector<std::uint64_t>, 8> scratch;
+  /// For a set of blocks (BlockKeySet): per thread, per octant, its blocks with their Morton
+  /// codes (free blocks' codes even, occupied ones' odd).
+  struct BlockRef {
+    std::uint64_t code;
+    const BlockKeySet::Block* block;
+  };
+  std::vector<std::array<std::vector<BlockRef>, 8>> block_split;
+  std::array<std::vector<BlockRef>, 8> octant_blocks;
 
   /// Makes it ready for a batch on `threads` threads: empty sets, zero counts.
   void Reset(int threads) {
     per_thread.resize(static_cast<std::size_t>(threads));
     for (auto& cells : per_thread) cells.Clear();
     split.resize(per_thread.size());
+    block_split.resize(per_thread.size());
   }
 };
 
@@ -115,18 +126,67 @@ void SplitByOctant(BatchWorkspace<Set>& workspace, int threads, unsigned bits) {
     const auto& cells = per_thread[static_cast<std::size_t>(t)];
     for (auto& part : octants) part.clear();
     using Cells = BasicBeamCells<Set>;
-    for (const std::uint64_t level : {std::uint64_t{0}, full}) {
-      Cells::ForEach(level != 0 ? cells.occupied : cells.free,
-                     [&octants, level, bits](std::uint64_t packed) {
-                       const std::uint64_t code = MortonCode(UnpackKey(packed));
-                       octants[code >> 45].push_back((code << bits) | level);
-                     });
+    if constexpr (std::is_same_v<Set, BlockKeySet>) {
+      auto& blocks = workspace.block_split[static_cast<std::size_t>(t)];
+      for (auto& part : blocks) part.clear();
+      for (const std::uint64_t occupied : {0, 1}) {
+        for (const auto& b : (occupied != 0 ? cells.occupied : cells.free).blocks()) {
+          const std::uint64_t code = MortonCode(UnpackKey(b.origin));
+          blocks[code >> 45].push_back({code | occupied, &b});
+        }
+      }
+    } else {
+      for (const std::uint64_t level : {std::uint64_t{0}, full}) {
+        Cells::ForEach(level != 0 ? cells.occupied : cells.free,
+                       [&octants, level, bits](std::uint64_t packed) {
+                         const std::uint64_t code = MortonCode(UnpackKey(packed));
+                         octants[code >> 45].push_back((code << bits) | level);
+                       });
+      }
     }
     for (const std::uint64_t share : cells.occupied_shares) {
       const std::uint64_t code = MortonCode(UnpackKey(share >> kShareBits));
       octants[code >> 45].push_back((code << bits) | (share & kShareLevelMax));
     }
   }
+}
+
+// Octant o's cells from the threads' blocks, in Morton order, merged into `updates` (sorted,
+// the shares of arc evidence only): a cell's copies adjacent, free before occupied.
+template <typename Set>
+void MergeBlocks(BatchWorkspace<Set>& workspace, int o, unsigned bits) {
+  auto& refs = workspace.octant_blocks[static_cast<std::size_t>(o)];
+  refs.clear();
+  for (const auto& octants : workspace.block_split) {
+    const auto& part = octants[static_cast<std::size_t>(o)];
+    refs.insert(refs.end(), part.begin(), part.end());
+  }
+  std::sort(refs.begin(), refs.end(), [](const auto& a, const auto& b) { return a.code < b.code; });
+  auto& updates = workspace.updates[static_cast<std::size_t>(o)];
+  auto& merged = workspace.scratch[static_cast<std::size_t>(o)];
+  merged.clear();
+  const std::uint64_t full = (std::uint64_t{1} << bits) - 1;
+  std::size_t share = 0;
+  for (std::size_t i = 0; i < refs.size();) {
+    const std::uint64_t block_code = refs[i].code & ~std::uint64_t{1};
+    std::array<std::uint64_t, 8> free{}, occupied{};
+    for (; i < refs.size() && (refs[i].code & ~std::uint64_t{1}) == block_code; ++i) {
+      auto& words = (refs[i].code & 1) != 0 ? occupied : free;
+      for (unsigned w = 0; w < 8; ++w) words[w] |= refs[i].block->bits[w];
+    }
+    for (unsigned w = 0; w < 8; ++w) {
+      for (std::uint64_t cells = free[w] | occupied[w]; cells != 0; cells &= cells - 1) {
+        const unsigned bit = static_cast<unsigned>(std::countr_zero(cells));
+        const std::uint64_t code = block_code | (64 * w + bit);
+        for (; share < updates.size() && (updates[share] >> bits) < code; ++share) {
+          merged.push_back(updates[share]);
+        }
+        merged.push_back((code << bits) | ((occupied[w] >> bit) & 1 ? full : 0));
+      }
+    }
+  }
+  merged.insert(merged.end(), updates.begin() + static_cast<std::ptrdiff_t>(share), updates.end());
+  updates.swap(merged);
 }
 
 // Octant o's updates from all threads, sorted, a cell's copies merged (the highest level wins:
@@ -144,8 +204,11 @@ std::array<std::size_t, 3> UpdateOctant(MapTree& tree, BatchWorkspace<Set>& work
     updates.insert(updates.end(), part.begin(), part.end());
   }
   RadixSort(updates, workspace.scratch[static_cast<std::size_t>(o)]);
-  // A cell's copies are adjacent, in increasing level: the last one is kept.
   const std::uint64_t full = (std::uint64_t{1} << bits) - 1;
+  if constexpr (std::is_same_v<Set, BlockKeySet>) {
+    MergeBlocks(workspace, o, bits);
+  }
+  // A cell's copies are adjacent, in increasing level: the last one is kept.
   std::size_t kept = 0;
   for (const std::uint64_t u : updates) {
     if (kept > 0 && (updates[kept - 1] >> bits) == (u >> bits)) {
@@ -194,6 +257,11 @@ BatchStats IntegrateCells(MapTree& tree, std::span<const Beam> beams,
     for (const auto& octants : workspace.split) {
       if (octants[o].empty()) continue;
       tree.CreatePath(KeyFromMortonCode(octants[o].front() >> bits));
+      break;
+    }
+    for (const auto& octants : workspace.block_split) {
+      if (octants[o].empty()) continue;
+      tree.CreatePath(UnpackKey(BlockKeySet::FirstKey(*octants[o].front().block)));
       break;
     }
   }
