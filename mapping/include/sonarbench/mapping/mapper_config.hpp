@@ -48,7 +48,7 @@ struct DetectionConfig {
 /// The key set the mapper collects cells in; the map does not depend on it.
 enum class KeySetKind {
   kBlocks,          ///< BlockKeySet: 8³-cell bit blocks, merged block by block
-  kOpenAddressing,  ///< sonarbench's OpenKeySet (quadratic probing, in-place resize)
+  kOpenAddressing,  ///< sonarbench's OpenKeySet (quadratic probing, all-at-once resize)
   kStd,             ///< std::unordered_set with OctoMap's KeyHash (OctoMap's KeySet)
 };
 
@@ -65,7 +65,7 @@ enum class Occupancy {
 };
 
 /// Parameters of the production mapper. In-class defaults are the seed paper's choices, but for
-/// `integration`.
+/// `integration` and `key_set`.
 struct MapperConfig {
   /// Edge of an OctoMap leaf cell [m].
   double resolution_m = 0.05;
@@ -89,6 +89,7 @@ struct MapperConfig {
   double free_range_m = 0.0;
   /// Worker threads for ray casting; 0 means all hardware threads. The map does not depend on it.
   int threads = 0;
+  /// kBlocks: the fastest in pipeline_bench, rays and exact alike (docs/benchmarks.md).
   KeySetKind key_set = KeySetKind::kBlocks;
 };
 
