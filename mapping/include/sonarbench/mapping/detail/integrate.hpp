@@ -110,11 +110,11 @@ struct BatchWorkspace {
 namespace integrate_detail {
 
 // The threads' cells are merged without a lock: split by the root's eight octants (disjoint
-// subtrees), then one thread per octant sorts its cells in Morton order, keeps one copy per cell
-// (occupied winning) and applies the updates (docs/mapper.md). An update is a cell's Morton code
-// << bits | level: `bits` 1 and level 1 for arc marking, kShareBits and the cell's share level
-// for arc evidence; level 0 is free.
-// Each thread's cells split by the root's octant, as updates.
+// subtrees), then one thread per octant sorts its cells in Morton order (a block set's: its
+// blocks, MergeBlocks), keeps one copy per cell (occupied winning) and applies the updates
+// (docs/mapper.md). An update is a cell's Morton code << bits | level: `bits` 1 and level 1 for
+// arc marking, kShareBits and the cell's share level for arc evidence; level 0 is free.
+// Each thread's cells split by the root's octant: as updates, or a block set's as its blocks.
 template <typename Set>
 void SplitByOctant(BatchWorkspace<Set>& workspace, int threads, unsigned bits) {
   auto& per_thread = workspace.per_thread;
