@@ -1,5 +1,7 @@
 #include "cli.hpp"
 
+#include <omp.h>
+
 #include <cmath>
 
 #include "sonarbench/io/dataset.hpp"
@@ -84,6 +86,10 @@ void AddThreadsOption(CLI::App* command, int& threads) {
                    "Threads; 0 = all cores. Outputs are identical for any value.")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
+  // Every parallel loop that names no thread count, the images' too, takes this one.
+  command->parse_complete_callback([&threads] {
+    if (threads > 0) omp_set_num_threads(threads);
+  });
 }
 
 }  // namespace sonarbench::app

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -264,30 +265,44 @@ ReportImage CertaintyImage(const CertaintyCurve& curve, const std::string& name)
                                    "mean occupancy probability", series, false, 0.0, 1.0))};
 }
 
-// The map's images (against the truth when `scene`), then the first sweep's.
-std::vector<ReportImage> LogMapImages(const LogMapResult& result, const Scene* scene,
-                                      const std::string& name, const MapCells& cells) {
-  std::vector<ReportImage> images;
+// The map's images: against the truth when `scene`, else from above.
+std::vector<ReportImage> MapImages(const LogMapResult& result, const Scene* scene,
+                                   const std::string& name, const MapCells& cells) {
   if (scene) {
     Eigen::Vector3d sonar = Eigen::Vector3d::Zero();
     if (!result.poses.empty()) sonar = result.poses.front().T_world_sonar.translation();
-    images = MapTruthImages(result.mapper->tree(), result.truth, result.observable, sonar,
-                            scene->name + ", " + name);
-  } else {
-    MapView top;
-    top.resolution_m = result.mapper->config().resolution_m;
-    top.title = name + ": map from above";
-    images.push_back(
-        {"map_top.png",
-         "Occupied cells from above (white), free cells grey, whole pixels per column.",
-         EncodePng(RenderMapView(cells, {}, {}, top))});
+    return MapTruthImages(result.mapper->tree(), result.truth, result.observable, sonar,
+                          scene->name + ", " + name);
   }
-  images.push_back(
-      {"polar.png", "First sweep, polar: one row per beam in time order, range to the right.",
-       EncodePng(RenderPolarImage(result.first_sweep, name + ": first sweep, polar"))});
-  images.push_back(
-      {"fan.png", "First sweep, Cartesian fan from above: the sonar at the centre, 1 cm per pixel.",
-       EncodePng(RenderFanImage(result.first_sweep, 0.01, name + ": first sweep, fan"))});
+  MapView top;
+  top.resolution_m = result.mapper->config().resolution_m;
+  top.title = name + ": map from above";
+  return {{"map_top.png",
+           "Occupied cells from above (white), free cells grey, whole pixels per column.",
+           EncodePng(RenderMapView(cells, {}, {}, top))}};
+}
+
+// map.bt and map.ot, the map's cells and images, and the first sweep's images, side by side on
+// the mapper's threads: the map's images, then polar.png and fan.png.
+std::vector<ReportImage> WriteMapAndImages(const std::filesystem::path& dir,
+                                           const LogMapResult& result, const Scene* scene,
+                                           const std::string& name, MapCells& cells) {
+  std::vector<ReportImage> images;
+  ReportImage polar, fan;
+  // Brings the map's inner nodes up to date: from then on the tasks may read it at once.
+  const octomap::OcTree& tree = result.mapper->tree();
+  const std::function<void()> tasks[] = {
+      [&] { fan = FanImage(result.first_sweep, name); },
+      [&] {
+        cells = CollectMapCells(tree);
+        images = MapImages(result, scene, name, cells);
+      },
+      [&] { result.mapper->WriteFull((dir / "map.ot").string()); },
+      [&] { result.mapper->WriteBinary((dir / "map.bt").string()); },
+      [&] { polar = PolarImage(result.first_sweep, name); }};
+  RunTasks(result.mapper->config().threads, tasks);
+  images.push_back(std::move(polar));
+  images.push_back(std::move(fan));
   return images;
 }
 
@@ -298,12 +313,11 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
   namespace fs = std::filesystem;
   CreateOutputDirectory(out_dir);
   const fs::path dir(out_dir);
-  result.mapper->WriteBinary((dir / "map.bt").string());
-  result.mapper->WriteFull((dir / "map.ot").string());
-  const MapCells cells = CollectMapCells(result.mapper->tree());
   const std::string name = fs::path(result.input).filename().string();
   const bool scored = scene && result.verdict;
-  std::vector<ReportImage> images = LogMapImages(result, scored ? scene : nullptr, name, cells);
+  MapCells cells;
+  std::vector<ReportImage> images =
+      WriteMapAndImages(dir, result, scored ? scene : nullptr, name, cells);
   const bool certainty = scored && result.certainty;
   if (certainty) images.push_back(CertaintyImage(*result.certainty, scene->name + ", " + name));
   WriteReportImages(out_dir, images);

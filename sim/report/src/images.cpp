@@ -109,7 +109,7 @@ class BeamsByAngle {
         k = (k + n - 1) % n;
       for (std::size_t step = 0; step < n && by_angle_[k].first == angle; ++step, k = (k + 1) % n) {
         const std::size_t i = by_angle_[k].second;
-        const double d = std::abs(std::remainder(sweep_[i].head_angle_rad - bearing, kTwoPi));
+        const double d = AngleBetween(sweep_[i].head_angle_rad, bearing);
         if (best == sweep_.size() || d < best_distance || (d == best_distance && i < best)) {
           best = i;
           best_distance = d;
@@ -122,6 +122,15 @@ class BeamsByAngle {
  private:
   static constexpr double kTwoPi = 2.0 * std::numbers::pi;
   static double Wrapped(double angle) { return angle - kTwoPi * std::floor(angle / kTwoPi); }
+  // |remainder(a - b, 2π)|, exact as remainder is, without its call for differences within
+  // ±3π: d <= π is its own remainder, and d - 2π is exact for d <= 4π (Sterbenz); the ties at
+  // ±π round to the even quotient, which gives the same magnitude.
+  static double AngleBetween(double a, double b) {
+    const double d = std::abs(a - b);
+    if (d <= 0.5 * kTwoPi) return d;
+    const double r = std::abs(d - kTwoPi);
+    return r <= 0.5 * kTwoPi ? r : std::abs(std::remainder(a - b, kTwoPi));
+  }
 
   std::span<const mapping::Beam> sweep_;
   std::vector<std::pair<double, std::size_t>> by_angle_;

@@ -1,6 +1,9 @@
 #include "sonarbench/sim/report/report_page.hpp"
 
+#include <omp.h>
+
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <sstream>
 
@@ -37,6 +40,34 @@ std::string CriteriaTestCases(const std::string& classname, const Verdict& v,
 }
 
 }  // namespace
+
+ReportImage PolarImage(std::span<const mapping::Beam> sweep, const std::string& name) {
+  return {"polar.png", "First sweep, polar: one row per beam in time order, range to the right.",
+          EncodePng(RenderPolarImage(sweep, name + ": first sweep, polar"))};
+}
+
+ReportImage FanImage(std::span<const mapping::Beam> sweep, const std::string& name) {
+  return {"fan.png",
+          "First sweep, Cartesian fan from above: the sonar at the centre, 1 cm per pixel.",
+          EncodePng(RenderFanImage(sweep, 0.01, name + ": first sweep, fan"))};
+}
+
+void RunTasks(int threads, std::span<const std::function<void()>> tasks) {
+  std::vector<std::exception_ptr> errors(tasks.size());
+  const auto count = static_cast<int>(tasks.size());
+#pragma omp parallel for num_threads(threads > 0 ? threads : omp_get_max_threads()) \
+    schedule(dynamic, 1)
+  for (int i = 0; i < count; ++i) {
+    try {
+      tasks[static_cast<std::size_t>(i)]();
+    } catch (...) {
+      errors[static_cast<std::size_t>(i)] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& error : errors) {
+    if (error) std::rethrow_exception(error);
+  }
+}
 
 std::string Seconds(double seconds) {
   char text[32];

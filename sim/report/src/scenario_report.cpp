@@ -146,16 +146,17 @@ double TotalSeconds(const StageTimings& t) {
 
 std::vector<ReportImage> RenderImages(const Scene& scene, const ScenarioResult& result) {
   const std::string name = scene.name + ", seed " + std::to_string(result.seed);
-  std::vector<ReportImage> images = {
-      {"polar.png", "First sweep, polar: one row per beam in time order, range to the right.",
-       EncodePng(RenderPolarImage(result.first_sweep, name + ": first sweep, polar"))},
-      {"fan.png", "First sweep, Cartesian fan from above: the sonar at the centre, 1 cm per pixel.",
-       EncodePng(RenderFanImage(result.first_sweep, 0.01, name + ": first sweep, fan"))},
-  };
-  for (ReportImage& image : MapTruthImages(result.mapper->tree(), result.truth, result.observable,
-                                           result.sonar_start_m, name)) {
-    images.push_back(std::move(image));
-  }
+  std::vector<ReportImage> images(2);
+  std::vector<ReportImage> map_images;
+  const std::function<void()> tasks[] = {[&] { images[1] = FanImage(result.first_sweep, name); },
+                                         [&] {
+                                           map_images = MapTruthImages(
+                                               result.mapper->tree(), result.truth,
+                                               result.observable, result.sonar_start_m, name);
+                                         },
+                                         [&] { images[0] = PolarImage(result.first_sweep, name); }};
+  RunTasks(result.threads, tasks);
+  for (ReportImage& image : map_images) images.push_back(std::move(image));
   return images;
 }
 

@@ -15,6 +15,7 @@
 #include <tuple>
 #include <vector>
 
+#include "cli_util.hpp"
 #include "sonarbench/io/mat_log.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
@@ -103,6 +104,24 @@ TEST(RealLogMap, FolderHoldingOneLogMeansThatLog) {
   }
   std::ofstream(dir.path() / "manifest.json") << "{}";
   EXPECT_EQ(sim::MatLogInDirectory(dir.path().string()), "");  // a dataset stays a dataset
+}
+
+// `sonarbench map`'s files are the same bytes on any number of threads: on two, the map's files
+// and images and the first sweep's images are written side by side.
+TEST(RealLogMap, OutputsAreTheSameOnOneThreadAsOnTwo) {
+  REQUIRE_REAL_LOG();
+  test::TempDir dir;
+  for (const int threads : {1, 2}) {
+    mapping::MapperConfig config;
+    config.threads = threads;
+    const sim::LogMapResult result = sim::MapLog(RealLogPath(), mapping::SensorGeometry{}, config);
+    sim::WriteLogMapOutputs((dir.path() / std::to_string(threads)).string(), result, nullptr);
+  }
+  for (const char* file : {"map.bt", "map.ot", "map_top.png", "polar.png", "fan.png"}) {
+    const std::string one = test::ReadFile(dir.path() / "1" / file);
+    EXPECT_GT(one.size(), 1000u) << file;
+    EXPECT_EQ(one, test::ReadFile(dir.path() / "2" / file)) << file;
+  }
 }
 
 // The real tank through `sonarbench map`'s defaults: its walls must come out straight and the

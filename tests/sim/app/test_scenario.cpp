@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "cli_util.hpp"
 #include "sonarbench/sim/app/scenario.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
@@ -264,14 +265,25 @@ TEST(SeabedScenario, NothingOccupiedAboveTheSeabed) {
   EXPECT_GT(result.metrics.occupied_recall, 0.0);
 }
 
+// The map and the report's images too: on two threads the images are drawn side by side.
 TEST(Scenario, MapIsIdenticalForOneAndTwoThreads) {
   Scene scene = LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   scene.sweeps = 2;
-  RunOptions one;
-  one.threads = 1;
-  RunOptions two;
-  two.threads = 2;
-  EXPECT_EQ(MapBytes(RunScenario(scene, one)), MapBytes(RunScenario(scene, two)));
+  test::TempDir dir;
+  std::string map[2];
+  for (const int threads : {1, 2}) {
+    RunOptions options;
+    options.threads = threads;
+    const ScenarioResult result = RunScenario(scene, options);
+    map[threads - 1] = MapBytes(result);
+    WriteScenarioOutputs((dir.path() / std::to_string(threads)).string(), scene, result);
+  }
+  EXPECT_EQ(map[0], map[1]);
+  for (const char* image : {"polar.png", "fan.png", "map_top.png", "map_side.png"}) {
+    const std::string one = test::ReadFile(dir.path() / "1" / image);
+    EXPECT_GT(one.size(), 1000u) << image;
+    EXPECT_EQ(one, test::ReadFile(dir.path() / "2" / image)) << image;
+  }
 }
 
 }  // namespace

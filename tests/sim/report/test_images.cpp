@@ -40,5 +40,23 @@ TEST(RenderFanImage, TheSameImageOnOneThreadAsOnTwo) {
   EXPECT_GT(spread[0] + spread[1] + spread[2], 10.0);
 }
 
+// A beam's head angle is a direction: given in [0, 2π), in [-π, π), or a turn or two on, the
+// same sweep draws the same fan (the nearest beam found by the angle between, wrapped).
+TEST(RenderFanImage, TheSameImageWhicheverTurnTheHeadAnglesAreGivenIn) {
+  const std::vector<mapping::Beam> sweep = Sweep();
+  const cv::Mat reference = RenderFanImage(sweep, 0.01, "fan");
+  for (const double turns : {-1.0, 1.0, 2.0, 3.0}) {
+    std::vector<mapping::Beam> turned = sweep;
+    for (mapping::Beam& beam : turned) {
+      // [-π, π) for turns = -1: only the upper half is moved.
+      if (turns >= 0.0 || beam.head_angle_rad >= std::numbers::pi)
+        beam.head_angle_rad += turns * 2.0 * std::numbers::pi;
+    }
+    const cv::Mat image = RenderFanImage(turned, 0.01, "fan");
+    ASSERT_EQ(image.size(), reference.size());
+    EXPECT_EQ(cv::norm(image, reference, cv::NORM_INF), 0.0) << turns << " turns";
+  }
+}
+
 }  // namespace
 }  // namespace sonarbench::sim

@@ -23,7 +23,8 @@ void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out);
 /// `config.integration`) and OctoMap log-odds updates. Threading: Integrate() finds the cells of
 /// a batch's beams on `config.threads` threads, each into its own key sets, merged afterwards,
 /// and updates the root's octants in parallel; the resulting map is identical for any thread
-/// count. A Mapper is not safe to call from several threads at once.
+/// count. A Mapper is not safe to call from several threads at once, but for its const members
+/// once tree() has returned after the last Integrate (which leaves the inner nodes to it).
 class Mapper {
  public:
   Mapper(const MapperConfig& config, const SensorGeometry& sensor);

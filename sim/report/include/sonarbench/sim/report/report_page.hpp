@@ -3,10 +3,13 @@
 #include <octomap/OcTree.h>
 
 #include <Eigen/Core>
+#include <functional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/mapping/detail/key_set.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/eval/verdict.hpp"
@@ -30,6 +33,16 @@ struct ReportImage {
                                                       const mapping::KeySet& observable,
                                                       const Eigen::Vector3d& side_slice_m,
                                                       const std::string& name);
+
+/// polar.png and fan.png of a sweep (report.html's "first sweep" images); `name` starts their
+/// titles.
+[[nodiscard]] ReportImage PolarImage(std::span<const mapping::Beam> sweep, const std::string& name);
+[[nodiscard]] ReportImage FanImage(std::span<const mapping::Beam> sweep, const std::string& name);
+
+/// Runs each of `tasks` once, on up to `threads` threads (0 = all cores), taking them in order:
+/// put the longest first. Then rethrows the exception of the first task (in order) that threw.
+/// The tasks must not share what they write.
+void RunTasks(int threads, std::span<const std::function<void()>> tasks);
 
 /// Writes each image into `dir` as its file, atomically.
 void WriteReportImages(const std::string& dir, const std::vector<ReportImage>& images);
