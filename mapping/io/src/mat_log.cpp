@@ -66,15 +66,18 @@ void CheckFieldTable(const std::string& path, matvar_t* data, std::size_t count)
 std::vector<std::uint8_t> ReadIntensities(const std::string& path,
                                           const std::optional<mat_v5::ArrayView>& bins,
                                           std::size_t i) {
-  const std::string where = path + ": beam " + std::to_string(i) + ", field 'intensities'";
-  if (!bins) throw InputError(where + ": missing");
+  auto where = [&] { return path + ": beam " + std::to_string(i) + ", field 'intensities'"; };
+  if (!bins) throw InputError(where() + ": missing");
   const std::size_t n = bins->count;
-  if (n == 0) throw InputError(where + ": empty");
+  if (n == 0) throw InputError(where() + ": empty");
+  if (const std::string_view bytes = bins->StoredBytes(); bytes.size() == n) {
+    return {bytes.begin(), bytes.end()};  // stored as uint8: each value already in 0..255
+  }
   std::vector<std::uint8_t> intensities(n);
   for (std::size_t k = 0; k < n; ++k) {
     const auto value = bins->NumericAt(k);
     if (!value || *value < 0.0 || *value > 255.0 || *value != std::floor(*value)) {
-      throw InputError(where + ", bin " + std::to_string(k) + ": expected an integer in 0..255");
+      throw InputError(where() + ", bin " + std::to_string(k) + ": expected an integer in 0..255");
     }
     intensities[k] = static_cast<std::uint8_t>(*value);
   }
@@ -105,11 +108,11 @@ MatLog ReadBeams(const std::string& path, std::size_t count, const FieldOf& fiel
   log.beams.reserve(count);
   auto scalar = [&](std::size_t i, const char* field) -> double {
     const auto var = field_of(i, field);
-    const std::string where = "beam " + std::to_string(i) + ", field '" + field + "'";
-    if (!var) throw fail(where + ": missing");
-    if (var->count != 1) throw fail(where + ": expected one number");
+    auto where = [&] { return "beam " + std::to_string(i) + ", field '" + field + "'"; };
+    if (!var) throw fail(where() + ": missing");
+    if (var->count != 1) throw fail(where() + ": expected one number");
     const auto value = var->NumericAt(0);
-    if (!value || !std::isfinite(*value)) throw fail(where + ": expected a finite number");
+    if (!value || !std::isfinite(*value)) throw fail(where() + ": expected a finite number");
     return *value;
   };
   std::map<std::size_t, std::size_t> bin_counts;

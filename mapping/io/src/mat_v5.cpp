@@ -359,6 +359,16 @@ std::optional<double> ArrayView::NumericAt(std::size_t k) const {
   }
 }
 
+std::string_view ArrayView::StoredBytes() const {
+  constexpr std::uint32_t kUint8 = 2;  // miUINT8
+  const bool holds_bytes =
+      array_class == 6 || array_class == 7 || (array_class >= 9 && array_class <= 13);
+  if (complex || data == nullptr || data_type != kUint8 || !holds_bytes || count > data_bytes) {
+    return {};
+  }
+  return {data, count};
+}
+
 const ArrayView* StructArray::Field(std::size_t i, std::string_view name) const {
   for (std::size_t f = 0; f < fields.size(); ++f) {
     if (fields[f] == name) return i < count ? &values[i * fields.size() + f] : nullptr;

@@ -29,6 +29,10 @@ struct ArrayView {
   /// Element k of a real array of class double, single or (u)int8..32, as the class holds it;
   /// nullopt for other classes, complex arrays and k out of range.
   [[nodiscard]] std::optional<double> NumericAt(std::size_t k) const;
+  /// The values as bytes when they are stored as uint8 in a real array whose class holds 0..255
+  /// exactly (double, single, uint8, (u)int16, (u)int32): what NumericAt reads, without a call
+  /// per value. Empty otherwise.
+  [[nodiscard]] std::string_view StoredBytes() const;
 };
 
 /// A struct array: its element count, field names and each element's fields.
