@@ -89,7 +89,7 @@ std::string RunMapper(const std::vector<Beam>& beams, const SensorGeometry& sens
                                                   sensor.MaxRangeM(), threads, workspace);
     if (totals != nullptr) *totals += stats;
   }
-  FinishUpdates(tree);
+  FinishUpdates(tree, threads);
   return Bytes(tree);
 }
 

@@ -56,7 +56,7 @@ Mapper& Mapper::operator=(Mapper&&) noexcept = default;
 
 const octomap::OcTree& Mapper::tree() const {
   if (state_->stale) {
-    FinishUpdates(state_->tree);
+    FinishUpdates(state_->tree, state_->threads);
     state_->stale = false;
   }
   return state_->tree;

@@ -244,14 +244,6 @@ TEST(BlockKeySet, HoldsWhatAReferenceSetHoldsAndWalksBlocksInMortonOrder) {
         ASSERT_LT(MortonCode(UnpackKey(walked[i - 1])), MortonCode(UnpackKey(walked[i])));
       }
     }
-    for (const BlockKeySet::Block& block : set.blocks()) {
-      const std::uint64_t first = BlockKeySet::FirstKey(block);
-      std::uint64_t least = ~std::uint64_t{0};
-      BlockKeySet::ForEachInBlock(block, [&](std::uint64_t packed) {
-        least = std::min(least, MortonCode(UnpackKey(packed)));
-      });
-      ASSERT_EQ(MortonCode(UnpackKey(first)), least);
-    }
   }
   set.clear();
   EXPECT_EQ(set.size(), 0u);

@@ -14,6 +14,72 @@
 
 namespace sonarbench::mapping {
 
+/// Blocks found by their `origin` member (any 64-bit value) in an open-addressing table, kept in
+/// the order first asked for, the last one found cached. A new block is value-initialised.
+template <typename Block>
+class BlockTable {
+ public:
+  /// The block of `origin`, made if missing.
+  Block& BlockOf(std::uint64_t origin) {
+    if (origin == last_origin_) return blocks_[last_];
+    if (2 * (blocks_.size() + 1) > slots_.size()) Rehash();
+    std::size_t i = Home(origin);
+    for (;; i = (i + 1) & (slots_.size() - 1)) {
+      const std::uint32_t s = slots_[i];
+      if (s == 0) break;
+      if (blocks_[s - 1].origin == origin) {
+        last_origin_ = origin;
+        last_ = s - 1;
+        return blocks_[last_];
+      }
+    }
+    blocks_.emplace_back();
+    blocks_.back().origin = origin;
+    slots_[i] = static_cast<std::uint32_t>(blocks_.size());
+    last_origin_ = origin;
+    last_ = blocks_.size() - 1;
+    return blocks_.back();
+  }
+  /// The block of `origin`, or nullptr.
+  [[nodiscard]] const Block* Find(std::uint64_t origin) const {
+    if (slots_.empty()) return nullptr;
+    for (std::size_t i = Home(origin);; i = (i + 1) & (slots_.size() - 1)) {
+      const std::uint32_t s = slots_[i];
+      if (s == 0) return nullptr;
+      if (blocks_[s - 1].origin == origin) return &blocks_[s - 1];
+    }
+  }
+  [[nodiscard]] std::span<const Block> blocks() const { return blocks_; }
+  [[nodiscard]] std::span<Block> blocks() { return blocks_; }
+  /// Empties the table, keeping its room.
+  void clear() {
+    std::fill(slots_.begin(), slots_.end(), 0u);
+    blocks_.clear();
+    last_origin_ = ~std::uint64_t{0};
+  }
+
+ private:
+  [[nodiscard]] std::size_t Home(std::uint64_t origin) const {
+    return static_cast<std::size_t>((origin * 0x9e3779b97f4a7c15ULL) >> shift_);
+  }
+  void Rehash() {
+    const std::size_t capacity = std::max<std::size_t>(64, 2 * slots_.size());
+    slots_.assign(capacity, 0u);
+    shift_ = 64 - static_cast<unsigned>(std::countr_zero(capacity));
+    for (std::size_t b = 0; b < blocks_.size(); ++b) {
+      std::size_t i = Home(blocks_[b].origin);
+      while (slots_[i] != 0) i = (i + 1) & (capacity - 1);
+      slots_[i] = static_cast<std::uint32_t>(b + 1);
+    }
+  }
+
+  std::vector<std::uint32_t> slots_;  // block index + 1; 0: empty
+  std::vector<Block> blocks_;
+  unsigned shift_ = 64;
+  std::uint64_t last_origin_ = ~std::uint64_t{0};
+  std::size_t last_ = 0;
+};
+
 /// A set of OcTreeKeys as 8 × 8 × 8 blocks of bits (as Bonxai and OpenVDB keep their leaves):
 /// a block per 8³ cells that holds any, found by its block coordinates in an open-addressing
 /// table, a cell's bit at its Morton index within the block. A block's cells in bit order are
@@ -56,30 +122,26 @@ class BlockKeySet {
   }
   [[nodiscard]] bool contains(const octomap::OcTreeKey& key) const {
     const std::uint64_t packed = PackKey(key);
-    const std::uint32_t slot = Find(packed & kOriginMask);
-    if (slot == 0) return false;
+    const Block* block = table_.Find(packed & kOriginMask);
+    if (block == nullptr) return false;
     const unsigned index = IndexInBlock(packed);
-    return (blocks_[slot - 1].bits[index >> 6] >> (index & 63)) & 1u;
+    return (block->bits[index >> 6] >> (index & 63)) & 1u;
   }
 
   /// The keys held: a count over the blocks.
   [[nodiscard]] std::size_t size() const {
     std::size_t count = 0;
-    for (const Block& b : blocks_) {
+    for (const Block& b : table_.blocks()) {
       for (const std::uint64_t w : b.bits) count += static_cast<std::size_t>(std::popcount(w));
     }
     return count;
   }
-  [[nodiscard]] bool empty() const { return blocks_.empty(); }
+  [[nodiscard]] bool empty() const { return table_.blocks().empty(); }
   /// The blocks, in the order they were first touched.
-  [[nodiscard]] std::span<const Block> blocks() const { return blocks_; }
+  [[nodiscard]] std::span<const Block> blocks() const { return table_.blocks(); }
 
   /// Empties the set, keeping its tables' room.
-  void clear() {
-    std::fill(slots_.begin(), slots_.end(), 0u);
-    blocks_.clear();
-    last_origin_ = ~std::uint64_t{0};
-  }
+  void clear() { table_.clear(); }
   /// Nothing: clear() keeps the tables' room, and how many blocks `count` keys take depends on
   /// where they lie. (The mapper reserves each set's last size after clearing it.)
   void reserve(std::size_t /*count*/) {}
@@ -87,7 +149,7 @@ class BlockKeySet {
   /// Calls `f(packed)` for each key: block by block, each block's in Morton order.
   template <typename F>
   void for_each_packed(F&& f) const {
-    for (const Block& b : blocks_) ForEachInBlock(b, f);
+    for (const Block& b : table_.blocks()) ForEachInBlock(b, f);
   }
   /// Calls `f(packed)` for each cell of block `b`, in Morton order.
   template <typename F>
@@ -98,12 +160,6 @@ class BlockKeySet {
       }
     }
   }
-  /// The packed key of the block's first cell in Morton order (a block holds one at least).
-  [[nodiscard]] static std::uint64_t FirstKey(const Block& b) {
-    unsigned w = 0;
-    while (b.bits[w] == 0) ++w;
-    return KeyInBlock(b.origin, 64 * w + static_cast<unsigned>(std::countr_zero(b.bits[w])));
-  }
   /// The packed key of Morton index `index` in the block at `origin`.
   [[nodiscard]] static std::uint64_t KeyInBlock(std::uint64_t origin, unsigned index) {
     auto compact = [](unsigned v) { return (v & 1) | ((v >> 2) & 2) | ((v >> 4) & 4); };
@@ -112,52 +168,9 @@ class BlockKeySet {
   }
 
  private:
-  [[nodiscard]] std::size_t Home(std::uint64_t origin) const {
-    return static_cast<std::size_t>((origin * 0x9e3779b97f4a7c15ULL) >> shift_);
-  }
-  // The slot (block index + 1) holding `origin`'s block, or 0.
-  [[nodiscard]] std::uint32_t Find(std::uint64_t origin) const {
-    if (slots_.empty()) return 0;
-    for (std::size_t i = Home(origin);; i = (i + 1) & (slots_.size() - 1)) {
-      const std::uint32_t s = slots_[i];
-      if (s == 0 || blocks_[s - 1].origin == origin) return s;
-    }
-  }
-  Block& BlockOf(std::uint64_t origin) {
-    if (origin == last_origin_) return blocks_[last_];
-    if (2 * (blocks_.size() + 1) > slots_.size()) Rehash();
-    std::size_t i = Home(origin);
-    for (;; i = (i + 1) & (slots_.size() - 1)) {
-      const std::uint32_t s = slots_[i];
-      if (s == 0) break;
-      if (blocks_[s - 1].origin == origin) {
-        last_origin_ = origin;
-        last_ = s - 1;
-        return blocks_[last_];
-      }
-    }
-    blocks_.push_back({origin, {}});
-    slots_[i] = static_cast<std::uint32_t>(blocks_.size());
-    last_origin_ = origin;
-    last_ = blocks_.size() - 1;
-    return blocks_.back();
-  }
-  void Rehash() {
-    const std::size_t capacity = std::max<std::size_t>(64, 2 * slots_.size());
-    slots_.assign(capacity, 0u);
-    shift_ = 64 - static_cast<unsigned>(std::countr_zero(capacity));
-    for (std::size_t b = 0; b < blocks_.size(); ++b) {
-      std::size_t i = Home(blocks_[b].origin);
-      while (slots_[i] != 0) i = (i + 1) & (capacity - 1);
-      slots_[i] = static_cast<std::uint32_t>(b + 1);
-    }
-  }
+  Block& BlockOf(std::uint64_t origin) { return table_.BlockOf(origin); }
 
-  std::vector<std::uint32_t> slots_;  // block index + 1; 0: empty
-  std::vector<Block> blocks_;
-  unsigned shift_ = 64;
-  std::uint64_t last_origin_ = ~std::uint64_t{0};
-  std::size_t last_ = 0;
+  BlockTable<Block> table_;
 };
 
 }  // namespace sonarbench::mapping

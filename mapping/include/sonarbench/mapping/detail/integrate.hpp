@@ -19,32 +19,6 @@
 
 namespace sonarbench::mapping {
 
-/// The key's Morton code: the bits of x, y and z interleaved, most significant first, which is
-/// the order of a depth-first walk of the octree.
-[[nodiscard]] inline std::uint64_t MortonCode(const octomap::OcTreeKey& key) {
-  auto spread = [](std::uint64_t v) {  // 16 bits to every third of 48
-    v = (v | (v << 16)) & 0x0000ff0000ffULL;
-    v = (v | (v << 8)) & 0x00f00f00f00fULL;
-    v = (v | (v << 4)) & 0x0c30c30c30c3ULL;
-    v = (v | (v << 2)) & 0x249249249249ULL;
-    return v;
-  };
-  return (spread(key[0]) << 2) | (spread(key[1]) << 1) | spread(key[2]);
-}
-
-/// The key whose Morton code is `code` (the inverse of MortonCode).
-[[nodiscard]] inline octomap::OcTreeKey KeyFromMortonCode(std::uint64_t code) {
-  auto compact = [](std::uint64_t v) {  // every third of 48 bits to 16
-    v &= 0x249249249249ULL;
-    v = (v | (v >> 2)) & 0x0c30c30c30c3ULL;
-    v = (v | (v >> 4)) & 0x00f00f00f00fULL;
-    v = (v | (v >> 8)) & 0x0000ff0000ffULL;
-    v = (v | (v >> 16)) & 0x00000000ffffULL;
-    return static_cast<octomap::key_type>(v);
-  };
-  return {compact(code >> 2), compact(code >> 1), compact(code)};
-}
-
 /// Sorts `values` in increasing order: a least-significant-digit radix sort, 11 bits a pass,
 /// that skips a pass whose digit is the same in every value (the high bits of the Morton codes
 /// of one region of space). `scratch` is reused between calls.
@@ -72,11 +46,15 @@ inline void RadixSort(std::vector<std::uint64_t>& values, std::vector<std::uint6
   }
 }
 
-/// Brings a tree that IntegrateBatch updated up to date for reading and writing: the inner nodes'
-/// occupancy (the maximum of their children's). Updates leave it stale (lazy evaluation, no
-/// pruning): it does not change how a later update goes, so this is needed once after the last
+/// Brings a tree that IntegrateBatch updated up to date for reading and writing: its leaves set
+/// to the log-odds the batches left beside it (MapTree::SyncLeaves, on up to `threads` threads),
+/// then the inner nodes' occupancy (the maximum of their children's; lazy evaluation, no
+/// pruning). Neither changes how a later update goes, so this is needed once after the last
 /// batch, not after each.
-inline void FinishUpdates(MapTree& tree) { tree.updateInnerOccupancy(); }
+inline void FinishUpdates(MapTree& tree, int threads = 1) {
+  tree.SyncLeaves(threads);
+  tree.updateInnerOccupancy();
+}
 
 /// What IntegrateBatch needs besides the tree: each thread's key sets and buffers, and each
 /// octant's updates. Kept from batch to batch, a workspace's tables are already grown to a
@@ -190,13 +168,13 @@ void MergeBlocks(BatchWorkspace<Set>& workspace, int o, unsigned bits) {
 }
 
 // Octant o's updates from all threads, sorted, a cell's copies merged (the highest level wins:
-// occupied over free), applied to `tree` with log_odds[level]. Returns {free cells, occupied
-// cells, nodes created}.
+// occupied over free), applied to `tree`'s leaves with log_odds[level]. Returns {free cells,
+// occupied cells}.
 template <typename Set>
-std::array<std::size_t, 3> UpdateOctant(MapTree& tree, BatchWorkspace<Set>& workspace, int o,
+std::array<std::size_t, 2> UpdateOctant(MapTree& tree, BatchWorkspace<Set>& workspace, int o,
                                         unsigned bits, std::span<const float> log_odds) {
   const auto& split = workspace.split;
-  std::array<std::size_t, 3> counts{};
+  std::array<std::size_t, 2> counts{};
   auto& updates = workspace.updates[static_cast<std::size_t>(o)];
   updates.clear();
   for (const auto& octants : split) {
@@ -219,11 +197,7 @@ std::array<std::size_t, 3> UpdateOctant(MapTree& tree, BatchWorkspace<Set>& work
   }
   updates.resize(kept);
   for (const std::uint64_t u : updates) counts[(u & full) != 0 ? 1 : 0] += 1;
-  // Octant o's subtree hangs below the root's child o, made above: threads share no node.
-  counts[2] = tree.UpdateLeavesUncounted(
-      updates.size(),
-      [&updates, bits](std::size_t i) { return KeyFromMortonCode(updates[i] >> bits); },
-      [&updates, &log_odds, full](std::size_t i) { return log_odds[updates[i] & full]; });
+  tree.ApplyUpdates(o, updates, bits, log_odds);
   return counts;
 }
 
@@ -242,6 +216,7 @@ BatchStats IntegrateCells(MapTree& tree, std::span<const Beam> beams,
                           BatchWorkspace<Set>& workspace, const ArcEvidence& evidence,
                           Cast&& cast) {
   const double start = omp_get_wtime();
+  if (evidence.on()) tree.SyncLeaves(threads);  // the shares read the map's leaves
   workspace.Reset(threads);
   auto& per_thread = workspace.per_thread;
   const auto count = static_cast<std::int64_t>(beams.size());
@@ -253,25 +228,13 @@ BatchStats IntegrateCells(MapTree& tree, std::span<const Beam> beams,
   const unsigned bits = evidence.on() ? kShareBits : 1;
   integrate_detail::SplitByOctant(workspace, threads, bits);
   const double split_done = omp_get_wtime();
-  for (unsigned o = 0; o < 8; ++o) {
-    for (const auto& octants : workspace.split) {
-      if (octants[o].empty()) continue;
-      tree.CreatePath(KeyFromMortonCode(octants[o].front() >> bits));
-      break;
-    }
-    for (const auto& octants : workspace.block_split) {
-      if (octants[o].empty()) continue;
-      tree.CreatePath(UnpackKey(BlockKeySet::FirstKey(*octants[o].front().block)));
-      break;
-    }
-  }
   std::vector<float> log_odds(std::size_t{1} << bits);
   log_odds[0] = tree.getProbMissLog();
   for (std::size_t level = 1; level < log_odds.size(); ++level) {
     log_odds[level] = evidence.on() ? ShareLogOdds(tree.getProbHit(), tree.getProbHitLog(), level)
                                     : tree.getProbHitLog();
   }
-  std::array<std::array<std::size_t, 3>, 8> counts{};
+  std::array<std::array<std::size_t, 2>, 8> counts{};
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
   for (int o = 0; o < 8; ++o) {
     counts[static_cast<std::size_t>(o)] =
@@ -281,7 +244,6 @@ BatchStats IntegrateCells(MapTree& tree, std::span<const Beam> beams,
   for (const auto& c : counts) {
     stats.free_cells += c[0];
     stats.occupied_cells += c[1];
-    tree.AddNodes(c[2]);
   }
   stats.beams = beams.size();
   for (const auto& o : obstacles) stats.beams_with_obstacle += o.empty() ? 0 : 1;

@@ -27,6 +27,32 @@ namespace sonarbench::mapping {
           static_cast<octomap::key_type>(packed & 0xffff)};
 }
 
+/// The key's Morton code: the bits of x, y and z interleaved, most significant first, which is
+/// the order of a depth-first walk of the octree.
+[[nodiscard]] inline std::uint64_t MortonCode(const octomap::OcTreeKey& key) {
+  auto spread = [](std::uint64_t v) {  // 16 bits to every third of 48
+    v = (v | (v << 16)) & 0x0000ff0000ffULL;
+    v = (v | (v << 8)) & 0x00f00f00f00fULL;
+    v = (v | (v << 4)) & 0x0c30c30c30c3ULL;
+    v = (v | (v << 2)) & 0x249249249249ULL;
+    return v;
+  };
+  return (spread(key[0]) << 2) | (spread(key[1]) << 1) | spread(key[2]);
+}
+
+/// The key whose Morton code is `code` (the inverse of MortonCode).
+[[nodiscard]] inline octomap::OcTreeKey KeyFromMortonCode(std::uint64_t code) {
+  auto compact = [](std::uint64_t v) {  // every third of 48 bits to 16
+    v &= 0x249249249249ULL;
+    v = (v | (v >> 2)) & 0x0c30c30c30c3ULL;
+    v = (v | (v >> 4)) & 0x00f00f00f00fULL;
+    v = (v | (v >> 8)) & 0x0000ff0000ffULL;
+    v = (v | (v >> 16)) & 0x00000000ffffULL;
+    return static_cast<octomap::key_type>(v);
+  };
+  return {compact(code >> 2), compact(code >> 1), compact(code)};
+}
+
 /// Collision resolution of the open-addressing set (the seed paper, section 2.2).
 enum class Probing {
   kLinear,     ///< h, h+1, h+2, ...

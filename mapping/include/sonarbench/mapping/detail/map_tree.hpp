@@ -2,9 +2,16 @@
 
 #include <octomap/OcTree.h>
 
+#include <algorithm>
+#include <array>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <span>
+#include <vector>
+
+#include "sonarbench/mapping/detail/block_set.hpp"
+#include "sonarbench/mapping/detail/key_set.hpp"
 
 namespace sonarbench::mapping::detail {
 struct ChildLinker;
@@ -28,13 +35,74 @@ class OcTreeBaseImpl<OcTreeNode, sonarbench::mapping::detail::ChildLinker> {
 
 namespace sonarbench::mapping {
 
-/// OctoMap's OcTree, plus what parallel updates need.
+/// OctoMap's OcTree, plus what parallel updates need: the log-odds of its leaves as batches
+/// leave them, kept in 8³-cell blocks beside the tree (as Bonxai keeps a map), each root octant's
+/// apart, and set into the tree's leaves when it is read (SyncLeaves, through FinishUpdates).
 class MapTree : public octomap::OcTree {
  public:
   using octomap::OcTree::OcTree;
 
-  /// Adds `created` nodes to OctoMap's count (the .bt header carries it), after updates that
-  /// left the count to the caller (UpdateLeavesUncounted in parallel).
+  /// Applies octant `octant`'s updates to its leaves' log-odds as OctoMap's updateNode(key,
+  /// log_odds, /*lazy_eval=*/true) applies them (add, then clamp), without walking the tree.
+  /// Updates are Morton code << bits | level (the update log_odds[level]), distinct and sorted;
+  /// threads may apply different octants at once.
+  void ApplyUpdates(int octant, std::span<const std::uint64_t> updates, unsigned bits,
+                    std::span<const float> log_odds) {
+    auto& leaves = leaves_[static_cast<std::size_t>(octant)];
+    const float min = clamping_thres_min, max = clamping_thres_max;
+    const std::uint64_t full = (std::uint64_t{1} << bits) - 1;
+    for (const std::uint64_t u : updates) {
+      const std::uint64_t code = u >> bits;
+      LeafBlock& block = leaves.BlockOf(code & ~std::uint64_t{511});
+      const std::size_t index = code & 511;
+      float value = block.log_odds[index];
+      value += log_odds[u & full];
+      block.log_odds[index] = value < min ? min : (value > max ? max : value);
+      block.dirty[index >> 6] |= std::uint64_t{1} << (index & 63);
+    }
+  }
+
+  /// Sets the tree's leaves to the log-odds of every cell updated since the last call, creating
+  /// nodes as updateNode would, the octants on up to `threads` threads.
+  void SyncLeaves(int threads) {
+    std::array<std::size_t, 8> nodes{};
+    for (std::size_t o = 0; o < 8; ++o) {  // each octant's cells in Morton order
+      auto& codes = sync_codes_[o];
+      auto& values = sync_values_[o];
+      codes.clear();
+      values.clear();
+      std::vector<LeafBlock*> dirty;
+      for (LeafBlock& block : leaves_[o].blocks()) {
+        if (block.dirty != std::array<std::uint64_t, 8>{}) dirty.push_back(&block);
+      }
+      std::sort(dirty.begin(), dirty.end(),
+                [](const LeafBlock* a, const LeafBlock* b) { return a->origin < b->origin; });
+      for (LeafBlock* block : dirty) {
+        for (unsigned w = 0; w < 8; ++w) {
+          for (std::uint64_t bits = block->dirty[w]; bits != 0; bits &= bits - 1) {
+            const unsigned index = 64 * w + static_cast<unsigned>(std::countr_zero(bits));
+            codes.push_back(block->origin | index);
+            values.push_back(block->log_odds[index]);
+          }
+          block->dirty[w] = 0;
+        }
+      }
+      // The root and its child o, made here: the threads below share no node.
+      if (!codes.empty()) CreatePath(KeyFromMortonCode(codes.front()));
+    }
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (int o = 0; o < 8; ++o) {
+      const auto& codes = sync_codes_[static_cast<std::size_t>(o)];
+      const auto& values = sync_values_[static_cast<std::size_t>(o)];
+      nodes[static_cast<std::size_t>(o)] = ForEachLeafUncounted(
+          codes.size(), [&codes](std::size_t i) { return KeyFromMortonCode(codes[i]); },
+          [&values](std::size_t i, octomap::OcTreeNode* leaf) { leaf->setLogOdds(values[i]); });
+    }
+    for (const std::size_t n : nodes) AddNodes(n);
+  }
+
+  /// Adds `created` nodes to OctoMap's count (the .bt header carries it), after walks that left
+  /// the count to the caller (ForEachLeafUncounted in parallel).
   void AddNodes(std::size_t created) {
     tree_size += created;
     size_changed = true;
@@ -54,14 +122,17 @@ class MapTree : public octomap::OcTree {
   /// to their deepest common node, which is then not walked again.
   template <typename Key, typename LogOdds>
   void UpdateLeavesInOrder(std::size_t count, Key&& key, LogOdds&& log_odds) {
-    AddNodes(UpdateLeavesUncounted(count, key, log_odds));
+    AddNodes(ForEachLeafUncounted(count, key, [&](std::size_t i, octomap::OcTreeNode* leaf) {
+      updateNodeLogOdds(leaf, log_odds(i));
+    }));
   }
 
-  /// UpdateLeavesInOrder, but the nodes it creates are returned, not counted in the tree: threads
-  /// may update disjoint subtrees (below existing nodes) at once, then AddNodes their sum.
-  template <typename Key, typename LogOdds>
-  [[nodiscard]] std::size_t UpdateLeavesUncounted(std::size_t count, Key&& key,
-                                                  LogOdds&& log_odds) {
+  /// Calls `leaf(i, node)` with the leaf of `key(i)` for i in [0, count), creating missing nodes
+  /// as UpdateLeavesInOrder does (keys distinct, in Morton order). The nodes it creates are
+  /// returned, not counted in the tree: threads may walk disjoint subtrees (below existing
+  /// nodes) at once, then AddNodes their sum.
+  template <typename Key, typename Leaf>
+  [[nodiscard]] std::size_t ForEachLeafUncounted(std::size_t count, Key&& key, Leaf&& leaf) {
     using Linker = octomap::OcTreeBaseImpl<octomap::OcTreeNode, detail::ChildLinker>;
     constexpr unsigned kDepth = 16;
     std::size_t nodes = 0;
@@ -104,11 +175,21 @@ class MapTree : public octomap::OcTree {
         }
         path[depth + 1] = getNodeChild(node, pos);
       }
-      updateNodeLogOdds(path[kDepth], log_odds(i));
+      leaf(i, path[kDepth]);
       previous = k;
     }
     return nodes;
   }
+
+ private:
+  struct LeafBlock {
+    std::uint64_t origin = 0;  // the Morton code of its first cell (low nine bits 0)
+    std::array<float, 512> log_odds{};
+    std::array<std::uint64_t, 8> dirty{};  // bit i: cell i updated since the last SyncLeaves
+  };
+  std::array<BlockTable<LeafBlock>, 8> leaves_;
+  std::array<std::vector<std::uint64_t>, 8> sync_codes_;
+  std::array<std::vector<float>, 8> sync_values_;
 };
 
 }  // namespace sonarbench::mapping
