@@ -115,13 +115,22 @@ void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out) {
   tree.writeBinaryData(out);
 }
 
+// Both write what the tree would, from the leaves' log-odds: the tree need not be built.
 void Mapper::WriteBinary(const std::string& path) const {
   // A failed write leaves `out` bad: WriteFileAtomically reports it with the OS's reason.
-  WriteFileAtomically(path, [&](std::ostream& out) { WriteOctomapBinary(tree(), out); });
+  WriteFileAtomically(path, [&](std::ostream& out) { state_->tree.WriteBinaryFromLeaves(out); });
 }
 
 void Mapper::WriteFull(const std::string& path) const {
-  WriteFileAtomically(path, [&](std::ostream& out) { (void)tree().write(out); });
+  WriteFileAtomically(path, [&](std::ostream& out) { state_->tree.WriteFullFromLeaves(out); });
+}
+
+void Mapper::ForEachLeaf(
+    const std::function<void(const octomap::OcTreeKey& key, bool occupied)>& f) const {
+  const MapTree& tree = state_->tree;
+  const float threshold = tree.getOccupancyThresLog();
+  tree.ForEachLeaf(
+      [&](const octomap::OcTreeKey& key, float log_odds) { f(key, log_odds >= threshold); });
 }
 
 }  // namespace sonarbench::mapping

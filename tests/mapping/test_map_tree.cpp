@@ -69,6 +69,7 @@ TEST(MapTree, UpdateLeavesInOrderBuildsUpdateNodesTree) {
 // Updates kept beside the tree (ApplyUpdates, octant by octant) and set into its leaves when it
 // is read (SyncLeaves, here after some batches and not others, on 1 or 2 threads) build the tree
 // updateNode builds, byte for byte: clamping, nodes created and their count included, .ot too.
+// The .bt and .ot written from the leaves alone are those bytes too.
 TEST(MapTree, UpdatesAppliedBesideTheTreeSyncToUpdateNodesTree) {
   for (const int threads : {1, 2}) {
     MapTree ours(0.05);
@@ -88,6 +89,9 @@ TEST(MapTree, UpdatesAppliedBesideTheTreeSyncToUpdateNodesTree) {
       }
       if (batch % 7 == 3) ours.SyncLeaves(threads);
     }
+    std::ostringstream from_leaves, full_from_leaves;
+    ours.WriteBinaryFromLeaves(from_leaves);  // before the last sync: the leaves alone
+    ours.WriteFullFromLeaves(full_from_leaves);
     FinishUpdates(ours, threads);
     FinishUpdates(ours, threads);  // nothing left to set: the same tree
     octomaps.updateInnerOccupancy();
@@ -99,7 +103,18 @@ TEST(MapTree, UpdatesAppliedBesideTheTreeSyncToUpdateNodesTree) {
     EXPECT_EQ(ours.size(), octomaps.size()) << threads << " threads";
     EXPECT_TRUE(a.str() == b.str()) << threads << " threads";
     EXPECT_TRUE(full_a.str() == full_b.str()) << threads << " threads";
+    EXPECT_TRUE(from_leaves.str() == b.str()) << threads << " threads";
+    EXPECT_TRUE(full_from_leaves.str() == full_b.str()) << threads << " threads";
   }
+  // No update, no root: a header alone, as OctoMap writes an empty tree.
+  const MapTree empty(0.05);
+  std::ostringstream a, b, full_a, full_b;
+  empty.WriteBinaryFromLeaves(a);
+  WriteOctomapBinary(empty, b);
+  empty.WriteFullFromLeaves(full_a);
+  (void)empty.write(full_b);
+  EXPECT_EQ(a.str(), b.str());
+  EXPECT_EQ(full_a.str(), full_b.str());
 }
 
 }  // namespace

@@ -1,9 +1,16 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
 #include <utility>
 #include <vector>
 
+#include "sonarbench/mapping/detail/key_set.hpp"
 #include "sonarbench/mapping/mapper.hpp"
+#include "test_util.hpp"
 
 namespace sonarbench::mapping {
 namespace {
@@ -101,6 +108,50 @@ TEST(Mapper, IntegrateSweepsIntegratesTheLastPartialSweep) {
   EXPECT_TRUE(IsFree(mapper, 1.025, 0.025, 0.025));
   EXPECT_TRUE(IsFree(mapper, 11.025, 0.025, 0.025));
   EXPECT_FALSE(IsOccupied(mapper, 11.025, 0.025, 0.025));
+}
+
+// The map's files and leaves come from the log-odds the batches left, without the tree: before
+// tree() is ever asked for they are what the tree, once built, writes and holds.
+TEST(Mapper, WritesAndListsTheMapAsItsTreeWithoutBuildingIt) {
+  const SensorGeometry sensor;
+  std::vector<Beam> beams;
+  std::vector<std::vector<double>> echoes;
+  for (int b = 0; b < 40; ++b) {
+    beams.push_back(AxisBeam(sensor, {0.0, 0.0, 0.1 * (b % 3)}));
+    beams.back().head_angle_rad = 0.05 * b;
+    echoes.push_back(b % 5 == 0 ? std::vector<double>{} : std::vector<double>{1.0 + 0.03 * b});
+  }
+  MapperConfig config = Config();
+  config.threads = 2;
+  Mapper mapper(config, sensor);
+  mapper.Integrate(std::span(beams).first(20), std::span(echoes).first(20));
+  mapper.Integrate(std::span(beams).last(20), std::span(echoes).last(20));
+  const test::TempDir dir;
+  mapper.WriteBinary((dir.path() / "map.bt").string());
+  mapper.WriteFull((dir.path() / "map.ot").string());
+  std::vector<std::pair<std::uint64_t, bool>> leaves;
+  mapper.ForEachLeaf([&leaves](const octomap::OcTreeKey& key, bool occupied) {
+    leaves.emplace_back(PackKey(key), occupied);
+  });
+  const octomap::OcTree& tree = mapper.tree();
+  std::ostringstream bt, ot;
+  WriteOctomapBinary(tree, bt);
+  (void)tree.write(ot);
+  EXPECT_GT(tree.size(), 1000u);
+  auto bytes = [&dir](const char* name) {
+    std::ifstream in(dir.path() / name, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_TRUE(bytes("map.bt") == bt.str());
+  EXPECT_TRUE(bytes("map.ot") == ot.str());
+  std::vector<std::pair<std::uint64_t, bool>> tree_leaves;
+  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
+    tree_leaves.emplace_back(PackKey(it.getKey()), tree.isNodeOccupied(*it));
+  }
+  std::sort(leaves.begin(), leaves.end());
+  std::sort(tree_leaves.begin(), tree_leaves.end());
+  EXPECT_EQ(leaves, tree_leaves);
+  EXPECT_TRUE(std::any_of(leaves.begin(), leaves.end(), [](const auto& l) { return l.second; }));
 }
 
 }  // namespace

@@ -289,12 +289,13 @@ std::vector<ReportImage> WriteMapAndImages(const std::filesystem::path& dir,
                                            const std::string& name, MapCells& cells) {
   std::vector<ReportImage> images;
   ReportImage polar, fan;
-  // Brings the map's inner nodes up to date: from then on the tasks may read it at once.
-  const octomap::OcTree& tree = result.mapper->tree();
+  // The truth images walk the tree: built first, it may be read by the tasks at once. The rest
+  // reads the map's leaves alone.
+  if (scene) (void)result.mapper->tree();
   const std::function<void()> tasks[] = {
       [&] { fan = FanImage(result.first_sweep, name); },
       [&] {
-        cells = CollectMapCells(tree);
+        cells = CollectMapCells(*result.mapper);
         images = MapImages(result, scene, name, cells);
       },
       [&] { result.mapper->WriteFull((dir / "map.ot").string()); },

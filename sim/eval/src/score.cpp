@@ -91,6 +91,14 @@ MapCells CollectMapCells(const octomap::OcTree& map) {
   return cells;
 }
 
+MapCells CollectMapCells(const mapping::Mapper& mapper) {
+  MapCells cells;
+  mapper.ForEachLeaf([&cells](const octomap::OcTreeKey& key, bool occupied) {
+    (occupied ? cells.occupied : cells.free).insert(key);
+  });
+  return cells;
+}
+
 namespace {
 
 // Whether `cells` holds a cell within `k` cells (Chebyshev) of `key`.

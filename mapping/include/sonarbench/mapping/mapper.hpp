@@ -24,7 +24,8 @@ void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out);
 /// a batch's beams on `config.threads` threads, each into its own key sets, merged afterwards,
 /// and updates the root's octants in parallel; the resulting map is identical for any thread
 /// count. A Mapper is not safe to call from several threads at once, but for its const members
-/// once tree() has returned after the last Integrate (which leaves the inner nodes to it).
+/// between Integrates; tree(), which builds the tree the batches leave to it, must have returned
+/// once before several threads call it.
 class Mapper {
  public:
   Mapper(const MapperConfig& config, const SensorGeometry& sensor);
@@ -54,6 +55,11 @@ class Mapper {
   void WriteBinary(const std::string& path) const;
   /// Writes the map as an OctoMap `.ot` file (full probabilities), atomically.
   void WriteFull(const std::string& path) const;
+  /// Calls `f` with each leaf of the map (a cell updated at least once) and whether it is
+  /// occupied (isNodeOccupied), in no particular order. Like the writers, it does not need the
+  /// tree built: for maps that tree() is never asked for, it never is.
+  void ForEachLeaf(
+      const std::function<void(const octomap::OcTreeKey& key, bool occupied)>& f) const;
 
  private:
   MapperConfig config_;

@@ -7,7 +7,9 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <ostream>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "sonarbench/mapping/detail/block_set.hpp"
@@ -59,6 +61,27 @@ class MapTree : public octomap::OcTree {
       value += log_odds[u & full];
       block.log_odds[index] = value < min ? min : (value > max ? max : value);
       block.dirty[index >> 6] |= std::uint64_t{1} << (index & 63);
+      block.present[index >> 6] |= std::uint64_t{1} << (index & 63);
+    }
+  }
+
+  /// Writes the map as WriteOctomapBinary (`.bt`) and OcTree::write (`.ot`) write the tree once
+  /// SyncLeaves and FinishUpdates ran, byte for byte, from the leaves' log-odds alone: the tree
+  /// need not be built. For a map made by ApplyUpdates only (the mapper's).
+  void WriteBinaryFromLeaves(std::ostream& out) const;
+  void WriteFullFromLeaves(std::ostream& out) const;
+  /// Calls `f(key, log_odds)` for every cell ApplyUpdates updated, in no particular order.
+  template <typename F>
+  void ForEachLeaf(F&& f) const {
+    for (const auto& leaves : leaves_) {
+      for (const LeafBlock& block : leaves.blocks()) {
+        for (unsigned w = 0; w < 8; ++w) {
+          for (std::uint64_t bits = block.present[w]; bits != 0; bits &= bits - 1) {
+            const unsigned index = 64 * w + static_cast<unsigned>(std::countr_zero(bits));
+            f(KeyFromMortonCode(block.origin | index), block.log_odds[index]);
+          }
+        }
+      }
     }
   }
 
@@ -182,10 +205,15 @@ class MapTree : public octomap::OcTree {
   }
 
  private:
+  // Every updated cell with its log-odds, in the order of OctoMap's depth-first walk: each
+  // level's child index x | y << 1 | z << 2, 48 bits.
+  [[nodiscard]] std::vector<std::pair<std::uint64_t, float>> LeavesInTreeOrder() const;
+
   struct LeafBlock {
     std::uint64_t origin = 0;  // the Morton code of its first cell (low nine bits 0)
     std::array<float, 512> log_odds{};
-    std::array<std::uint64_t, 8> dirty{};  // bit i: cell i updated since the last SyncLeaves
+    std::array<std::uint64_t, 8> dirty{};    // bit i: cell i updated since the last SyncLeaves
+    std::array<std::uint64_t, 8> present{};  // bit i: cell i updated at all
   };
   std::array<BlockTable<LeafBlock>, 8> leaves_;
   std::array<std::vector<std::uint64_t>, 8> sync_codes_;

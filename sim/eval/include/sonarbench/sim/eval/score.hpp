@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
 
@@ -94,5 +95,7 @@ struct MapCells {
   mapping::KeySet free;
 };
 [[nodiscard]] MapCells CollectMapCells(const octomap::OcTree& map);
+/// The same cells of a mapper's map, from its leaves (the tree need not be built).
+[[nodiscard]] MapCells CollectMapCells(const mapping::Mapper& mapper);
 
 }  // namespace sonarbench::sim
