@@ -87,28 +87,38 @@ namespace {
 class BeamsByAngle {
  public:
   explicit BeamsByAngle(std::span<const mapping::Beam> sweep) : sweep_(sweep) {
+    std::vector<std::pair<double, std::size_t>> by_angle;
     for (std::size_t i = 0; i < sweep.size(); ++i)
-      by_angle_.emplace_back(Wrapped(sweep[i].head_angle_rad), i);
-    std::sort(by_angle_.begin(), by_angle_.end());
+      by_angle.emplace_back(Wrapped(sweep[i].head_angle_rad), i);
+    std::sort(by_angle.begin(), by_angle.end());
+    for (const auto& [angle, i] : by_angle) {
+      angles_.push_back(angle);
+      beams_.push_back(i);
+    }
+    // Equal angles lie side by side: each position's group of them.
+    group_.resize(angles_.size());
+    for (std::size_t k = 0, first = 0; k < angles_.size(); ++k) {
+      if (angles_[k] != angles_[first]) first = k;
+      group_[k].first = first;
+    }
+    for (std::size_t k = angles_.size(), end = k; k-- > 0;) {
+      if (angles_[k] != angles_[end - 1]) end = k + 1;
+      group_[k].second = end;
+    }
   }
 
   // The beam nearest `bearing` [rad]; the sweep must not be empty.
   const mapping::Beam& Nearest(double bearing) const {
-    const std::size_t n = by_angle_.size();
-    const auto first_above = std::lower_bound(by_angle_.begin(), by_angle_.end(),
-                                              std::make_pair(Wrapped(bearing), std::size_t{0}));
-    const std::size_t above = static_cast<std::size_t>(first_above - by_angle_.begin()) % n;
-    const std::size_t below = (above + n - 1) % n;
+    const std::size_t n = angles_.size();
+    const auto first_above = std::lower_bound(angles_.begin(), angles_.end(), Wrapped(bearing));
+    std::size_t above = static_cast<std::size_t>(first_above - angles_.begin());
+    if (above == n) above = 0;
+    const std::size_t below = (above == 0 ? n : above) - 1;
     std::size_t best = sweep_.size();
     double best_distance = 0.0;
     for (const std::size_t start : {below, above}) {
-      // The whole group of beams sharing this angle.
-      const double angle = by_angle_[start].first;
-      std::size_t k = start;
-      while (by_angle_[(k + n - 1) % n].first == angle && (k + n - 1) % n != start)
-        k = (k + n - 1) % n;
-      for (std::size_t step = 0; step < n && by_angle_[k].first == angle; ++step, k = (k + 1) % n) {
-        const std::size_t i = by_angle_[k].second;
+      for (std::size_t k = group_[start].first; k < group_[start].second; ++k) {
+        const std::size_t i = beams_[k];
         const double d = AngleBetween(sweep_[i].head_angle_rad, bearing);
         if (best == sweep_.size() || d < best_distance || (d == best_distance && i < best)) {
           best = i;
@@ -133,7 +143,9 @@ class BeamsByAngle {
   }
 
   std::span<const mapping::Beam> sweep_;
-  std::vector<std::pair<double, std::size_t>> by_angle_;
+  std::vector<double> angles_;      // the beams' wrapped head angles, sorted
+  std::vector<std::size_t> beams_;  // the beam at each
+  std::vector<std::pair<std::size_t, std::size_t>> group_;  // [first, end) of equal angles
 };
 
 }  // namespace

@@ -58,5 +58,25 @@ TEST(RenderFanImage, TheSameImageWhicheverTurnTheHeadAnglesAreGivenIn) {
   }
 }
 
+// Beams heard at one head angle (a head that paused) are one direction: the fan shows the
+// earliest of them, as a scan of the sweep in order would pick it.
+TEST(RenderFanImage, BeamsAtOneAngleShowTheEarliest) {
+  std::vector<mapping::Beam> paused, single;
+  for (int b = 0; b < 100; ++b) {
+    mapping::Beam beam;
+    beam.head_angle_rad = b * 3.6 * std::numbers::pi / 180.0;
+    beam.bin_size_m = 0.02;
+    beam.intensities.assign(60, 200);
+    single.push_back(beam);
+    paused.push_back(beam);
+    beam.intensities.assign(60, 50);  // heard later at the same angle
+    paused.push_back(beam);
+  }
+  const cv::Mat expected = RenderFanImage(single, 0.01, "fan");
+  const cv::Mat fan = RenderFanImage(paused, 0.01, "fan");
+  ASSERT_EQ(fan.size(), expected.size());
+  EXPECT_EQ(cv::norm(fan, expected, cv::NORM_INF), 0.0);
+}
+
 }  // namespace
 }  // namespace sonarbench::sim
