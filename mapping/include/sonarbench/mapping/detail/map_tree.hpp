@@ -117,7 +117,7 @@ class MapTree : public octomap::OcTree {
     for (int o = 0; o < 8; ++o) {
       const auto& codes = sync_codes_[static_cast<std::size_t>(o)];
       const auto& values = sync_values_[static_cast<std::size_t>(o)];
-      nodes[static_cast<std::size_t>(o)] = ForEachLeafUncounted(
+      nodes[static_cast<std::size_t>(o)] = WalkLeavesUncounted(
           codes.size(), [&codes](std::size_t i) { return KeyFromMortonCode(codes[i]); },
           [&values](std::size_t i, octomap::OcTreeNode* leaf) { leaf->setLogOdds(values[i]); });
     }
@@ -125,7 +125,7 @@ class MapTree : public octomap::OcTree {
   }
 
   /// Adds `created` nodes to OctoMap's count (the .bt header carries it), after walks that left
-  /// the count to the caller (ForEachLeafUncounted in parallel).
+  /// the count to the caller (WalkLeavesUncounted in parallel).
   void AddNodes(std::size_t created) {
     tree_size += created;
     size_changed = true;
@@ -145,7 +145,7 @@ class MapTree : public octomap::OcTree {
   /// to their deepest common node, which is then not walked again.
   template <typename Key, typename LogOdds>
   void UpdateLeavesInOrder(std::size_t count, Key&& key, LogOdds&& log_odds) {
-    AddNodes(ForEachLeafUncounted(count, key, [&](std::size_t i, octomap::OcTreeNode* leaf) {
+    AddNodes(WalkLeavesUncounted(count, key, [&](std::size_t i, octomap::OcTreeNode* leaf) {
       updateNodeLogOdds(leaf, log_odds(i));
     }));
   }
@@ -155,7 +155,7 @@ class MapTree : public octomap::OcTree {
   /// returned, not counted in the tree: threads may walk disjoint subtrees (below existing
   /// nodes) at once, then AddNodes their sum.
   template <typename Key, typename Leaf>
-  [[nodiscard]] std::size_t ForEachLeafUncounted(std::size_t count, Key&& key, Leaf&& leaf) {
+  [[nodiscard]] std::size_t WalkLeavesUncounted(std::size_t count, Key&& key, Leaf&& leaf) {
     using Linker = octomap::OcTreeBaseImpl<octomap::OcTreeNode, detail::ChildLinker>;
     constexpr unsigned kDepth = 16;
     std::size_t nodes = 0;
