@@ -108,6 +108,16 @@ std::array<unsigned, 512> MortonOfTreeIndex() {
 
 }  // namespace
 
+void WriteOctomapBinaryHeader(const octomap::OcTree& tree, std::size_t nodes, std::ostream& out) {
+  // AbstractOccupancyOcTree::writeBinaryConst's header.
+  out << "# Octomap OcTree binary file\n# (feel free to add / change comments, but leave the first "
+         "line as it is!)\n#\n"
+      << "id " << tree.getTreeType() << "\n"
+      << "size " << nodes << "\n"
+      << "res " << tree.getResolution() << "\n"
+      << "data\n";
+}
+
 std::vector<std::pair<std::uint64_t, float>> MapTree::LeavesInTreeOrder() const {
   static const std::array<unsigned, 512> kMorton = MortonOfTreeIndex();
   std::vector<std::pair<std::uint64_t, const LeafBlock*>> blocks;
@@ -133,12 +143,7 @@ void MapTree::WriteBinaryFromLeaves(std::ostream& out) const {
   std::string data;
   std::size_t nodes = 0;
   if (!leaves.empty()) BinaryNode(leaves, 0, leaves.size(), 0, occ_prob_thres_log, data, nodes);
-  out << "# Octomap OcTree binary file\n# (feel free to add / change comments, but leave the first "
-         "line as it is!)\n#\n"
-      << "id " << getTreeType() << "\n"
-      << "size " << nodes << "\n"
-      << "res " << getResolution() << "\n"
-      << "data\n";
+  WriteOctomapBinaryHeader(*this, nodes, out);
   out.write(data.data(), static_cast<std::streamsize>(data.size()));
 }
 

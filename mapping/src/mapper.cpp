@@ -105,13 +105,7 @@ BatchStats Mapper::Integrate(std::span<const Beam> beams,
 }
 
 void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out) {
-  // AbstractOccupancyOcTree::writeBinaryConst's header, then the node data.
-  out << "# Octomap OcTree binary file\n# (feel free to add / change comments, but leave the first "
-         "line as it is!)\n#\n"
-      << "id " << tree.getTreeType() << "\n"
-      << "size " << tree.size() << "\n"
-      << "res " << tree.getResolution() << "\n"
-      << "data\n";
+  WriteOctomapBinaryHeader(tree, tree.size(), out);
   tree.writeBinaryData(out);
 }
 

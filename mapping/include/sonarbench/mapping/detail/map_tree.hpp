@@ -37,6 +37,9 @@ class OcTreeBaseImpl<OcTreeNode, sonarbench::mapping::detail::ChildLinker> {
 
 namespace sonarbench::mapping {
 
+/// The header of OctoMap's binary `.bt` file (writeBinaryConst's) for `tree` holding `nodes` nodes.
+void WriteOctomapBinaryHeader(const octomap::OcTree& tree, std::size_t nodes, std::ostream& out);
+
 /// OctoMap's OcTree, plus what parallel updates need: the log-odds of its leaves as batches
 /// leave them, kept in 8³-cell blocks beside the tree (as Bonxai keeps a map), each root octant's
 /// apart, and set into the tree's leaves when it is read (SyncLeaves, through FinishUpdates).
