@@ -139,9 +139,68 @@ void VisitLanes(unsigned check, const std::uint64_t* index, std::uint64_t* marks
   }
 }
 
-// The AVX-512 kernel: eight walks side by side, one per 64-bit lane, each step of WalkRay done
-// for all eight with masks instead of branches (the same IEEE additions and comparisons, so the
-// same cells).
+// One group of eight walks of the AVX-512 kernel: its state, kept in registers.
+struct Group512 {
+  __m512d tx, ty, tz;
+  __m512i cell;
+  __mmask8 active;
+};
+
+// The group of walks [o, o + 8) of `batch`, its lanes past `count` inactive.
+template <std::size_t kBatch>
+__attribute__((target("avx512f"), always_inline)) inline Group512 LoadGroup512(
+    const WalkLanes<kBatch>& batch, std::size_t o, std::size_t count) {
+  const std::size_t lanes = std::min(kLanes, count - std::min(count, o));
+  return {_mm512_load_pd(batch.t[0] + o), _mm512_load_pd(batch.t[1] + o),
+          _mm512_load_pd(batch.t[2] + o), _mm512_load_si512(batch.cell + o),
+          static_cast<__mmask8>((1u << lanes) - 1)};
+}
+
+// One step of WalkRay for each active walk of the group [o, o + 8) of `batch`, with masks
+// instead of branches (the same IEEE additions and comparisons, so the same cells). Visits the
+// cells stepped into, counts them in `visits` and returns the lanes still active.
+template <std::size_t kBatch>
+__attribute__((target("avx512f"), always_inline)) inline unsigned StepGroup512(
+    Group512& g, const WalkLanes<kBatch>& batch, std::size_t o, std::uint64_t* marks,
+    std::vector<std::uint64_t>& touched, std::size_t& visits) {
+  const __mmask8 x_first = _mm512_cmp_pd_mask(g.tx, g.ty, _CMP_LT_OQ);
+  const __mmask8 step_x = g.active & x_first & _mm512_cmp_pd_mask(g.tx, g.tz, _CMP_LT_OQ);
+  const __mmask8 step_y =
+      g.active & static_cast<__mmask8>(~x_first) & _mm512_cmp_pd_mask(g.ty, g.tz, _CMP_LT_OQ);
+  const __mmask8 step_z = g.active & static_cast<__mmask8>(~(step_x | step_y));
+  g.tx = _mm512_mask_add_pd(g.tx, step_x, g.tx, _mm512_load_pd(batch.delta[0] + o));
+  g.ty = _mm512_mask_add_pd(g.ty, step_y, g.ty, _mm512_load_pd(batch.delta[1] + o));
+  g.tz = _mm512_mask_add_pd(g.tz, step_z, g.tz, _mm512_load_pd(batch.delta[2] + o));
+  g.cell = _mm512_mask_add_epi64(g.cell, step_x, g.cell, _mm512_load_si512(batch.step[0] + o));
+  g.cell = _mm512_mask_add_epi64(g.cell, step_y, g.cell, _mm512_load_si512(batch.step[1] + o));
+  g.cell = _mm512_mask_add_epi64(g.cell, step_z, g.cell, _mm512_load_si512(batch.step[2] + o));
+  // min(tx, ty, tz) > length, as three comparisons.
+  const __m512d length = _mm512_load_pd(batch.length + o);
+  const __mmask8 done =
+      _mm512_cmpeq_epi64_mask(g.cell, _mm512_load_si512(batch.last + o)) |
+      (_mm512_cmp_pd_mask(g.tx, length, _CMP_GT_OQ) & _mm512_cmp_pd_mask(g.ty, length, _CMP_GT_OQ) &
+       _mm512_cmp_pd_mask(g.tz, length, _CMP_GT_OQ));
+  g.active = g.active & static_cast<__mmask8>(~done);
+  // Most visits repeat a cell (≈70 per distinct cell of a beam). Walks from one origin stand in
+  // the same cell only after the same number of steps (each step is one cell along one axis),
+  // and neighbouring rays sit in neighbouring lanes: a lane on the same cell as the lane before
+  // it is not checked against the marks, being that lane's visit again. The others are checked
+  // one by one (on these processors faster than a gather).
+  const __m512i before = _mm512_maskz_alignr_epi64(0xff, g.cell, g.cell, 7);
+  const __mmask8 repeat = _mm512_mask_cmpeq_epi64_mask(
+      static_cast<__mmask8>(g.active & (g.active << 1)), g.cell, before);
+  const unsigned check = g.active & static_cast<__mmask8>(~repeat);
+  if (check != 0) {
+    alignas(64) std::uint64_t index[kLanes];
+    _mm512_store_si512(index, g.cell);
+    VisitLanes(check, index, marks, touched);
+  }
+  visits += static_cast<std::size_t>(__builtin_popcount(g.active));
+  return g.active;
+}
+
+// The AVX-512 kernel: eight walks side by side, one per 64-bit lane, each stepped by
+// StepGroup512.
 __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWalk> walks,
                                                           const Box& box, std::uint64_t* marks,
                                                           std::vector<std::uint64_t>& touched) {
@@ -152,64 +211,18 @@ __attribute__((target("avx512f"))) std::size_t WalkAvx512(std::span<const RayWal
   constexpr std::size_t kBatch = kGroups * kLanes;
   std::size_t visits = 0;
   WalkLanes<kBatch> batch;
-  alignas(64) std::uint64_t index[kLanes];
   for (std::size_t first = 0; first < walks.size(); first += kBatch) {
     const std::size_t count = batch.Fill(walks, first, box);
     // Every walk starts by visiting the origin's cell.
     Visit(marks, touched, static_cast<std::uint64_t>(batch.cell[0]));
     visits += count;
-    __m512d tx[kGroups], ty[kGroups], tz[kGroups];
-    __m512i cell[kGroups];
-    __mmask8 active[kGroups];
-    for (std::size_t g = 0; g < kGroups; ++g) {
-      tx[g] = _mm512_load_pd(batch.t[0] + g * kLanes);
-      ty[g] = _mm512_load_pd(batch.t[1] + g * kLanes);
-      tz[g] = _mm512_load_pd(batch.t[2] + g * kLanes);
-      cell[g] = _mm512_load_si512(batch.cell + g * kLanes);
-      const std::size_t lanes = std::min(kLanes, count - std::min(count, g * kLanes));
-      active[g] = static_cast<__mmask8>((1u << lanes) - 1);
-    }
+    Group512 group[kGroups];
+    for (std::size_t g = 0; g < kGroups; ++g) group[g] = LoadGroup512(batch, g * kLanes, count);
     for (;;) {
       unsigned any = 0;
 #pragma GCC unroll 4
       for (std::size_t g = 0; g < kGroups; ++g) {
-        const std::size_t o = g * kLanes;
-        const __mmask8 x_first = _mm512_cmp_pd_mask(tx[g], ty[g], _CMP_LT_OQ);
-        const __mmask8 step_x = active[g] & x_first & _mm512_cmp_pd_mask(tx[g], tz[g], _CMP_LT_OQ);
-        const __mmask8 step_y = active[g] & static_cast<__mmask8>(~x_first) &
-                                _mm512_cmp_pd_mask(ty[g], tz[g], _CMP_LT_OQ);
-        const __mmask8 step_z = active[g] & static_cast<__mmask8>(~(step_x | step_y));
-        tx[g] = _mm512_mask_add_pd(tx[g], step_x, tx[g], _mm512_load_pd(batch.delta[0] + o));
-        ty[g] = _mm512_mask_add_pd(ty[g], step_y, ty[g], _mm512_load_pd(batch.delta[1] + o));
-        tz[g] = _mm512_mask_add_pd(tz[g], step_z, tz[g], _mm512_load_pd(batch.delta[2] + o));
-        cell[g] =
-            _mm512_mask_add_epi64(cell[g], step_x, cell[g], _mm512_load_si512(batch.step[0] + o));
-        cell[g] =
-            _mm512_mask_add_epi64(cell[g], step_y, cell[g], _mm512_load_si512(batch.step[1] + o));
-        cell[g] =
-            _mm512_mask_add_epi64(cell[g], step_z, cell[g], _mm512_load_si512(batch.step[2] + o));
-        // min(tx, ty, tz) > length, as three comparisons.
-        const __m512d length = _mm512_load_pd(batch.length + o);
-        const __mmask8 done = _mm512_cmpeq_epi64_mask(cell[g], _mm512_load_si512(batch.last + o)) |
-                              (_mm512_cmp_pd_mask(tx[g], length, _CMP_GT_OQ) &
-                               _mm512_cmp_pd_mask(ty[g], length, _CMP_GT_OQ) &
-                               _mm512_cmp_pd_mask(tz[g], length, _CMP_GT_OQ));
-        active[g] = active[g] & static_cast<__mmask8>(~done);
-        any |= active[g];
-        // Most visits repeat a cell (≈70 per distinct cell of a beam). Walks from one origin
-        // stand in the same cell only after the same number of steps (each step is one cell
-        // along one axis), and neighbouring rays sit in neighbouring lanes: a lane on the same
-        // cell as the lane before it is not checked against the marks, being that lane's visit
-        // again. The others are checked one by one (on these processors faster than a gather).
-        const __m512i before = _mm512_maskz_alignr_epi64(0xff, cell[g], cell[g], 7);
-        const __mmask8 repeat = _mm512_mask_cmpeq_epi64_mask(
-            static_cast<__mmask8>(active[g] & (active[g] << 1)), cell[g], before);
-        unsigned check = active[g] & static_cast<__mmask8>(~repeat);
-        if (check != 0) {
-          _mm512_store_si512(index, cell[g]);
-          VisitLanes(check, index, marks, touched);
-        }
-        visits += static_cast<std::size_t>(__builtin_popcount(active[g]));
+        any |= StepGroup512(group[g], batch, g * kLanes, marks, touched, visits);
       }
       if (any == 0) break;
     }
@@ -222,79 +235,91 @@ __attribute__((target("avx2"), always_inline)) inline __m256i LoadLanes(const st
   return _mm256_load_si256(reinterpret_cast<const __m256i*>(p));
 }
 
-// The AVX2 kernel, for processors without AVX-512: WalkAvx512's steps on four 64-bit lanes,
-// its masks held as vector lanes of all ones (compares, and, andnot) and the masked additions
-// as blends (doubles: the same sum or the same value, bit for bit) or additions of a step
-// and-ed with the mask (integers).
+constexpr std::size_t kLanes4 = 4;  // 64-bit lanes of an AVX2 vector
+
+// One group of four walks of the AVX2 kernel, its masks held as vector lanes of all ones.
+struct Group256 {
+  __m256d tx, ty, tz;
+  __m256i cell;
+  __m256d active;
+};
+
+// The group of walks [o, o + 4) of `batch`, its lanes past `count` inactive.
+template <std::size_t kBatch>
+__attribute__((target("avx2"), always_inline)) inline Group256 LoadGroup256(
+    const WalkLanes<kBatch>& batch, std::size_t o, std::size_t count) {
+  const std::size_t lanes = std::min(kLanes4, count - std::min(count, o));
+  const __m256i lane_number = _mm256_set_epi64x(3, 2, 1, 0);
+  return {_mm256_load_pd(batch.t[0] + o), _mm256_load_pd(batch.t[1] + o),
+          _mm256_load_pd(batch.t[2] + o), LoadLanes(batch.cell + o),
+          _mm256_castsi256_pd(_mm256_cmpgt_epi64(
+              _mm256_set1_epi64x(static_cast<std::int64_t>(lanes)), lane_number))};
+}
+
+// StepGroup512 on four lanes: the masks' and, andnot and or as vector operations, the masked
+// additions as blends (doubles: the same sum or the same value, bit for bit) or additions of a
+// step and-ed with the mask (integers).
+template <std::size_t kBatch>
+__attribute__((target("avx2"), always_inline)) inline unsigned StepGroup256(
+    Group256& g, const WalkLanes<kBatch>& batch, std::size_t o, std::uint64_t* marks,
+    std::vector<std::uint64_t>& touched, std::size_t& visits) {
+  const __m256d x_first = _mm256_cmp_pd(g.tx, g.ty, _CMP_LT_OQ);
+  const __m256d step_x =
+      _mm256_and_pd(_mm256_and_pd(g.active, x_first), _mm256_cmp_pd(g.tx, g.tz, _CMP_LT_OQ));
+  const __m256d step_y =
+      _mm256_and_pd(_mm256_andnot_pd(x_first, g.active), _mm256_cmp_pd(g.ty, g.tz, _CMP_LT_OQ));
+  const __m256d step_z = _mm256_andnot_pd(_mm256_or_pd(step_x, step_y), g.active);
+  g.tx = _mm256_blendv_pd(g.tx, _mm256_add_pd(g.tx, _mm256_load_pd(batch.delta[0] + o)), step_x);
+  g.ty = _mm256_blendv_pd(g.ty, _mm256_add_pd(g.ty, _mm256_load_pd(batch.delta[1] + o)), step_y);
+  g.tz = _mm256_blendv_pd(g.tz, _mm256_add_pd(g.tz, _mm256_load_pd(batch.delta[2] + o)), step_z);
+  g.cell = _mm256_add_epi64(
+      g.cell, _mm256_and_si256(_mm256_castpd_si256(step_x), LoadLanes(batch.step[0] + o)));
+  g.cell = _mm256_add_epi64(
+      g.cell, _mm256_and_si256(_mm256_castpd_si256(step_y), LoadLanes(batch.step[1] + o)));
+  g.cell = _mm256_add_epi64(
+      g.cell, _mm256_and_si256(_mm256_castpd_si256(step_z), LoadLanes(batch.step[2] + o)));
+  const __m256d length = _mm256_load_pd(batch.length + o);
+  const __m256d done =
+      _mm256_or_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(g.cell, LoadLanes(batch.last + o))),
+                   _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(g.tx, length, _CMP_GT_OQ),
+                                               _mm256_cmp_pd(g.ty, length, _CMP_GT_OQ)),
+                                 _mm256_cmp_pd(g.tz, length, _CMP_GT_OQ)));
+  g.active = _mm256_andnot_pd(done, g.active);
+  const auto bits = static_cast<unsigned>(_mm256_movemask_pd(g.active));
+  // Lane l against lane l - 1 (lane 0 against lane 3, which the mask leaves out).
+  const __m256i before = _mm256_permute4x64_epi64(g.cell, _MM_SHUFFLE(2, 1, 0, 3));
+  const auto repeat = static_cast<unsigned>(
+      _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(g.cell, before))));
+  const unsigned check = bits & ~(repeat & bits & (bits << 1));
+  if (check != 0) {
+    alignas(32) std::uint64_t index[kLanes4];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(index), g.cell);
+    VisitLanes(check, index, marks, touched);
+  }
+  visits += static_cast<std::size_t>(__builtin_popcount(bits));
+  return bits;
+}
+
+// The AVX2 kernel, for processors without AVX-512: WalkAvx512 on four 64-bit lanes.
 __attribute__((target("avx2"))) std::size_t WalkAvx2(std::span<const RayWalk> walks, const Box& box,
                                                      std::uint64_t* marks,
                                                      std::vector<std::uint64_t>& touched) {
-  constexpr std::size_t kLanes4 = 4;  // 64-bit lanes of an AVX2 vector
   constexpr std::size_t kGroups = 4;
   constexpr std::size_t kBatch = kGroups * kLanes4;
   std::size_t visits = 0;
   WalkLanes<kBatch> batch;
-  alignas(32) std::uint64_t index[kLanes4];
   for (std::size_t first = 0; first < walks.size(); first += kBatch) {
     const std::size_t count = batch.Fill(walks, first, box);
     // Every walk starts by visiting the origin's cell.
     Visit(marks, touched, static_cast<std::uint64_t>(batch.cell[0]));
     visits += count;
-    __m256d tx[kGroups], ty[kGroups], tz[kGroups];
-    __m256i cell[kGroups];
-    __m256d active[kGroups];
-    for (std::size_t g = 0; g < kGroups; ++g) {
-      tx[g] = _mm256_load_pd(batch.t[0] + g * kLanes4);
-      ty[g] = _mm256_load_pd(batch.t[1] + g * kLanes4);
-      tz[g] = _mm256_load_pd(batch.t[2] + g * kLanes4);
-      cell[g] = LoadLanes(batch.cell + g * kLanes4);
-      const std::size_t lanes = std::min(kLanes4, count - std::min(count, g * kLanes4));
-      const __m256i lane_number = _mm256_set_epi64x(3, 2, 1, 0);
-      active[g] = _mm256_castsi256_pd(
-          _mm256_cmpgt_epi64(_mm256_set1_epi64x(static_cast<std::int64_t>(lanes)), lane_number));
-    }
+    Group256 group[kGroups];
+    for (std::size_t g = 0; g < kGroups; ++g) group[g] = LoadGroup256(batch, g * kLanes4, count);
     for (;;) {
       unsigned any = 0;
 #pragma GCC unroll 4
       for (std::size_t g = 0; g < kGroups; ++g) {
-        const std::size_t o = g * kLanes4;
-        const __m256d x_first = _mm256_cmp_pd(tx[g], ty[g], _CMP_LT_OQ);
-        const __m256d step_x = _mm256_and_pd(_mm256_and_pd(active[g], x_first),
-                                             _mm256_cmp_pd(tx[g], tz[g], _CMP_LT_OQ));
-        const __m256d step_y = _mm256_and_pd(_mm256_andnot_pd(x_first, active[g]),
-                                             _mm256_cmp_pd(ty[g], tz[g], _CMP_LT_OQ));
-        const __m256d step_z = _mm256_andnot_pd(_mm256_or_pd(step_x, step_y), active[g]);
-        tx[g] = _mm256_blendv_pd(tx[g], _mm256_add_pd(tx[g], _mm256_load_pd(batch.delta[0] + o)),
-                                 step_x);
-        ty[g] = _mm256_blendv_pd(ty[g], _mm256_add_pd(ty[g], _mm256_load_pd(batch.delta[1] + o)),
-                                 step_y);
-        tz[g] = _mm256_blendv_pd(tz[g], _mm256_add_pd(tz[g], _mm256_load_pd(batch.delta[2] + o)),
-                                 step_z);
-        cell[g] = _mm256_add_epi64(
-            cell[g], _mm256_and_si256(_mm256_castpd_si256(step_x), LoadLanes(batch.step[0] + o)));
-        cell[g] = _mm256_add_epi64(
-            cell[g], _mm256_and_si256(_mm256_castpd_si256(step_y), LoadLanes(batch.step[1] + o)));
-        cell[g] = _mm256_add_epi64(
-            cell[g], _mm256_and_si256(_mm256_castpd_si256(step_z), LoadLanes(batch.step[2] + o)));
-        const __m256d length = _mm256_load_pd(batch.length + o);
-        const __m256d done = _mm256_or_pd(
-            _mm256_castsi256_pd(_mm256_cmpeq_epi64(cell[g], LoadLanes(batch.last + o))),
-            _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(tx[g], length, _CMP_GT_OQ),
-                                        _mm256_cmp_pd(ty[g], length, _CMP_GT_OQ)),
-                          _mm256_cmp_pd(tz[g], length, _CMP_GT_OQ)));
-        active[g] = _mm256_andnot_pd(done, active[g]);
-        const auto bits = static_cast<unsigned>(_mm256_movemask_pd(active[g]));
-        any |= bits;
-        // Lane l against lane l - 1 (lane 0 against lane 3, which the mask leaves out).
-        const __m256i before = _mm256_permute4x64_epi64(cell[g], _MM_SHUFFLE(2, 1, 0, 3));
-        const auto repeat = static_cast<unsigned>(
-            _mm256_movemask_pd(_mm256_castsi256_pd(_mm256_cmpeq_epi64(cell[g], before))));
-        unsigned check = bits & ~(repeat & bits & (bits << 1));
-        if (check != 0) {
-          _mm256_store_si256(reinterpret_cast<__m256i*>(index), cell[g]);
-          VisitLanes(check, index, marks, touched);
-        }
-        visits += static_cast<std::size_t>(__builtin_popcount(bits));
+        any |= StepGroup256(group[g], batch, g * kLanes4, marks, touched, visits);
       }
       if (any == 0) break;
     }
@@ -302,11 +327,95 @@ __attribute__((target("avx2"))) std::size_t WalkAvx2(std::span<const RayWalk> wa
   return visits;
 }
 
-// StartRayWalkFromKey for eight segments at a time: the float difference, the float norm (as
-// OctoMap's Vector3::norm: float squares summed in float, the square root in double, rounded to
-// float), the float division, then the double arithmetic of the borders and steps. The file is
-// compiled without contraction into fused multiply-adds, so each operation rounds as the
-// scalar code's does.
+// Eight segments from one origin laid out by lane, as StartWalksAvx512 computes them.
+struct StartLanes {
+  alignas(64) float coordinate[3][kLanes];  // the segments' ends
+  alignas(64) std::int64_t key[3][kLanes];  // the ends' keys
+  alignas(64) double t_max[3][kLanes];
+  alignas(64) double t_delta[3][kLanes];
+  alignas(64) double length[kLanes];
+  __mmask8 up[3];    // lanes stepping +1 along each axis
+  __mmask8 down[3];  // and -1
+};
+
+// coordToKeyChecked for the ends of `lanes` into lanes.key: (int) floor(resolution_factor *
+// coordinate) + tree_max_val, valid in [0, 2 tree_max_val); returns the valid lanes. `d` gets
+// each end's float difference from `origin`.
+__attribute__((target("avx512f"), always_inline)) inline __mmask8 EndKeysAvx512(
+    double factor, std::int64_t max_val, const octomap::point3d& origin, StartLanes& lanes,
+    __m256 d[3]) {
+  __mmask8 valid = 0xff;
+  for (unsigned i = 0; i < 3; ++i) {
+    const __m256 c = _mm256_load_ps(lanes.coordinate[i]);
+    const __m512d scaled = _mm512_maskz_roundscale_pd(
+        0xff, _mm512_mul_pd(_mm512_set1_pd(factor), _mm512_maskz_cvtps_pd(0xff, c)),
+        _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+    // (int): outside the int range the conversion gives INT_MIN, which fails the check (as
+    // the scalar conversion does on this processor).
+    const __m512i k =
+        _mm512_add_epi64(_mm512_maskz_cvtepi32_epi64(0xff, _mm512_maskz_cvttpd_epi32(0xff, scaled)),
+                         _mm512_set1_epi64(max_val));
+    valid &= _mm512_cmpge_epi64_mask(k, _mm512_setzero_si512()) &
+             _mm512_cmplt_epi64_mask(k, _mm512_set1_epi64(2 * max_val));
+    _mm512_store_si512(lanes.key[i], k);
+    d[i] = _mm256_sub_ps(c, _mm256_set1_ps(origin(i)));
+  }
+  return valid;
+}
+
+// The walks' lengths, steps and borders from the differences `d`: the float norm (as OctoMap's
+// Vector3::norm: float squares summed in float, the square root in double, rounded to float),
+// the float division, then the double arithmetic of the borders and steps.
+__attribute__((target("avx512f"), always_inline)) inline void WalkStartsAvx512(
+    const __m256 d[3], const octomap::point3d& origin, const double border_up[3],
+    const double border_down[3], double resolution, StartLanes& lanes) {
+  const __m256 norm_sq =
+      _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(d[0], d[0]), _mm256_mul_ps(d[1], d[1])),
+                    _mm256_mul_ps(d[2], d[2]));
+  const __m256 len =
+      _mm512_maskz_cvtpd_ps(0xff, _mm512_maskz_sqrt_pd(0xff, _mm512_maskz_cvtps_pd(0xff, norm_sq)));
+  _mm512_store_pd(lanes.length, _mm512_maskz_cvtps_pd(0xff, len));
+  const __m512d v_max = _mm512_set1_pd(std::numeric_limits<double>::max());
+  for (unsigned i = 0; i < 3; ++i) {
+    const __m512d u = _mm512_maskz_cvtps_pd(0xff, _mm256_div_ps(d[i], len));  // exact widening
+    lanes.up[i] = _mm512_cmp_pd_mask(u, _mm512_setzero_pd(), _CMP_GT_OQ);
+    lanes.down[i] = _mm512_cmp_pd_mask(u, _mm512_setzero_pd(), _CMP_LT_OQ);
+    const __m512d border = _mm512_mask_blend_pd(lanes.up[i], _mm512_set1_pd(border_down[i]),
+                                                _mm512_set1_pd(border_up[i]));
+    const __m512d from = _mm512_set1_pd(static_cast<double>(origin(i)));
+    const auto moving = static_cast<__mmask8>(lanes.up[i] | lanes.down[i]);
+    _mm512_store_pd(lanes.t_max[i],
+                    _mm512_mask_div_pd(v_max, moving, _mm512_sub_pd(border, from), u));
+    _mm512_store_pd(lanes.t_delta[i], _mm512_mask_div_pd(v_max, moving, _mm512_set1_pd(resolution),
+                                                         _mm512_abs_pd(u)));
+  }
+}
+
+// The walks of the first `count` lanes whose keys are `valid` and whose end is not the origin's
+// cell, appended to `walks` in lane order.
+void AppendWalks(const StartLanes& lanes, std::size_t count, unsigned valid,
+                 const octomap::OcTreeKey& origin_key, std::vector<RayWalk>& walks) {
+  for (std::size_t l = 0; l < count; ++l) {
+    if (((valid >> l) & 1u) == 0) continue;
+    RayWalk walk;
+    walk.origin_key = origin_key;
+    for (unsigned i = 0; i < 3; ++i) {
+      walk.end_key[i] = static_cast<octomap::key_type>(lanes.key[i][l]);
+    }
+    if (walk.end_key == origin_key) continue;
+    for (unsigned i = 0; i < 3; ++i) {
+      walk.t_max[i] = lanes.t_max[i][l];
+      walk.t_delta[i] = lanes.t_delta[i][l];
+      walk.step[i] =
+          static_cast<int>((lanes.up[i] >> l) & 1u) - static_cast<int>((lanes.down[i] >> l) & 1u);
+    }
+    walk.length = lanes.length[l];
+    walks.push_back(walk);
+  }
+}
+
+// StartRayWalkFromKey for eight segments at a time, each operation rounding as the scalar
+// code's does (the file is compiled without contraction into fused multiply-adds).
 __attribute__((target("avx512f"))) void StartWalksAvx512(const octomap::OcTree& tree,
                                                          const octomap::point3d& origin,
                                                          const octomap::OcTreeKey& origin_key,
@@ -323,77 +432,17 @@ __attribute__((target("avx512f"))) void StartWalksAvx512(const octomap::OcTree& 
     border_up[i] = centre + static_cast<float>(1 * resolution * 0.5);
     border_down[i] = centre + static_cast<float>(-1 * resolution * 0.5);
   }
-  const __m512d v_factor = _mm512_set1_pd(factor);
-  const __m512d v_resolution = _mm512_set1_pd(resolution);
-  const __m512d v_max = _mm512_set1_pd(std::numeric_limits<double>::max());
-  const __m512i v_max_val = _mm512_set1_epi64(max_val);
-  const __m512i v_key_limit = _mm512_set1_epi64(2 * max_val);
-  alignas(64) float coordinate[3][kLanes];
-  alignas(64) std::int64_t key[3][kLanes];
-  alignas(64) double t_max[3][kLanes];
-  alignas(64) double t_delta[3][kLanes];
-  alignas(64) double length[kLanes];
+  StartLanes lanes;
   for (std::size_t first = 0; first < ends.size(); first += kLanes) {
     const std::size_t count = std::min(kLanes, ends.size() - first);
     for (std::size_t l = 0; l < kLanes; ++l) {
       const octomap::point3d& end = ends[first + std::min(l, count - 1)];
-      for (unsigned i = 0; i < 3; ++i) coordinate[i][l] = end(i);
+      for (unsigned i = 0; i < 3; ++i) lanes.coordinate[i][l] = end(i);
     }
-    __mmask8 valid = static_cast<__mmask8>((1u << count) - 1);
     __m256 d[3];
-    for (unsigned i = 0; i < 3; ++i) {
-      // coordToKeyChecked: (int) floor(resolution_factor * coordinate) + tree_max_val, in
-      // [0, 2 tree_max_val).
-      const __m256 c = _mm256_load_ps(coordinate[i]);
-      const __m512d scaled =
-          _mm512_maskz_roundscale_pd(0xff, _mm512_mul_pd(v_factor, _mm512_maskz_cvtps_pd(0xff, c)),
-                                     _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
-      // (int): outside the int range the conversion gives INT_MIN, which fails the check (as
-      // the scalar conversion does on this processor).
-      const __m512i k = _mm512_add_epi64(
-          _mm512_maskz_cvtepi32_epi64(0xff, _mm512_maskz_cvttpd_epi32(0xff, scaled)), v_max_val);
-      valid &= _mm512_cmpge_epi64_mask(k, _mm512_setzero_si512()) &
-               _mm512_cmplt_epi64_mask(k, v_key_limit);
-      _mm512_store_si512(key[i], k);
-      d[i] = _mm256_sub_ps(c, _mm256_set1_ps(origin(i)));
-    }
-    // Vector3::norm(), rounded to float as StartRayWalkFromKey does.
-    const __m256 norm_sq =
-        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(d[0], d[0]), _mm256_mul_ps(d[1], d[1])),
-                      _mm256_mul_ps(d[2], d[2]));
-    const __m256 len = _mm512_maskz_cvtpd_ps(
-        0xff, _mm512_maskz_sqrt_pd(0xff, _mm512_maskz_cvtps_pd(0xff, norm_sq)));
-    _mm512_store_pd(length, _mm512_maskz_cvtps_pd(0xff, len));
-    __mmask8 up[3];
-    __mmask8 down[3];
-    for (unsigned i = 0; i < 3; ++i) {
-      const __m512d u = _mm512_maskz_cvtps_pd(0xff, _mm256_div_ps(d[i], len));  // exact widening
-      up[i] = _mm512_cmp_pd_mask(u, _mm512_setzero_pd(), _CMP_GT_OQ);
-      down[i] = _mm512_cmp_pd_mask(u, _mm512_setzero_pd(), _CMP_LT_OQ);
-      const __m512d border =
-          _mm512_mask_blend_pd(up[i], _mm512_set1_pd(border_down[i]), _mm512_set1_pd(border_up[i]));
-      const __m512d from = _mm512_set1_pd(static_cast<double>(origin(i)));
-      const auto moving = static_cast<__mmask8>(up[i] | down[i]);
-      _mm512_store_pd(t_max[i], _mm512_mask_div_pd(v_max, moving, _mm512_sub_pd(border, from), u));
-      _mm512_store_pd(t_delta[i],
-                      _mm512_mask_div_pd(v_max, moving, v_resolution, _mm512_abs_pd(u)));
-    }
-    for (std::size_t l = 0; l < count; ++l) {
-      if (((valid >> l) & 1u) == 0) continue;
-      RayWalk walk;
-      walk.origin_key = origin_key;
-      for (unsigned i = 0; i < 3; ++i) {
-        walk.end_key[i] = static_cast<octomap::key_type>(key[i][l]);
-      }
-      if (walk.end_key == origin_key) continue;
-      for (unsigned i = 0; i < 3; ++i) {
-        walk.t_max[i] = t_max[i][l];
-        walk.t_delta[i] = t_delta[i][l];
-        walk.step[i] = static_cast<int>((up[i] >> l) & 1u) - static_cast<int>((down[i] >> l) & 1u);
-      }
-      walk.length = length[l];
-      walks.push_back(walk);
-    }
+    const __mmask8 valid = EndKeysAvx512(factor, max_val, origin, lanes, d);
+    WalkStartsAvx512(d, origin, border_up, border_down, resolution, lanes);
+    AppendWalks(lanes, count, valid, origin_key, walks);
   }
 }
 #endif
