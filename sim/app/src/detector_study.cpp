@@ -32,12 +32,13 @@ std::string EchoRule(const Detection& d) {
 // A map of `beams` with `detection`, scored against the truth and what a perfect sensor sees.
 MapMetrics MapAndScore(const mapping::MapperConfig& base, const Detection& detection,
                        const mapping::SensorGeometry& sensor, std::span<const mapping::Beam> beams,
-                       const mapping::KeySet& truth, const mapping::KeySet& observable) {
+                       const mapping::KeySet& truth, const mapping::KeySet& observable,
+                       const DirectEchoes& direct) {
   mapping::MapperConfig config = base;
   config.detection = detection;
   mapping::Mapper mapper(config, sensor);
   (void)mapper.IntegrateSweeps(beams);
-  return ScoreMap(mapper.tree(), truth, observable);
+  return ScoreMap(mapper.tree(), truth, observable, {}, {}, &direct);
 }
 
 json MetricsJson(const MapMetrics& m) {
@@ -47,6 +48,8 @@ json MetricsJson(const MapMetrics& m) {
           {"recall_1", m.recall_within[1]},
           {"f1_1", m.f1_within[1]},
           {"ghost_share", m.ghost_share},
+          {"ghost_arc_share", m.ghost_arc_share.value_or(NAN)},
+          {"ghost_echo_share", m.ghost_echo_share.value_or(NAN)},
           {"column_precision", m.column_precision},
           {"column_recall", m.column_recall},
           {"coverage", m.coverage},
@@ -54,8 +57,9 @@ json MetricsJson(const MapMetrics& m) {
 }
 
 const std::vector<std::string> kMetricColumns = {
-    "precision",   "recall",           "precision_1",   "recall_1", "f1_1",
-    "ghost_share", "column_precision", "column_recall", "coverage", "occupied_cells"};
+    "precision",   "recall",          "precision_1",      "recall_1",         "f1_1",
+    "ghost_share", "ghost_arc_share", "ghost_echo_share", "column_precision", "column_recall",
+    "coverage",    "occupied_cells"};
 
 void WriteCsv(const std::string& path, const std::vector<DetectorRow>& rows, bool with_log) {
   std::ostringstream csv;
@@ -145,9 +149,10 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
   // does, its truth and observable cells kept.
   std::optional<LogMapResult> log;
   mapping::KeySet log_truth, log_observable;
+  DirectEchoes log_direct;
   if (!options.log.empty()) {
     log = MapLog(options.log, scene.sensor.geometry, base, &scene, scene.budgets);
-    (void)ScoreLogMap(*log, scene, &log_truth, &log_observable);
+    (void)ScoreLogMap(*log, scene, &log_truth, &log_observable, &log_direct);
   }
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
@@ -158,11 +163,11 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
   for (const DetectorItem& item : items) {
     DetectorRow row{item,
                     MapAndScore(base, item.detection, scene.sensor.geometry, simulated.beams,
-                                simulated.truth, simulated.observable),
+                                simulated.truth, simulated.observable, simulated.direct),
                     std::nullopt};
     if (log) {
-      row.log =
-          MapAndScore(base, item.detection, log->sensor, log->mapped, log_truth, log_observable);
+      row.log = MapAndScore(base, item.detection, log->sensor, log->mapped, log_truth,
+                            log_observable, log_direct);
     }
     rows.push_back(std::move(row));
     if (options.progress) options.progress(rows.size(), items.size());

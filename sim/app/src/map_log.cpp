@@ -161,16 +161,18 @@ Eigen::Isometry3d StaticSonarPose(const Scene& scene) {
 }
 
 MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene, mapping::KeySet* truth,
-                       mapping::KeySet* observable) {
+                       mapping::KeySet* observable, DirectEchoes* direct_out) {
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
   const octomap::OcTree& map = result.mapper->tree();
   mapping::KeySet surface = VoxelizeMeshes(meshes, map);
-  mapping::KeySet seen =
-      PerfectSensorCells(tracer, result.poses, result.sensor, scene.sensor.acoustics, map);
-  const MapMetrics metrics = ScoreMap(map, surface, seen, meshes);
+  DirectEchoes direct;
+  mapping::KeySet seen = PerfectSensorCells(tracer, result.poses, result.sensor,
+                                            scene.sensor.acoustics, map, {}, &direct);
+  const MapMetrics metrics = ScoreMap(map, surface, seen, meshes, {}, &direct);
   if (truth) *truth = std::move(surface);
   if (observable) *observable = std::move(seen);
+  if (direct_out) *direct_out = std::move(direct);
   return metrics;
 }
 

@@ -66,11 +66,13 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
   std::vector<BeamPose> poses;
   for (std::size_t b = 0; b < synthesized.size(); ++b) poses.push_back(ScheduleBeam(scene, b).pose);
   if (!poses.empty()) result.sonar_start_m = poses.front().T_world_sonar.translation();
-  result.observable = PerfectSensorCells(tracer, poses, scene.sensor.geometry,
-                                         scene.sensor.acoustics, map, report("observable"));
+  DirectEchoes direct;
+  result.observable =
+      PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics, map,
+                         report("observable"), &direct);
   result.timings.ground_truth_s = clock.Lap();
 
-  result.metrics = ScoreMap(map, result.truth, result.observable, meshes, report("score"));
+  result.metrics = ScoreMap(map, result.truth, result.observable, meshes, report("score"), &direct);
   result.verdict = Evaluate(scene.criteria, result.metrics);
   result.timings.score_s = clock.Lap();
   return result;

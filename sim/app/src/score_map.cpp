@@ -139,10 +139,11 @@ MapFileScore ScoreMapFile(const std::string& map_file, const Scene& scene, const
   CheckKeyRange(map_file, s.file.resolution_m, scene, meshes);
   const RayTracer tracer(meshes);
   s.truth = VoxelizeMeshes(meshes, *s.map);
+  DirectEchoes direct;
   s.observable = PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics,
-                                    *s.map, progress);
+                                    *s.map, progress, &direct);
   s.ground_truth_s = SecondsSince(clock);
-  s.metrics = ScoreMap(*s.map, s.truth, s.observable, meshes);
+  s.metrics = ScoreMap(*s.map, s.truth, s.observable, meshes, {}, &direct);
   s.verdict = Evaluate(scene.criteria, s.metrics);
   if (s.metrics.ghost_share > kGhostShareWarning) {
     s.verdict.warnings.push_back(

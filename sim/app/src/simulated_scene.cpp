@@ -12,8 +12,8 @@ SimulatedScene SimulateForScoring(const Scene& scene, const std::vector<Triangle
   std::vector<BeamPose> poses;
   for (std::size_t b = 0; b < s.synthesized.size(); ++b)
     poses.push_back(ScheduleBeam(scene, b).pose);
-  s.observable =
-      PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics, key_space);
+  s.observable = PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics,
+                                    key_space, {}, &s.direct);
   return s;
 }
 

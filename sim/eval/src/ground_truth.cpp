@@ -3,8 +3,11 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
+#include <map>
+#include <numbers>
 
 namespace sonarbench::sim {
 namespace {
@@ -141,13 +144,90 @@ mapping::KeySet VoxelizeMeshes(std::span<const TriangleMesh> meshes,
   return cells;
 }
 
+namespace {
+
+// Each beam's index among the distinct beams (the same pose and head angle, bit for bit), and
+// whether it is the first of its kind.
+std::vector<std::size_t> DistinctBeams(std::span<const BeamPose> beams, std::vector<bool>& first,
+                                       std::size_t& distinct) {
+  std::map<std::array<double, 13>, std::size_t> seen;
+  std::vector<std::size_t> index(beams.size());
+  first.assign(beams.size(), false);
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    std::array<double, 13> pose{};
+    const Eigen::Matrix4d& m = beams[b].T_world_sonar.matrix();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c) pose[static_cast<std::size_t>(4 * r + c)] = m(r, c);
+    }
+    pose[12] = beams[b].head_angle_rad;
+    const auto [it, inserted] = seen.emplace(pose, seen.size());
+    index[b] = it->second;
+    first[b] = inserted;
+  }
+  distinct = seen.size();
+  return index;
+}
+
+// Sorted ranges [m] merged into disjoint intervals, each widened by `tolerance` on both sides.
+std::vector<std::pair<double, double>> RangeIntervals(std::vector<float>& hits, double tolerance) {
+  std::sort(hits.begin(), hits.end());
+  std::vector<std::pair<double, double>> intervals;
+  for (const float hit : hits) {
+    const double lo = hit - tolerance;
+    const double hi = hit + tolerance;
+    if (!intervals.empty() && lo <= intervals.back().second) {
+      intervals.back().second = hi;
+    } else {
+      intervals.emplace_back(lo, hi);
+    }
+  }
+  return intervals;
+}
+
+}  // namespace
+
+bool DirectEchoes::Explains(const Vector3d& centre, double cell_half_diagonal_m) const {
+  // A cell's angular radius stays under 30° beyond two half-diagonals, so a direction further
+  // than that past the aperture's edge cannot be in it: a cheap test before the angles.
+  const double limit = half_width_horizontal_rad + std::numbers::pi / 6.0;
+  const double tan_limit = limit < 0.5 * std::numbers::pi ? std::tan(limit) : INFINITY;
+  for (const Beam& beam : beams) {
+    const Vector3d v = beam.world_to_head * (centre - beam.origin);
+    const double range = v.norm();
+    if (range > 2.0 * cell_half_diagonal_m &&
+        (v.x() <= 0.0 || std::abs(v.y()) > tan_limit * v.x())) {
+      continue;
+    }
+    const double widen = std::asin(std::min(1.0, cell_half_diagonal_m / range));
+    if (std::abs(std::atan2(v.y(), v.x())) > half_width_horizontal_rad + widen ||
+        std::abs(std::atan2(v.z(), std::hypot(v.x(), v.y()))) > half_width_vertical_rad + widen) {
+      continue;
+    }
+    const auto after = std::upper_bound(
+        beam.ranges.begin(), beam.ranges.end(), range,
+        [](double r, const std::pair<double, double>& interval) { return r < interval.first; });
+    if (after != beam.ranges.begin() && range <= std::prev(after)->second) return true;
+  }
+  return false;
+}
+
 mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer, std::span<const BeamPose> beams,
                                        const mapping::SensorGeometry& sensor, int rays_horizontal,
                                        int rays_vertical, const octomap::OcTree& key_space,
-                                       const StageProgress& progress) {
+                                       const StageProgress& progress, DirectEchoes* direct) {
   const std::vector<Eigen::Vector3d> directions =
       mapping::BeamRayDirections(sensor, rays_horizontal, rays_vertical);
   const auto max_range = static_cast<float>(sensor.MaxRangeM());
+  // Beams alike see alike: each distinct beam is traced once.
+  std::vector<bool> first;
+  std::size_t distinct = 0;
+  const std::vector<std::size_t> index = DistinctBeams(beams, first, distinct);
+  if (direct) {
+    direct->beams.assign(distinct, {});
+    direct->half_width_horizontal_rad = 0.5 * sensor.beam_width_horizontal_rad;
+    direct->half_width_vertical_rad = 0.5 * sensor.beam_width_vertical_rad;
+    direct->tolerance_m = 0.5 * std::sqrt(3.0) * key_space.getResolution() + sensor.bin_size_m;
+  }
   std::vector<mapping::KeySet> per_thread(static_cast<std::size_t>(omp_get_max_threads()));
   const auto count = static_cast<std::int64_t>(beams.size());
   std::atomic<std::size_t> done = 0;
@@ -156,19 +236,27 @@ mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer, std::span<const 
     // The first thread alone reports, so the callback needs no lock.
     const std::size_t finished = done.fetch_add(1, std::memory_order_relaxed);
     if (progress && omp_get_thread_num() == 0) progress(finished, beams.size());
+    if (!first[static_cast<std::size_t>(b)]) continue;
     const BeamPose& pose = beams[static_cast<std::size_t>(b)];
     mapping::KeySet& cells = per_thread[static_cast<std::size_t>(omp_get_thread_num())];
     const Eigen::Matrix3d R =
         pose.T_world_sonar.linear() *
         Eigen::AngleAxisd(pose.head_angle_rad, Vector3d::UnitZ()).toRotationMatrix();
     const Eigen::Vector3f origin = pose.T_world_sonar.translation().cast<float>();
+    std::vector<float> hits;
     for (const Vector3d& d : directions) {
       const Eigen::Vector3f direction = (R * d).cast<float>();
       if (const auto hit = tracer.Intersect(origin, direction, max_range)) {
         const Eigen::Vector3f p = origin + hit->distance * direction;
         octomap::OcTreeKey key;
         if (key_space.coordToKeyChecked(p.x(), p.y(), p.z(), key)) cells.insert(key);
+        if (direct) hits.push_back(hit->distance);
       }
+    }
+    if (direct) {
+      direct->beams[index[static_cast<std::size_t>(b)]] = {
+          pose.T_world_sonar.translation(), R.transpose(),
+          RangeIntervals(hits, direct->tolerance_m)};
     }
   }
   if (progress) progress(beams.size(), beams.size());
@@ -180,9 +268,9 @@ mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer, std::span<const 
 mapping::KeySet PerfectSensorCells(const RayTracer& tracer, std::span<const BeamPose> beams,
                                    const mapping::SensorGeometry& sensor,
                                    const Acoustics& acoustics, const octomap::OcTree& key_space,
-                                   const StageProgress& progress) {
+                                   const StageProgress& progress, DirectEchoes* direct) {
   return ObservableSurfaceCells(tracer, beams, sensor, 2 * acoustics.rays_horizontal,
-                                2 * acoustics.rays_vertical, key_space, progress);
+                                2 * acoustics.rays_vertical, key_space, progress, direct);
 }
 
 }  // namespace sonarbench::sim

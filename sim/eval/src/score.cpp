@@ -143,6 +143,25 @@ void CountWithinTolerance(const MapCells& cells, const mapping::KeySet& truth,
   m.ghost_share = cells.occupied.empty() ? 0.0 : 1.0 - m.precision_within[2];
 }
 
+// The ghosts (occupied, more than 2 cells from every truth cell) on a direct echo's arc, and
+// the others.
+void SplitGhosts(const octomap::OcTree& map, const MapCells& cells, const mapping::KeySet& truth,
+                 const DirectEchoes& direct, MapMetrics& m) {
+  std::vector<Key> ghosts;
+  for (const auto& key : cells.occupied) {
+    if (!AnyWithin(truth, key, 2)) ghosts.push_back(key);
+  }
+  const double half_diagonal = 0.5 * std::sqrt(3.0) * map.getResolution();
+  std::size_t on_arc = 0;
+  const auto count = static_cast<std::int64_t>(ghosts.size());
+#pragma omp parallel for reduction(+ : on_arc) schedule(dynamic, 64)
+  for (std::int64_t i = 0; i < count; ++i) {
+    on_arc += direct.Explains(Centre(map, ghosts[static_cast<std::size_t>(i)]), half_diagonal);
+  }
+  m.ghost_arc_share = Ratio(on_arc, m.occupied_cells);
+  m.ghost_echo_share = Ratio(ghosts.size() - on_arc, m.occupied_cells);
+}
+
 // Column precision and recall: the cells' (x, y) columns, top down.
 void CountColumns(const MapCells& cells, const mapping::KeySet& truth,
                   const mapping::KeySet& observable, MapMetrics& m) {
@@ -261,11 +280,12 @@ DistanceStats MeshToMap(const octomap::OcTree& map, const MapCells& cells,
 
 MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
                     const mapping::KeySet& observable, std::span<const TriangleMesh> meshes,
-                    const StageProgress& progress) {
+                    const StageProgress& progress, const DirectEchoes* direct) {
   const MapCells cells = CollectMapCells(map);
   MapMetrics m;
   CountCells(cells, truth, observable, m);
   CountWithinTolerance(cells, truth, observable, m);
+  if (direct) SplitGhosts(map, cells, truth, *direct, m);
   CountColumns(cells, truth, observable, m);
   std::vector<TriangleMesh> truth_meshes;
   for (const TriangleMesh& mesh : meshes) {

@@ -56,6 +56,8 @@ double MetricValue(const MapMetrics& metrics, const std::string& name) {
   if (name == "occupied_f1_within_1") return metrics.f1_within[1];
   if (name == "occupied_f1_within_2") return metrics.f1_within[2];
   if (name == "ghost_share") return metrics.ghost_share;
+  if (name == "ghost_arc_share") return metrics.ghost_arc_share.value_or(NAN);
+  if (name == "ghost_echo_share") return metrics.ghost_echo_share.value_or(NAN);
   if (name == "column_precision") return metrics.column_precision;
   if (name == "column_recall") return metrics.column_recall;
   if (name == "coverage") return metrics.coverage;

@@ -220,33 +220,36 @@ nlohmann::json CriteriaJson(const Verdict& v) {
 }
 
 nlohmann::json MetricsJson(const MapMetrics& m) {
-  return {{"occupied_precision", m.occupied_precision},
-          {"occupied_recall", m.occupied_recall},
-          {"occupied_f1", m.occupied_f1},
-          {"within_cells",
-           {{"cells", {0, 1, 2}},
-            {"precision", m.precision_within},
-            {"recall", m.recall_within},
-            {"f1", m.f1_within}}},
-          {"ghost_share", m.ghost_share},
-          {"column_precision", m.column_precision},
-          {"column_recall", m.column_recall},
-          {"coverage", m.coverage},
-          {"coverage_absolute", m.coverage_absolute},
-          {"free_accuracy", m.free_accuracy},
-          {"per_mesh", PerMeshJson(m)},
-          {"surface_distance",
-           {{"map_to_mesh", DistanceJson(m.map_to_mesh)},
-            {"mesh_to_map", DistanceJson(m.mesh_to_map)}}},
-          {"counts",
-           {{"truth_cells", m.truth_cells},
-            {"observable_cells", m.observable_cells},
-            {"occupied_cells", m.occupied_cells},
-            {"free_cells", m.free_cells},
-            {"true_positive_cells", m.true_positive_cells},
-            {"observed_occupied_cells", m.observed_occupied_cells},
-            {"known_observable_cells", m.known_observable_cells},
-            {"free_on_surface_cells", m.free_on_surface_cells}}}};
+  nlohmann::json json = {{"occupied_precision", m.occupied_precision},
+                         {"occupied_recall", m.occupied_recall},
+                         {"occupied_f1", m.occupied_f1},
+                         {"within_cells",
+                          {{"cells", {0, 1, 2}},
+                           {"precision", m.precision_within},
+                           {"recall", m.recall_within},
+                           {"f1", m.f1_within}}},
+                         {"ghost_share", m.ghost_share},
+                         {"column_precision", m.column_precision},
+                         {"column_recall", m.column_recall},
+                         {"coverage", m.coverage},
+                         {"coverage_absolute", m.coverage_absolute},
+                         {"free_accuracy", m.free_accuracy},
+                         {"per_mesh", PerMeshJson(m)},
+                         {"surface_distance",
+                          {{"map_to_mesh", DistanceJson(m.map_to_mesh)},
+                           {"mesh_to_map", DistanceJson(m.mesh_to_map)}}},
+                         {"counts",
+                          {{"truth_cells", m.truth_cells},
+                           {"observable_cells", m.observable_cells},
+                           {"occupied_cells", m.occupied_cells},
+                           {"free_cells", m.free_cells},
+                           {"true_positive_cells", m.true_positive_cells},
+                           {"observed_occupied_cells", m.observed_occupied_cells},
+                           {"known_observable_cells", m.known_observable_cells},
+                           {"free_on_surface_cells", m.free_on_surface_cells}}}};
+  if (m.ghost_arc_share) json["ghost_arc_share"] = *m.ghost_arc_share;
+  if (m.ghost_echo_share) json["ghost_echo_share"] = *m.ghost_echo_share;
+  return json;
 }
 
 nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& result) {

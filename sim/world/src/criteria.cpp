@@ -28,6 +28,8 @@ const std::vector<MetricInfo>& KnownMetrics() {
       {"occupied_f1_within_1", "harmonic mean of precision and recall within 1 cell"},
       {"occupied_f1_within_2", "harmonic mean of precision and recall within 2 cells"},
       {"ghost_share", "occupied cells more than 2 cells from every surface / occupied cells"},
+      {"ghost_arc_share", "ghosts on the arc of an echo a surface returns directly / occupied"},
+      {"ghost_echo_share", "ghosts where no surface answers directly in their beams / occupied"},
       {"column_precision",
        "(x, y) columns with an occupied cell that hold a surface / columns with an occupied cell"},
       {"column_recall",

@@ -53,8 +53,16 @@ TEST(DetectorStudy, ADatasetOfTheSceneScoresAsTheScene) {
     EXPECT_EQ(row.log->true_positive_cells, row.scene.true_positive_cells) << row.item.name;
     EXPECT_DOUBLE_EQ(row.log->recall_within[1], row.scene.recall_within[1]) << row.item.name;
     EXPECT_DOUBLE_EQ(row.log->ghost_share, row.scene.ghost_share) << row.item.name;
+    // The ghosts split the same way from the dataset's poses, the two parts making the whole.
+    ASSERT_TRUE(row.scene.ghost_arc_share && row.scene.ghost_echo_share &&
+                row.log->ghost_arc_share);
+    EXPECT_DOUBLE_EQ(*row.log->ghost_arc_share, *row.scene.ghost_arc_share) << row.item.name;
+    EXPECT_NEAR(*row.scene.ghost_arc_share + *row.scene.ghost_echo_share, row.scene.ghost_share,
+                1e-12);
   }
   EXPECT_LT(rows[1].scene.ghost_share, rows[0].scene.ghost_share);
+  // What `supported` drops are the detector's ghosts, not the arc's.
+  EXPECT_LT(*rows[1].scene.ghost_echo_share, *rows[0].scene.ghost_echo_share);
   EXPECT_LT(rows[1].scene.occupied_cells, rows[0].scene.occupied_cells);
 
   const auto out = dir.path() / "study";
@@ -64,6 +72,7 @@ TEST(DetectorStudy, ADatasetOfTheSceneScoresAsTheScene) {
   std::string header;
   std::getline(csv, header);
   EXPECT_NE(header.find("log_ghost_share"), std::string::npos);
+  EXPECT_NE(header.find("scene_ghost_arc_share,scene_ghost_echo_share"), std::string::npos);
   std::size_t lines = 0;
   for (std::string line; std::getline(csv, line);) ++lines;
   EXPECT_EQ(lines, 2u);

@@ -145,6 +145,10 @@ TEST(RealLogMap, AnImportedLogScoresAsTheMatLogDoes) {
   const nlohmann::json b = sim::MetricsJson(sim::ScoreLogMap(from_dataset, scene));
   EXPECT_GT(a["counts"]["true_positive_cells"].get<std::size_t>(), 100u);
   EXPECT_EQ(a, b);
+  // The ghosts' split is reported, its parts summing to the whole.
+  EXPECT_NEAR(a["ghost_arc_share"].get<double>() + a["ghost_echo_share"].get<double>(),
+              a["ghost_share"].get<double>(), 1e-12);
+  EXPECT_GT(a["ghost_echo_share"].get<double>(), 0.0);
   // A dataset simulated from one scene is not scored against another.
   const sim::Scene harbour = sim::LoadScene(test::SourcePath("scenes/harbour-wall.yaml"));
   sim::Scene one_sweep = scene;

@@ -81,6 +81,8 @@ TEST(Verdict, EveryKnownMetricReadsItsOwnField) {
   m.occupied_cells = 100;
   m.true_positive_cells = 101;
   m.free_on_surface_cells = 102;
+  m.ghost_arc_share = 103.0;
+  m.ghost_echo_share = 104.0;
   std::set<double> values;
   for (const MetricInfo& info : KnownMetrics()) {
     const double value = MetricValue(m, info.name);
@@ -92,6 +94,9 @@ TEST(Verdict, EveryKnownMetricReadsItsOwnField) {
   EXPECT_EQ(MetricValue(m, "occupied_cells"), 100.0);
   EXPECT_EQ(MetricValue(m, "ghost_share"), 19.0);
   EXPECT_TRUE(std::isnan(MetricValue(m, "no_such_metric")));
+  // Without the beams' direct echoes the ghosts are not split: a criterion on the split fails.
+  m.ghost_arc_share.reset();
+  EXPECT_TRUE(std::isnan(MetricValue(m, "ghost_arc_share")));
 }
 
 }  // namespace

@@ -75,11 +75,12 @@ struct LogMapResult {
 /// Scores `result`'s map against `scene`'s surfaces as `sonarbench run` scores a simulated one
 /// (ScoreMap): the truth voxelised from the scene's meshes, the cells a perfect sensor could see
 /// from the poses the log's beams were mapped from, rays twice as dense as the scene's sensor
-/// samples each beam, over the log's own beam geometry. The surface and observable cells go to
-/// `truth` and `observable` when given.
+/// samples each beam, over the log's own beam geometry. The surface and observable cells and the
+/// beams' direct echoes go to `truth`, `observable` and `direct` when given.
 [[nodiscard]] MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene,
                                      mapping::KeySet* truth = nullptr,
-                                     mapping::KeySet* observable = nullptr);
+                                     mapping::KeySet* observable = nullptr,
+                                     DirectEchoes* direct_out = nullptr);
 
 /// The files WriteLogMapOutputs writes, relative to its `out_dir`.
 inline const std::vector<std::string> kLogMapOutputFiles = {

@@ -12,12 +12,13 @@ namespace sonarbench::sim {
 
 /// A scene simulated once, with what every map of it is scored against (the studies' shared
 /// inputs): the beams, the cells its surfaces cross and those a perfect sensor sees from the
-/// beams' poses, on the scene's mapping resolution.
+/// beams' poses, on the scene's mapping resolution, and the beams' direct echoes.
 struct SimulatedScene {
   std::vector<SynthesizedBeam> synthesized;
   std::vector<mapping::Beam> beams;
   mapping::KeySet truth;
   mapping::KeySet observable;
+  DirectEchoes direct;
 };
 
 /// Simulates `scene` with `seed` on `tracer` (built from `meshes`, the scene's) and voxelises its

@@ -5,6 +5,8 @@
 #include <Eigen/Core>
 #include <functional>
 #include <span>
+#include <utility>
+#include <vector>
 
 #include "sonarbench/mapping/detail/beam_volume.hpp"
 #include "sonarbench/sim/world/geometry.hpp"
@@ -25,23 +27,43 @@ using StageProgress = std::function<void(std::size_t done, std::size_t total)>;
                                              const octomap::OcTree& key_space,
                                              const StageProgress& progress = {});
 
+/// The ranges at which each distinct beam (pose and head angle) meets a surface directly: the
+/// first hits of its rays on any mesh, truth or not. An echo a perfect detector would report
+/// lies at one of them, somewhere on its arc. Ranges are kept as intervals widened on both sides
+/// by `tolerance_m`: a cell's half-diagonal plus one range bin, how far from the shell a cell the
+/// mapper marks for that echo may lie.
+struct DirectEchoes {
+  struct Beam {
+    Eigen::Vector3d origin;         ///< the sonar [m, world]
+    Eigen::Matrix3d world_to_head;  ///< world → the head's frame (x along the beam, z up)
+    std::vector<std::pair<double, double>> ranges;  ///< widened, sorted, disjoint [m]
+  };
+  std::vector<Beam> beams;
+  double half_width_horizontal_rad = 0.0;
+  double half_width_vertical_rad = 0.0;
+  double tolerance_m = 0.0;
+
+  /// Whether a beam's aperture holds the cell centred at `centre` [m, world] (its direction,
+  /// widened by the cell's angular radius seen from the sonar) at a range one of that beam's
+  /// direct echoes explains.
+  [[nodiscard]] bool Explains(const Eigen::Vector3d& centre, double cell_half_diagonal_m) const;
+};
+
 /// Cells a perfect sensor with the same beams, poses and range could see: the cell of the first
 /// surface along each ray of a dense regular rays_h × rays_v grid across every beam's full
-/// aperture. Rays that leave the scene or pass the maximum range see no cell.
-[[nodiscard]] mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer,
-                                                     std::span<const BeamPose> beams,
-                                                     const mapping::SensorGeometry& sensor,
-                                                     int rays_horizontal, int rays_vertical,
-                                                     const octomap::OcTree& key_space,
-                                                     const StageProgress& progress = {});
+/// aperture. Rays that leave the scene or pass the maximum range see no cell. With `direct`,
+/// the same rays' first hits fill it (its tolerance from the key space's resolution and the
+/// sensor's bin).
+[[nodiscard]] mapping::KeySet ObservableSurfaceCells(
+    const RayTracer& tracer, std::span<const BeamPose> beams, const mapping::SensorGeometry& sensor,
+    int rays_horizontal, int rays_vertical, const octomap::OcTree& key_space,
+    const StageProgress& progress = {}, DirectEchoes* direct = nullptr);
 
 /// ObservableSurfaceCells as every score takes it: a perfect sensor, with rays twice as dense in
 /// each direction as the synthesis samples a beam (`acoustics`).
-[[nodiscard]] mapping::KeySet PerfectSensorCells(const RayTracer& tracer,
-                                                 std::span<const BeamPose> beams,
-                                                 const mapping::SensorGeometry& sensor,
-                                                 const Acoustics& acoustics,
-                                                 const octomap::OcTree& key_space,
-                                                 const StageProgress& progress = {});
+[[nodiscard]] mapping::KeySet PerfectSensorCells(
+    const RayTracer& tracer, std::span<const BeamPose> beams, const mapping::SensorGeometry& sensor,
+    const Acoustics& acoustics, const octomap::OcTree& key_space,
+    const StageProgress& progress = {}, DirectEchoes* direct = nullptr);
 
 }  // namespace sonarbench::sim

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -51,6 +52,13 @@ struct MapMetrics {
   /// Occupied cells more than 2 cells from every truth cell / occupied: the ghosts' share,
   /// 1 - precision_within[2] (0 for an empty map).
   double ghost_share = 0.0;
+  /// The ghosts split, when the scorer knows the beams' direct echoes (absent otherwise): those on
+  /// the arc of an echo a surface returns directly (DirectEchoes::Explains: where on its arc a
+  /// sonar cannot tell), and the rest, at ranges where no surface answers directly in any beam
+  /// holding them (multipath, round trips, sidelobes, noise). Shares of occupied; their sum is
+  /// ghost_share.
+  std::optional<double> ghost_arc_share;
+  std::optional<double> ghost_echo_share;
   /// Top down, over (x, y) columns of cells: columns holding an occupied cell that hold a truth
   /// cell / columns holding an occupied cell; columns of observable cells that hold an occupied
   /// cell / columns of observable cells. Fair to a static sonar, whose echo's elevation on its
@@ -82,12 +90,14 @@ struct MapMetrics {
 
 /// Scores `map` against the surface cells `truth` and the subset `observable` a perfect sensor
 /// could see (cells of `observable` outside `truth` are ignored); `meshes` give the exact surface
-/// for distances (none: distances are not computed); meshes that are not `truth` are left out.
+/// for distances (none: distances are not computed); meshes that are not `truth` are left out;
+/// `direct` splits the ghosts (none: ghost_arc_share and ghost_echo_share stay absent).
 /// `progress` counts its passes: the counts, each mesh's recall, the two distances.
 [[nodiscard]] MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
                                   const mapping::KeySet& observable,
                                   std::span<const TriangleMesh> meshes = {},
-                                  const StageProgress& progress = {});
+                                  const StageProgress& progress = {},
+                                  const DirectEchoes* direct = nullptr);
 
 /// Leaf cells of `map` at its finest resolution, split by occupancy.
 struct MapCells {
