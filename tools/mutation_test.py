@@ -2,7 +2,7 @@
 """Mutation testing of the mapping library and the scoring: do the tests catch a wrong mapper?
 
 Each mutant below is one operator or constant change to mapping/ (the OctoMap file reader in
-mapping/io/ included) or sim/eval/src/score.cpp. The
+mapping/io/ included) or sim/eval/src/score.cpp and ground_truth.cpp. The
 tool copies the source tree to WORK, builds it once, then applies the mutants one at a time,
 rebuilds and runs the suites that cover that code, fastest first, stopping at the first that
 fails. A mutant is killed when a suite fails (or runs past its timeout), survives when all pass.
@@ -161,6 +161,16 @@ MUTANTS = [
      None),
     ("wedge-plane-near", "mapping/src/wedge_cell_tester.hpp",
      "    if (f > 0.0) {", "    if (f > 1e9) {", None),
+    ("direct-no-widen", "sim/eval/src/ground_truth.cpp",
+     "const double widen = std::asin(std::min(1.0, cell_half_diagonal_m / range));",
+     "const double widen = 0.0;", None),
+    ("direct-no-bin", "sim/eval/src/ground_truth.cpp",
+     "key_space.getResolution() + sensor.bin_size_m;", "key_space.getResolution();", None),
+    ("direct-any-range", "sim/eval/src/ground_truth.cpp",
+     "if (after != beam.ranges.begin() && range <= std::prev(after)->second) return true;",
+     "if (!beam.ranges.empty()) return true;", None),
+    ("ghost-split-swap", "sim/eval/src/score.cpp",
+     "on_arc += direct.Explains(", "on_arc += !direct.Explains(", None),
     ("wedge-two-cuts", "mapping/src/wedge_cell_tester.hpp",
      "if (cuts >= 2 && !Meets(centre)) continue;", "if (cuts >= 3 && !Meets(centre)) continue;",
      "the scan examines only cells that overlap a column's exact extent of the wedge's pyramid, "
