@@ -122,15 +122,22 @@ double F1(double precision, double recall) {
 }
 
 // Precision, recall and F1 within 1 and 2 cells (index 0: CountCells' exact figures, which it
-// needs first), and the ghosts' share.
-void CountWithinTolerance(const MapCells& cells, const mapping::KeySet& truth,
-                          const mapping::KeySet& observable, MapMetrics& m) {
+// needs first), and the ghosts' share; returns the ghosts.
+std::vector<Key> CountWithinTolerance(const MapCells& cells, const mapping::KeySet& truth,
+                                      const mapping::KeySet& observable, MapMetrics& m) {
   m.precision_within[0] = m.occupied_precision;
   m.recall_within[0] = m.occupied_recall;
   m.f1_within[0] = m.occupied_f1;
+  std::vector<Key> ghosts;
   for (int k = 1; k < 3; ++k) {
     std::size_t near_truth = 0;
-    for (const auto& key : cells.occupied) near_truth += AnyWithin(truth, key, k) ? 1 : 0;
+    for (const auto& key : cells.occupied) {
+      if (AnyWithin(truth, key, k)) {
+        ++near_truth;
+      } else if (k == 2) {
+        ghosts.push_back(key);
+      }
+    }
     std::size_t seen = 0;
     for (const auto& key : observable) {
       if (truth.contains(key)) seen += AnyWithin(cells.occupied, key, k) ? 1 : 0;
@@ -141,16 +148,13 @@ void CountWithinTolerance(const MapCells& cells, const mapping::KeySet& truth,
     m.f1_within[index] = F1(m.precision_within[index], m.recall_within[index]);
   }
   m.ghost_share = cells.occupied.empty() ? 0.0 : 1.0 - m.precision_within[2];
+  return ghosts;
 }
 
 // The ghosts (occupied, more than 2 cells from every truth cell) on a direct echo's arc, and
 // the others.
-void SplitGhosts(const octomap::OcTree& map, const MapCells& cells, const mapping::KeySet& truth,
+void SplitGhosts(const octomap::OcTree& map, const std::vector<Key>& ghosts,
                  const DirectEchoes& direct, MapMetrics& m) {
-  std::vector<Key> ghosts;
-  for (const auto& key : cells.occupied) {
-    if (!AnyWithin(truth, key, 2)) ghosts.push_back(key);
-  }
   const double half_diagonal = 0.5 * std::sqrt(3.0) * map.getResolution();
   std::size_t on_arc = 0;
   const auto count = static_cast<std::int64_t>(ghosts.size());
@@ -284,8 +288,8 @@ MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
   const MapCells cells = CollectMapCells(map);
   MapMetrics m;
   CountCells(cells, truth, observable, m);
-  CountWithinTolerance(cells, truth, observable, m);
-  if (direct) SplitGhosts(map, cells, truth, *direct, m);
+  const std::vector<Key> ghosts = CountWithinTolerance(cells, truth, observable, m);
+  if (direct) SplitGhosts(map, ghosts, *direct, m);
   CountColumns(cells, truth, observable, m);
   std::vector<TriangleMesh> truth_meshes;
   for (const TriangleMesh& mesh : meshes) {
