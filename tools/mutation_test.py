@@ -170,7 +170,7 @@ MUTANTS = [
      "if (after != beam.ranges.begin() && range <= std::prev(after)->second) return true;",
      "if (!beam.ranges.empty()) return true;", None),
     ("ghost-split-swap", "sim/eval/src/score.cpp",
-     "on_arc += direct.Explains(", "on_arc += !direct.Explains(", None),
+     "half_diagonal) ? 1 : 0;", "half_diagonal) ? 0 : 1;", None),
     ("wedge-two-cuts", "mapping/src/wedge_cell_tester.hpp",
      "if (cuts >= 2 && !Meets(centre)) continue;", "if (cuts >= 3 && !Meets(centre)) continue;",
      "the scan examines only cells that overlap a column's exact extent of the wedge's pyramid, "

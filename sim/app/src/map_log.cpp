@@ -161,7 +161,8 @@ Eigen::Isometry3d StaticSonarPose(const Scene& scene) {
 }
 
 MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene, mapping::KeySet* truth,
-                       mapping::KeySet* observable, DirectEchoes* direct_out) {
+                       mapping::KeySet* observable, DirectEchoes* direct_out,
+                       mapping::KeySet* detector_ghosts) {
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
   const octomap::OcTree& map = result.mapper->tree();
@@ -169,7 +170,7 @@ MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene, mapping::
   DirectEchoes direct;
   mapping::KeySet seen = PerfectSensorCells(tracer, result.poses, result.sensor,
                                             scene.sensor.acoustics, map, {}, &direct);
-  const MapMetrics metrics = ScoreMap(map, surface, seen, meshes, {}, &direct);
+  const MapMetrics metrics = ScoreMap(map, surface, seen, meshes, {}, &direct, detector_ghosts);
   if (truth) *truth = std::move(surface);
   if (observable) *observable = std::move(seen);
   if (direct_out) *direct_out = std::move(direct);
@@ -273,8 +274,8 @@ std::vector<ReportImage> MapImages(const LogMapResult& result, const Scene* scen
   if (scene) {
     Eigen::Vector3d sonar = Eigen::Vector3d::Zero();
     if (!result.poses.empty()) sonar = result.poses.front().T_world_sonar.translation();
-    return MapTruthImages(result.mapper->tree(), result.truth, result.observable, sonar,
-                          scene->name + ", " + name);
+    return MapTruthImages(result.mapper->tree(), result.truth, result.observable,
+                          result.detector_ghosts, sonar, scene->name + ", " + name);
   }
   MapView top;
   top.resolution_m = result.mapper->config().resolution_m;

@@ -72,7 +72,8 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
                          report("observable"), &direct);
   result.timings.ground_truth_s = clock.Lap();
 
-  result.metrics = ScoreMap(map, result.truth, result.observable, meshes, report("score"), &direct);
+  result.metrics = ScoreMap(map, result.truth, result.observable, meshes, report("score"), &direct,
+                            &result.detector_ghosts);
   result.verdict = Evaluate(scene.criteria, result.metrics);
   result.timings.score_s = clock.Lap();
   return result;

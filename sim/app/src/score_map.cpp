@@ -143,7 +143,7 @@ MapFileScore ScoreMapFile(const std::string& map_file, const Scene& scene, const
   s.observable = PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics,
                                     *s.map, progress, &direct);
   s.ground_truth_s = SecondsSince(clock);
-  s.metrics = ScoreMap(*s.map, s.truth, s.observable, meshes, {}, &direct);
+  s.metrics = ScoreMap(*s.map, s.truth, s.observable, meshes, {}, &direct, &s.detector_ghosts);
   s.verdict = Evaluate(scene.criteria, s.metrics);
   if (s.metrics.ghost_share > kGhostShareWarning) {
     s.verdict.warnings.push_back(
@@ -160,7 +160,7 @@ void WriteMapFileScoreOutputs(const std::string& out_dir, const Scene& scene,
                               const MapFileScore& s) {
   CreateOutputDirectory(out_dir);
   const std::vector<ReportImage> images =
-      MapTruthImages(*s.map, s.truth, s.observable, s.sonar_start_m,
+      MapTruthImages(*s.map, s.truth, s.observable, s.detector_ghosts, s.sonar_start_m,
                      scene.name + ", " + std::filesystem::path(s.map_file).filename().string());
   WriteReportImages(out_dir, images);
   WriteFileAtomically(out_dir + "/junit.xml", [&](std::ostream& out) {

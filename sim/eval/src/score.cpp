@@ -152,18 +152,24 @@ std::vector<Key> CountWithinTolerance(const MapCells& cells, const mapping::KeyS
 }
 
 // The ghosts (occupied, more than 2 cells from every truth cell) on a direct echo's arc, and
-// the others.
+// the others, the detector's: their shares, and their cells into `detector_ghosts` if given.
 void SplitGhosts(const octomap::OcTree& map, const std::vector<Key>& ghosts,
-                 const DirectEchoes& direct, MapMetrics& m) {
+                 const DirectEchoes& direct, MapMetrics& m, mapping::KeySet* detector_ghosts) {
   const double half_diagonal = 0.5 * std::sqrt(3.0) * map.getResolution();
-  std::size_t on_arc = 0;
+  std::vector<char> on_arc(ghosts.size());
   const auto count = static_cast<std::int64_t>(ghosts.size());
-#pragma omp parallel for reduction(+ : on_arc) schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, 64)
   for (std::int64_t i = 0; i < count; ++i) {
-    on_arc += direct.Explains(Centre(map, ghosts[static_cast<std::size_t>(i)]), half_diagonal);
+    const auto g = static_cast<std::size_t>(i);
+    on_arc[g] = direct.Explains(Centre(map, ghosts[g]), half_diagonal) ? 1 : 0;
   }
-  m.ghost_arc_share = Ratio(on_arc, m.occupied_cells);
-  m.ghost_echo_share = Ratio(ghosts.size() - on_arc, m.occupied_cells);
+  std::size_t arc = 0;
+  for (std::size_t g = 0; g < ghosts.size(); ++g) {
+    arc += static_cast<std::size_t>(on_arc[g]);
+    if (detector_ghosts && on_arc[g] == 0) detector_ghosts->insert(ghosts[g]);
+  }
+  m.ghost_arc_share = Ratio(arc, m.occupied_cells);
+  m.ghost_echo_share = Ratio(ghosts.size() - arc, m.occupied_cells);
 }
 
 // Column precision and recall: the cells' (x, y) columns, top down.
@@ -284,12 +290,13 @@ DistanceStats MeshToMap(const octomap::OcTree& map, const MapCells& cells,
 
 MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
                     const mapping::KeySet& observable, std::span<const TriangleMesh> meshes,
-                    const StageProgress& progress, const DirectEchoes* direct) {
+                    const StageProgress& progress, const DirectEchoes* direct,
+                    mapping::KeySet* detector_ghosts) {
   const MapCells cells = CollectMapCells(map);
   MapMetrics m;
   CountCells(cells, truth, observable, m);
   const std::vector<Key> ghosts = CountWithinTolerance(cells, truth, observable, m);
-  if (direct) SplitGhosts(map, ghosts, *direct, m);
+  if (direct) SplitGhosts(map, ghosts, *direct, m, detector_ghosts);
   CountColumns(cells, truth, observable, m);
   std::vector<TriangleMesh> truth_meshes;
   for (const TriangleMesh& mesh : meshes) {

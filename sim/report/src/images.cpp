@@ -187,15 +187,16 @@ void WriteFanImage(const std::string& path, std::span<const mapping::Beam> sweep
 namespace {
 
 // A map view's cells as labels, one per cell column (top) or slab cell (side), row 0 at the top:
-// 0 unknown, 1 free, 2 missed truth, 3 false positive, 4 true positive, 5 occupied without a
-// truth (higher wins); and the keys of its first and last column and row.
+// 0 unknown, 1 free, 2 missed truth, 3 false positive, 4 the detector's ghost, 5 true positive,
+// 6 occupied without a truth (higher wins); and the keys of its first and last column and row.
 struct ViewLabels {
   cv::Mat label;
   int lo_u = 0, hi_u = 0, lo_v = 0, hi_v = 0;
 };
 
 ViewLabels LabelView(const MapCells& map, const mapping::KeySet& truth,
-                     const mapping::KeySet& observable, const MapView& view) {
+                     const mapping::KeySet& observable, const mapping::KeySet& detector_ghosts,
+                     const MapView& view) {
   // Image axes: u (key index) to the right, v up; the third axis is projected (top) or sliced.
   const int u = 0;
   const int v = view.kind == MapView::Kind::kTop ? 1 : 2;
@@ -228,25 +229,29 @@ ViewLabels LabelView(const MapCells& map, const mapping::KeySet& truth,
   }
   // Without a truth (a real log), occupied is simply occupied: drawn white.
   const bool scored = !truth.empty();
-  for (const auto& k : map.occupied) mark(k, !scored ? 5 : truth.contains(k) ? 4 : 3);
+  for (const auto& k : map.occupied) {
+    mark(k, !scored ? 6 : truth.contains(k) ? 5 : detector_ghosts.contains(k) ? 4 : 3);
+  }
   return out;
 }
 
 }  // namespace
 
 cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
-                      const mapping::KeySet& observable, const MapView& view) {
-  const ViewLabels labels = LabelView(map, truth, observable, view);
+                      const mapping::KeySet& observable, const MapView& view,
+                      const mapping::KeySet& detector_ghosts) {
+  const ViewLabels labels = LabelView(map, truth, observable, detector_ghosts, view);
   const cv::Mat& label = labels.label;
-  const cv::Vec3b palette[] = {{0, 0, 0},   {70, 70, 70}, {255, 120, 0},
-                               {0, 0, 230}, {0, 210, 0},  {255, 255, 255}};
+  const cv::Vec3b palette[] = {{0, 0, 0},     {70, 70, 70}, {255, 120, 0},  {0, 0, 230},
+                               {230, 0, 230}, {0, 210, 0},  {255, 255, 255}};
   const char* names[] = {"unknown",
                          "free",
                          "observable surface missed",
                          "occupied, off surface",
+                         "occupied, the detector's ghost",
                          "occupied, on a surface",
                          "occupied"};
-  bool present[6] = {};
+  bool present[7] = {};
   cv::Mat colour(label.size(), CV_8UC3);
   for (int r = 0; r < label.rows; ++r) {
     for (int c = 0; c < label.cols; ++c) {
@@ -260,7 +265,7 @@ cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
       std::max(1, (800 + std::max(label.rows, label.cols) - 1) / std::max(label.rows, label.cols));
   cv::resize(colour, colour, cv::Size(), scale, scale, cv::INTER_NEAREST);
   std::vector<std::pair<cv::Vec3b, std::string>> legend;
-  for (int l = 0; l < 6; ++l) {
+  for (int l = 0; l < 7; ++l) {
     if (present[l]) legend.emplace_back(palette[l], names[l]);
   }
   const double res = view.resolution_m > 0.0 ? view.resolution_m : 1.0;

@@ -77,6 +77,7 @@ std::string Seconds(double seconds) {
 
 std::vector<ReportImage> MapTruthImages(const octomap::OcTree& map, const mapping::KeySet& truth,
                                         const mapping::KeySet& observable,
+                                        const mapping::KeySet& detector_ghosts,
                                         const Eigen::Vector3d& side_slice_m,
                                         const std::string& name) {
   const MapCells cells = CollectMapCells(map);
@@ -91,12 +92,13 @@ std::vector<ReportImage> MapTruthImages(const octomap::OcTree& map, const mappin
   side.title = name + slice;
   return {
       {"map_top.png",
-       "Map against truth from above, whole pixels per cell column: green true positive, red only "
-       "false positives, blue observable truth missed, grey free.",
-       EncodePng(RenderMapView(cells, truth, observable, top))},
+       "Map against truth from above, whole pixels per cell column: green true positive, magenta "
+       "the detector's ghosts (where no surface answers directly), red other false positives, "
+       "blue observable truth missed, grey free.",
+       EncodePng(RenderMapView(cells, truth, observable, top, detector_ghosts))},
       {"map_side.png",
        "Side slice through the sonar (3 cells thick in y), x to the right, z up; same colours.",
-       EncodePng(RenderMapView(cells, truth, observable, side))},
+       EncodePng(RenderMapView(cells, truth, observable, side, detector_ghosts))},
   };
 }
 

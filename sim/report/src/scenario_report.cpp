@@ -148,13 +148,13 @@ std::vector<ReportImage> RenderImages(const Scene& scene, const ScenarioResult& 
   const std::string name = scene.name + ", seed " + std::to_string(result.seed);
   std::vector<ReportImage> images(2);
   std::vector<ReportImage> map_images;
-  const std::function<void()> tasks[] = {[&] { images[1] = FanImage(result.first_sweep, name); },
-                                         [&] {
-                                           map_images = MapTruthImages(
-                                               result.mapper->tree(), result.truth,
-                                               result.observable, result.sonar_start_m, name);
-                                         },
-                                         [&] { images[0] = PolarImage(result.first_sweep, name); }};
+  const std::function<void()> tasks[] = {
+      [&] { images[1] = FanImage(result.first_sweep, name); },
+      [&] {
+        map_images = MapTruthImages(result.mapper->tree(), result.truth, result.observable,
+                                    result.detector_ghosts, result.sonar_start_m, name);
+      },
+      [&] { images[0] = PolarImage(result.first_sweep, name); }};
   RunTasks(result.threads, tasks);
   for (ReportImage& image : map_images) images.push_back(std::move(image));
   return images;

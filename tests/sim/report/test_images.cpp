@@ -5,6 +5,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/report/images.hpp"
 
 namespace sonarbench::sim {
@@ -76,6 +77,44 @@ TEST(RenderFanImage, BeamsAtOneAngleShowTheEarliest) {
   const cv::Mat fan = RenderFanImage(paused, 0.01, "fan");
   ASSERT_EQ(fan.size(), expected.size());
   EXPECT_EQ(cv::norm(fan, expected, cv::NORM_INF), 0.0);
+}
+
+// Pixels of one colour (BGR) in an image.
+int CountColour(const cv::Mat& image, const cv::Vec3b& colour) {
+  int count = 0;
+  for (int r = 0; r < image.rows; ++r) {
+    for (int c = 0; c < image.cols; ++c) count += image.at<cv::Vec3b>(r, c) == colour ? 1 : 0;
+  }
+  return count;
+}
+
+// Three occupied columns from above: one on the truth (green), two off it (red); given as the
+// detector's ghosts, the second is drawn magenta instead, the first and the third unchanged.
+TEST(RenderMapView, TheDetectorsGhostsAreDrawnApartFromTheOtherFalsePositives) {
+  const auto key = [](int x) {
+    return octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + x), 32768, 32768);
+  };
+  MapCells map;
+  for (int x : {0, 10, 20}) map.occupied.insert(key(x));
+  mapping::KeySet truth;
+  truth.insert(key(0));
+  MapView top;
+  top.resolution_m = 0.05;
+  top.title = "test";
+  mapping::KeySet ghosts;
+  ghosts.insert(key(20));
+  const cv::Vec3b red(0, 0, 230);
+  const cv::Vec3b magenta(230, 0, 230);
+  const cv::Vec3b green(0, 210, 0);
+  const cv::Mat plain = RenderMapView(map, truth, truth, top);
+  const cv::Mat split = RenderMapView(map, truth, truth, top, ghosts);
+  EXPECT_EQ(CountColour(plain, magenta), 0);
+  EXPECT_GT(CountColour(split, magenta), 0);
+  // One cell's square of pixels moves from red to magenta (the legend adds a swatch of each).
+  const int cell = CountColour(plain, red) - CountColour(split, red);
+  EXPECT_GT(cell, 0);
+  EXPECT_EQ(CountColour(split, magenta) - cell, CountColour(split, red) - cell);
+  EXPECT_EQ(CountColour(split, green), CountColour(plain, green));
 }
 
 }  // namespace

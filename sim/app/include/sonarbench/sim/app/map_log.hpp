@@ -35,10 +35,11 @@ struct LogMapResult {
   /// Every beam's pose as mapped.
   std::vector<BeamPose> poses;
   /// The map scored against a scene's surfaces (ScoreLogMap), if it was; the scene's surface
-  /// cells and those a perfect sensor sees, for the map's images.
+  /// cells, those a perfect sensor sees and the detector's ghosts, for the map's images.
   std::optional<MapMetrics> metrics;
   mapping::KeySet truth;
   mapping::KeySet observable;
+  mapping::KeySet detector_ghosts;
   /// The metrics against the scene's criteria, when scored.
   std::optional<Verdict> verdict;
   /// The occupied cells' probability sweep by sweep, when scored (SweepCertainty).
@@ -75,12 +76,14 @@ struct LogMapResult {
 /// Scores `result`'s map against `scene`'s surfaces as `sonarbench run` scores a simulated one
 /// (ScoreMap): the truth voxelised from the scene's meshes, the cells a perfect sensor could see
 /// from the poses the log's beams were mapped from, rays twice as dense as the scene's sensor
-/// samples each beam, over the log's own beam geometry. The surface and observable cells and the
-/// beams' direct echoes go to `truth`, `observable` and `direct` when given.
+/// samples each beam, over the log's own beam geometry. The surface and observable cells, the
+/// beams' direct echoes and the detector's ghosts go to `truth`, `observable`, `direct_out` and
+/// `detector_ghosts` when given.
 [[nodiscard]] MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene,
                                      mapping::KeySet* truth = nullptr,
                                      mapping::KeySet* observable = nullptr,
-                                     DirectEchoes* direct_out = nullptr);
+                                     DirectEchoes* direct_out = nullptr,
+                                     mapping::KeySet* detector_ghosts = nullptr);
 
 /// The files WriteLogMapOutputs writes, relative to its `out_dir`.
 inline const std::vector<std::string> kLogMapOutputFiles = {

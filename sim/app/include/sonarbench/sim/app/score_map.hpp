@@ -21,9 +21,11 @@ struct MapFileScore {
   std::string map_file;
   mapping::OcTreeFileInfo file;
   std::unique_ptr<octomap::OcTree> map;
-  /// The scene's surface cells at the map's resolution, and those a perfect sensor sees.
+  /// The scene's surface cells at the map's resolution, those a perfect sensor sees, and the
+  /// detector's ghosts (ScoreMap).
   mapping::KeySet truth;
   mapping::KeySet observable;
+  mapping::KeySet detector_ghosts;
   MapMetrics metrics;
   Verdict verdict;
   /// The frame check: the box the scene's sonar reaches (its positions' box grown by its range)

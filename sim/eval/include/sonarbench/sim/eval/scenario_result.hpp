@@ -34,8 +34,10 @@ struct ScenarioResult {
   std::unique_ptr<mapping::Mapper> mapper;
   /// The first sweep's beams, for images.
   std::vector<mapping::Beam> first_sweep;
+  /// The scene's surface cells, those a perfect sensor sees, and the detector's ghosts (ScoreMap).
   mapping::KeySet truth;
   mapping::KeySet observable;
+  mapping::KeySet detector_ghosts;
   /// The sonar's position at the first beam [m], where the side slice of the map is cut.
   Eigen::Vector3d sonar_start_m = Eigen::Vector3d::Zero();
   /// Each mesh's name, triangle count and preflight findings, in scene order, then the

@@ -91,13 +91,15 @@ struct MapMetrics {
 /// Scores `map` against the surface cells `truth` and the subset `observable` a perfect sensor
 /// could see (cells of `observable` outside `truth` are ignored); `meshes` give the exact surface
 /// for distances (none: distances are not computed); meshes that are not `truth` are left out;
-/// `direct` splits the ghosts (none: ghost_arc_share and ghost_echo_share stay absent).
+/// `direct` splits the ghosts (none: ghost_arc_share and ghost_echo_share stay absent), and the
+/// detector's ghosts' cells go to `detector_ghosts` when given.
 /// `progress` counts its passes: the counts, each mesh's recall, the two distances.
 [[nodiscard]] MapMetrics ScoreMap(const octomap::OcTree& map, const mapping::KeySet& truth,
                                   const mapping::KeySet& observable,
                                   std::span<const TriangleMesh> meshes = {},
                                   const StageProgress& progress = {},
-                                  const DirectEchoes* direct = nullptr);
+                                  const DirectEchoes* direct = nullptr,
+                                  mapping::KeySet* detector_ghosts = nullptr);
 
 /// Leaf cells of `map` at its finest resolution, split by occupancy.
 struct MapCells {

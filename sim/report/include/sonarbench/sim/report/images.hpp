@@ -50,12 +50,14 @@ struct MapView {
 };
 
 /// Renders the map against the truth, whole pixels per cell with the longer side at least 800
-/// pixels: green where a pixel's cells hold a true positive, red where only false positives,
-/// blue where observable truth the map missed, grey where only free cells, black unknown. With
-/// an empty `truth` (a real log), occupied cells are white. Framed with the view's title, axes in
-/// metres, a scale bar and a legend of the colours shown.
+/// pixels: green where a pixel's cells hold a true positive, magenta where a false positive is
+/// one of `detector_ghosts` (and none is true), red where only other false positives, blue where
+/// observable truth the map missed, grey where only free cells, black unknown. With an empty
+/// `truth` (a real log), occupied cells are white. Framed with the view's title, axes in metres,
+/// a scale bar and a legend of the colours shown.
 [[nodiscard]] cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
-                                    const mapping::KeySet& observable, const MapView& view);
+                                    const mapping::KeySet& observable, const MapView& view,
+                                    const mapping::KeySet& detector_ghosts = {});
 
 /// One line of a plot: its legend name, colour (BGR) and points.
 struct PlotSeries {

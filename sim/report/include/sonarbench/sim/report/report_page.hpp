@@ -25,12 +25,13 @@ struct ReportImage {
   std::vector<unsigned char> png;
 };
 
-/// map_top.png and map_side.png: `map` against the truth from above, and in a slice 3 cells
-/// thick in y through `side_slice_m` [m, world frame]; `name` (the scene and seed, or the map)
-/// starts their titles.
+/// map_top.png and map_side.png: `map` against the truth (its `detector_ghosts` apart) from
+/// above, and in a slice 3 cells thick in y through `side_slice_m` [m, world frame]; `name` (the
+/// scene and seed, or the map) starts their titles.
 [[nodiscard]] std::vector<ReportImage> MapTruthImages(const octomap::OcTree& map,
                                                       const mapping::KeySet& truth,
                                                       const mapping::KeySet& observable,
+                                                      const mapping::KeySet& detector_ghosts,
                                                       const Eigen::Vector3d& side_slice_m,
                                                       const std::string& name);
 
