@@ -56,8 +56,11 @@ int Map(const MapArgs& args) {
       [&](std::size_t done, std::size_t total) { progress.Update("map", done, total); });
   progress.Clear();
   if (scene) {
-    result.metrics = sonarbench::sim::ScoreLogMap(result, *scene, &result.truth, &result.observable,
-                                                  nullptr, &result.detector_ghosts);
+    sonarbench::sim::LogScoreParts parts;
+    result.metrics = sonarbench::sim::ScoreLogMap(result, *scene, &parts);
+    result.truth = std::move(parts.truth);
+    result.observable = std::move(parts.observable);
+    result.detector_ghosts = std::move(parts.detector_ghosts);
     result.verdict = sonarbench::sim::Evaluate(scene->criteria, *result.metrics);
     result.certainty = sonarbench::sim::SweepCertainty(result.mapped, result.sensor, config,
                                                        result.mapper->tree(), result.truth);

@@ -146,13 +146,12 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
   mapping::MapperConfig base = scene.mapping;
   base.threads = options.threads;
   // The log first (bad input fails before the simulation): read and placed once as `map --score`
-  // does, its truth and observable cells kept.
+  // does, its truth, observable cells and direct echoes kept.
   std::optional<LogMapResult> log;
-  mapping::KeySet log_truth, log_observable;
-  DirectEchoes log_direct;
+  LogScoreParts log_parts;
   if (!options.log.empty()) {
     log = MapLog(options.log, scene.sensor.geometry, base, &scene, scene.budgets);
-    (void)ScoreLogMap(*log, scene, &log_truth, &log_observable, &log_direct);
+    (void)ScoreLogMap(*log, scene, &log_parts);
   }
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
@@ -166,8 +165,8 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
                                 simulated.truth, simulated.observable, simulated.direct),
                     std::nullopt};
     if (log) {
-      row.log = MapAndScore(base, item.detection, log->sensor, log->mapped, log_truth,
-                            log_observable, log_direct);
+      row.log = MapAndScore(base, item.detection, log->sensor, log->mapped, log_parts.truth,
+                            log_parts.observable, log_parts.direct);
     }
     rows.push_back(std::move(row));
     if (options.progress) options.progress(rows.size(), items.size());

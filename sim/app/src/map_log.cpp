@@ -160,21 +160,16 @@ Eigen::Isometry3d StaticSonarPose(const Scene& scene) {
   return first;
 }
 
-MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene, mapping::KeySet* truth,
-                       mapping::KeySet* observable, DirectEchoes* direct_out,
-                       mapping::KeySet* detector_ghosts) {
+MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene, LogScoreParts* parts) {
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
   const octomap::OcTree& map = result.mapper->tree();
-  mapping::KeySet surface = VoxelizeMeshes(meshes, map);
-  DirectEchoes direct;
-  mapping::KeySet seen = PerfectSensorCells(tracer, result.poses, result.sensor,
-                                            scene.sensor.acoustics, map, {}, &direct);
-  const MapMetrics metrics = ScoreMap(map, surface, seen, meshes, {}, &direct, detector_ghosts);
-  if (truth) *truth = std::move(surface);
-  if (observable) *observable = std::move(seen);
-  if (direct_out) *direct_out = std::move(direct);
-  return metrics;
+  LogScoreParts own;
+  LogScoreParts& p = parts ? *parts : own;
+  p.truth = VoxelizeMeshes(meshes, map);
+  p.observable = PerfectSensorCells(tracer, result.poses, result.sensor, scene.sensor.acoustics,
+                                    map, {}, &p.direct);
+  return ScoreMap(map, p.truth, p.observable, meshes, {}, &p.direct, &p.detector_ghosts);
 }
 
 namespace {

@@ -76,14 +76,16 @@ struct LogMapResult {
 /// Scores `result`'s map against `scene`'s surfaces as `sonarbench run` scores a simulated one
 /// (ScoreMap): the truth voxelised from the scene's meshes, the cells a perfect sensor could see
 /// from the poses the log's beams were mapped from, rays twice as dense as the scene's sensor
-/// samples each beam, over the log's own beam geometry. The surface and observable cells, the
-/// beams' direct echoes and the detector's ghosts go to `truth`, `observable`, `direct_out` and
-/// `detector_ghosts` when given.
+/// samples each beam, over the log's own beam geometry. What it builds on the way goes to `parts`
+/// when given.
+struct LogScoreParts {
+  mapping::KeySet truth;            ///< the scene's surface cells
+  mapping::KeySet observable;       ///< those a perfect sensor sees
+  DirectEchoes direct;              ///< the beams' direct echoes
+  mapping::KeySet detector_ghosts;  ///< the ghosts no direct echo explains
+};
 [[nodiscard]] MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene,
-                                     mapping::KeySet* truth = nullptr,
-                                     mapping::KeySet* observable = nullptr,
-                                     DirectEchoes* direct_out = nullptr,
-                                     mapping::KeySet* detector_ghosts = nullptr);
+                                     LogScoreParts* parts = nullptr);
 
 /// The files WriteLogMapOutputs writes, relative to its `out_dir`.
 inline const std::vector<std::string> kLogMapOutputFiles = {
