@@ -1,9 +1,11 @@
 #include "sonarbench/mapping/atomic_file.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -87,12 +89,82 @@ void CreateOutputDirectory(const std::string& dir) {
   }
 }
 
-std::string ReadFileBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot be read");
-  std::stringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
+namespace {
+
+// What `mode` is, for a refusal: "a FIFO", "a directory".
+const char* FileKind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+// Refuses what `info` describes unless a regular file of at most `max_bytes`.
+void CheckRegular(const std::string& path, const struct stat& info, std::uint64_t max_bytes) {
+  if (!S_ISREG(info.st_mode)) {
+    throw InputError(path + ": is " + FileKind(info.st_mode) + " (expected a regular file)");
+  }
+  const auto size = static_cast<std::uint64_t>(info.st_size);
+  if (size > max_bytes) {
+    throw InputError(path + ": holds " + ByteCount(size) + ", more than the " +
+                     ByteCount(max_bytes) + " sonarbench reads from such a file");
+  }
+}
+
+}  // namespace
+
+std::string ByteCount(std::uint64_t bytes) {
+  if (bytes < 1024) return std::to_string(bytes) + " bytes";
+  const char* units[] = {"KiB", "MiB", "GiB", "TiB"};
+  double value = static_cast<double>(bytes) / 1024.0;
+  int unit = 0;
+  while (value >= 1024.0 && unit < 3) {
+    value /= 1024.0;
+    ++unit;
+  }
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g %s", value, units[unit]);
+  return text;
+}
+
+std::uint64_t CheckInputFile(const std::string& path, std::uint64_t max_bytes) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0) {
+    throw InputError(path + ": cannot be read (" + std::strerror(errno) + ")");
+  }
+  CheckRegular(path, info, max_bytes);
+  return static_cast<std::uint64_t>(info.st_size);
+}
+
+std::string ReadFileBytes(const std::string& path, std::uint64_t max_bytes) {
+  // O_NONBLOCK: a FIFO opens at once (and is refused by its type) instead of waiting for a writer.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) throw InputError(path + ": cannot be read (" + std::strerror(errno) + ")");
+  std::string bytes;
+  try {
+    struct stat info {};
+    if (::fstat(fd, &info) != 0) {
+      throw InputError(path + ": cannot be read (" + std::strerror(errno) + ")");
+    }
+    CheckRegular(path, info, max_bytes);
+    bytes.resize(static_cast<std::size_t>(info.st_size));
+    std::size_t done = 0;
+    while (done < bytes.size()) {
+      const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) throw InputError(path + ": cannot be read (" + std::strerror(errno) + ")");
+      if (n == 0) break;  // shrank while read: what is there
+      done += static_cast<std::size_t>(n);
+    }
+    bytes.resize(done);
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  ::close(fd);
+  return bytes;
 }
 
 }  // namespace sonarbench

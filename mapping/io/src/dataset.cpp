@@ -247,13 +247,14 @@ Dataset ReadDataset(const std::string& dir) {
                      "`sonarbench simulate` leaves none until it completes: rerun it)");
   }
   Dataset dataset;
+  const std::string text = ReadFileBytes(manifest_path, kMaxJsonBytes);
   try {
-    dataset.manifest = nlohmann::json::parse(ReadFileBytes(manifest_path));
+    dataset.manifest = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {  // a syntax error, or a number past a double
     throw InputError(manifest_path + ": not valid JSON: " + e.what());
   }
   // JSON is YAML: the strict reader checks the keys the mapper needs, with line and column.
-  YamlReader reader = YamlReader::FromFile(manifest_path);
+  YamlReader reader = YamlReader::FromString(text, manifest_path);
   std::string format;
   int schema = 0;
   int sweeps = 0;

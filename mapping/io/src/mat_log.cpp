@@ -137,12 +137,12 @@ MatLog ReadBeams(const std::string& path, std::size_t count, const FieldOf& fiel
 }
 
 // A MAT v5 file's log, read in place once its layout is checked.
-MatLog ReadV5Log(const std::string& path, const std::string& bytes) {
+MatLog ReadV5Log(const std::string& path, const std::string& bytes, std::uint64_t max_bytes) {
   auto fail = [&](const std::string& what) { return InputError(path + ": " + what); };
   const mat_v5::Fail corrupt = [&](const std::string& what) {
     return fail("a corrupt MAT file (" + what + ")");
   };
-  std::optional<std::string> variable = mat_v5::CheckFile(bytes, "parsedData", corrupt);
+  std::optional<std::string> variable = mat_v5::CheckFile(bytes, "parsedData", corrupt, max_bytes - bytes.size());
   if (!variable) throw fail(kNoParsedData);
   const std::optional<mat_v5::StructArray> read =
       mat_v5::ReadStructArray(std::move(*variable), corrupt);
@@ -160,12 +160,12 @@ MatLog ReadV5Log(const std::string& path, const std::string& bytes) {
 
 }  // namespace
 
-MatLog ReadMatLog(const std::string& path) {
+MatLog ReadMatLog(const std::string& path, std::uint64_t max_bytes) {
   auto fail = [&](const std::string& what) { return InputError(path + ": " + what); };
-  if (std::filesystem::is_regular_file(path)) {
-    const std::string bytes = ReadFileBytes(path);
+  {
+    const std::string bytes = ReadFileBytes(path, max_bytes);
     CheckMatHeader(bytes, fail);
-    if (mat_v5::IsV5(bytes)) return ReadV5Log(path, bytes);
+    if (mat_v5::IsV5(bytes)) return ReadV5Log(path, bytes, max_bytes);
   }
   // v7.3 (HDF5): libmatio.
   std::unique_ptr<mat_t, MatCloser> mat(Mat_Open(path.c_str(), MAT_ACC_RDONLY));

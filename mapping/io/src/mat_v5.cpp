@@ -10,6 +10,8 @@
 #include <sstream>
 #include <type_traits>
 
+#include "sonarbench/mapping/atomic_file.hpp"
+
 namespace sonarbench::mapping::mat_v5 {
 namespace {
 
@@ -89,7 +91,8 @@ std::optional<double> As(double value) {
 // allocated 13 GB for one byte changed inside the compressed log), then read in place.
 class Walker {
  public:
-  explicit Walker(Fail fail) : fail_(std::move(fail)) {}
+  explicit Walker(Fail fail, std::uint64_t max_inflated = UINT64_MAX)
+      : fail_(std::move(fail)), left_(max_inflated) {}
 
   // Checks the file's elements; returns the first top-level variable called `name`, inflated.
   std::optional<std::string> File(const std::string& bytes, std::string_view name) const {
@@ -233,14 +236,19 @@ class Walker {
     stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data()));
     stream.avail_in = static_cast<uInt>(compressed.size());
     int status = Z_OK;
-    while (status == Z_OK) {
+    while (status == Z_OK && stream.total_out <= left_) {
       out.resize(out.size() + (1 << 20));
       stream.next_out = reinterpret_cast<Bytef*>(out.data() + stream.total_out);
       stream.avail_out = 1 << 20;
       status = inflate(&stream, Z_NO_FLUSH);
     }
-    out.resize(stream.total_out);
     inflateEnd(&stream);
+    if (stream.total_out > left_) {
+      throw fail_("its compressed elements inflate to more than the " + ByteCount(left_) +
+                  " left of what sonarbench reads from one log (import's --max-input-mb raises it)");
+    }
+    out.resize(stream.total_out);
+    left_ -= out.size();
     if (status != Z_STREAM_END) throw fail_("a compressed element does not inflate whole");
     return out;
   }
@@ -326,6 +334,8 @@ class Walker {
   }
 
   Fail fail_;
+  // What compressed elements may still inflate to (bytes), checked as they inflate.
+  mutable std::uint64_t left_;
 };
 
 }  // namespace
@@ -382,8 +392,9 @@ bool IsV5(const std::string& bytes) {
 }
 
 std::optional<std::string> CheckFile(const std::string& bytes, std::string_view name,
-                                     const Fail& fail) {
-  return Walker(fail).File(bytes, name);
+                                     const Fail& fail, std::uint64_t max_inflated) {
+  const Walker walker(fail, max_inflated);
+  return walker.File(bytes, name);
 }
 
 std::optional<StructArray> ReadStructArray(std::string variable, const Fail& fail) {

@@ -51,9 +51,11 @@ struct StructArray {
 
 /// Checks every element of a MAT v5 file against the bytes it holds (throws fail(what) for the
 /// first that does not fit: libmatio sizes arrays by what a file states) and returns the first
-/// top-level variable called `name`, inflated, if there is one.
+/// top-level variable called `name`, inflated, if there is one. Compressed elements inflate to
+/// at most `max_inflated` bytes in all, checked as they inflate.
 [[nodiscard]] std::optional<std::string> CheckFile(const std::string& bytes, std::string_view name,
-                                                   const Fail& fail);
+                                                   const Fail& fail,
+                                                   std::uint64_t max_inflated = UINT64_MAX);
 
 /// A struct array variable (one CheckFile returned) read in place; nullopt for another class.
 [[nodiscard]] std::optional<StructArray> ReadStructArray(std::string variable, const Fail& fail);

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <fstream>
 #include <set>
 #include <string_view>
@@ -146,14 +147,12 @@ class Reader {
 };
 
 McapFile Reader::Read() {
-  std::error_code error;
-  const auto size = std::filesystem::file_size(path_, error);
-  if (error) throw InputError(path_ + ": cannot be read (" + error.message() + ")");
+  const std::uint64_t size = CheckInputFile(path_, std::numeric_limits<std::uint64_t>::max());
   if (size > budget_) {
-    Fail(0, "the file holds " + std::to_string(size) + " bytes, more than the limit of " +
-                std::to_string(budget_));
+    Fail(0, "the file holds " + ByteCount(size) + ", more than the " + ByteCount(budget_) +
+                " sonarbench reads from one log (import's --max-input-mb raises it)");
   }
-  file_ = ReadFileBytes(path_);
+  file_ = ReadFileBytes(path_, budget_);
   budget_ -= file_.size();
   if (file_.size() < 2 * kMagicSize || file_.compare(0, kMagicSize, kMcapMagic) != 0) {
     Fail(0, "not an MCAP file: expected the magic bytes 0x89 'MCAP0' '\\r\\n' at its start");
@@ -253,8 +252,9 @@ void Reader::OnChunk(Cursor& c, std::uint64_t offset) {
     plain = stored;
   } else if (compression == "zstd") {
     if (size > budget_) {
-      Fail(offset, "chunk of " + std::to_string(size) + " bytes uncompressed: past the limit of " +
-                       std::to_string(budget_) + " bytes left for this file");
+      Fail(offset, "chunk of " + ByteCount(size) + " uncompressed: more than the " +
+                       ByteCount(budget_) + " left of what sonarbench reads from one log " +
+                       "(import's --max-input-mb raises it)");
     }
     plain.resize(size);
     const std::size_t n = ZSTD_decompress(plain.data(), plain.size(), stored.data(), stored.size());
@@ -444,6 +444,8 @@ void McapWriter::Finish() {
 }
 
 bool StartsAsMcap(const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return false;  // never waits on a FIFO
   std::string magic(kMagicSize, '\0');
   std::ifstream in(path, std::ios::binary);
   return in.read(magic.data(), kMagicSize) && magic == std::string(kMcapMagic, kMagicSize);
@@ -451,6 +453,8 @@ bool StartsAsMcap(const std::string& path) {
 
 std::optional<std::string> McapLibrary(const std::string& path) {
   constexpr std::uint64_t kMaxHeader = 1 << 20;  // a header's two strings; longer is not MCAP
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) return std::nullopt;
   std::ifstream in(path, std::ios::binary);
   std::string head(kMagicSize + 9, '\0');
   if (!in.read(head.data(), static_cast<std::streamsize>(head.size())) ||

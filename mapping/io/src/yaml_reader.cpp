@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench {
@@ -137,16 +138,8 @@ YamlReader::YamlReader(YAML::Node node, std::shared_ptr<State> state, std::strin
 }
 
 YamlReader YamlReader::FromFile(const std::string& path) {
-  // A directory opens as a stream too, and reads as an empty document.
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) {
-    throw InputError(path + ": is a directory (expected a readable YAML file)");
-  }
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open file (expected a readable YAML file)");
-  std::stringstream text;
-  text << in.rdbuf();
-  return FromString(text.str(), path);
+  // A directory, FIFO or device is refused by its type, a file past the budget by its size.
+  return FromString(ReadFileBytes(path, kMaxYamlBytes), path);
 }
 
 YamlReader YamlReader::FromString(const std::string& text, const std::string& source_name) {

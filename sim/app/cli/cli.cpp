@@ -9,12 +9,6 @@
 
 namespace sonarbench::app {
 
-sonarbench::sim::Scene LoadScene(const std::string& path, const sonarbench::sim::Budgets& budgets) {
-  sonarbench::sim::Scene scene = sonarbench::sim::LoadScene(path);
-  scene.budgets = budgets;
-  return scene;
-}
-
 std::string MetricsLine(const sonarbench::sim::MapMetrics& m) {
   std::ostringstream line;
   line << "occupied precision " << m.occupied_precision << " (" << m.true_positive_cells << "/"
@@ -76,6 +70,11 @@ void AddBudgetOptions(CLI::App* command, sonarbench::sim::Budgets& budgets) {
       ->add_option("--max-cells", budgets.max_cells,
                    "Refuse a scene whose ground truth or map would hold more cells (estimated "
                    "from the scene, or the log's poses, before anything is built)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command
+      ->add_option("--max-beams", budgets.max_beams,
+                   "Refuse a scene whose sweeps would make more beams (each held in memory)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
 }

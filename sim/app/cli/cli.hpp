@@ -94,8 +94,6 @@ class ProgressLine {
   std::chrono::steady_clock::time_point last_print_;
 };
 
-/// The scene at `path`, to be built within `budgets`.
-[[nodiscard]] sim::Scene LoadScene(const std::string& path, const sim::Budgets& budgets);
 /// "occupied precision P (tp/occupied), recall R (..), coverage C (..)": a map's scores.
 [[nodiscard]] std::string MetricsLine(const sim::MapMetrics& m);
 /// Prints the verdict's warnings, "PASS|FAIL NAME: M/N criteria met" and each reason.

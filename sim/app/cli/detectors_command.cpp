@@ -22,7 +22,7 @@ struct DetectorsArgs {
 int Detectors(const DetectorsArgs& args) {
   namespace sim = sonarbench::sim;
   sonarbench::CheckOutputDirectory(args.out);
-  const sim::Scene scene = LoadScene(args.scene, args.budgets);
+  const sim::Scene scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
   sim::CheckBudgets(scene, args.budgets);
   sim::DetectorStudyOptions options;
   options.seed = args.seed;

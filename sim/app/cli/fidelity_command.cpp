@@ -31,7 +31,7 @@ struct FidelityArgs {
 int Fidelity(const FidelityArgs& args) {
   namespace sim = sonarbench::sim;
   sonarbench::CheckOutputDirectory(args.out);
-  const sim::Scene scene = LoadScene(args.scene, args.budgets);
+  const sim::Scene scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
   if (const double range = scene.sensor.geometry.MaxRangeM(); args.wall_min_range_m >= range) {
     std::ostringstream message;
     message << "--wall-min-range " << args.wall_min_range_m << ": expected less than the sonar's "

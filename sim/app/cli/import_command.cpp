@@ -20,6 +20,7 @@ struct ImportArgs {
   std::string topic;
   bool static_sonar = false;
   bool force = false;
+  std::uint64_t max_input_mb = kMaxLogBytes >> 20;
 };
 
 // A ROS 2 bag's beams, posed by its transforms (or static at the origin with --static).
@@ -28,6 +29,7 @@ sim::ImportedLog ReadBag(const ImportArgs& args, const mapping::SensorGeometry& 
   options.sensor = sensor;
   options.topic = args.topic;
   options.static_sonar = args.static_sonar;
+  options.max_bytes = args.max_input_mb << 20;
   mapping::RosbagBeams bag = mapping::ReadRosbag(args.log, options);
   bool moves = false;
   for (const mapping::Beam& beam : bag.beams) {
@@ -62,7 +64,7 @@ int Import(const ImportArgs& args) {
   if (bag) {
     log = ReadBag(args, sensor);
   } else {
-    log = sim::ImportedMatLog(mapping::ReadMatLog(args.log));
+    log = sim::ImportedMatLog(mapping::ReadMatLog(args.log, args.max_input_mb << 20));
   }
   const sim::DatasetSummary summary =
       sim::ImportLogDataset(args.log, log, sensor, args.out, args.force);
@@ -92,6 +94,11 @@ CLI::App* AddOptions(CLI::App& app, ImportArgs& args) {
   command->add_flag("--static", args.static_sonar,
                     "Bag without transforms: the sonar static at the origin, as a .mat log");
   command->add_flag("--force", args.force, "Replace an existing dataset");
+  command
+      ->add_option("--max-input-mb", args.max_input_mb,
+                   "MiB the log may take, its file and what it decompresses to together")
+      ->capture_default_str()
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 20));
   return command;
 }
 

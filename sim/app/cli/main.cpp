@@ -3,6 +3,7 @@
 // internal error.
 #include <filesystem>
 #include <iostream>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,12 @@ int main(int argc, char** argv) {
     }
   } catch (const sonarbench::InputError& e) {
     std::cerr << "sonarbench: error: " << e.what() << "\n";
+    return app::kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    // The readers and the budgets refuse what would not fit before allocating; this is the
+    // machine's refusal of what is left (a memory limit set lower than the budgets assume).
+    std::cerr << "sonarbench: error: out of memory: the machine refused an allocation (lower "
+                 "--max-triangles, --max-cells or --max-beams, or raise the memory limit)\n";
     return app::kExitBadInput;
   } catch (const std::filesystem::filesystem_error& e) {
     // The machine's refusal (a read-only or full disk, no permission), with the OS's reason.

@@ -29,7 +29,7 @@ int Map(const MapArgs& args) {
   sonarbench::mapping::SensorGeometry sensor;
   sonarbench::mapping::MapperConfig config;
   if (!args.scene.empty()) {
-    const sonarbench::sim::Scene scene = LoadScene(args.scene, args.budgets);
+    const sonarbench::sim::Scene scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
     sensor = scene.sensor.geometry;
     config = scene.mapping;
   }
@@ -43,7 +43,7 @@ int Map(const MapArgs& args) {
   // A .mat log scored against the scene is mapped from the scene's sonar pose.
   std::optional<sonarbench::sim::Scene> scene;
   if (args.score) {
-    scene = LoadScene(args.scene, args.budgets);
+    scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
     sonarbench::sim::CheckBudgets(*scene, args.budgets);
   }
   std::vector<std::string> files = sonarbench::sim::kLogMapOutputFiles;

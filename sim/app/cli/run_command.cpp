@@ -41,11 +41,17 @@ void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::Sc
   PrintVerdict(scene.name, r.verdict);
 }
 
-// A run that broke still leaves a junit.xml saying so (and no other output), for the CI
-// system that collects it.
+// A run that broke leaves a junit.xml saying so (and no other output) for the CI system that
+// collects it; but an earlier complete result in --out stays as it was, whole.
 void CommitErrorJunit(sonarbench::sim::OutputDirectory& out, const RunArgs& args,
                       std::string_view type, const std::string& message) {
   try {
+    out.DiscardStaged();
+    if (out.HoldsRecord()) {
+      std::cerr << "sonarbench: " << args.out
+                << ": the last complete run's outputs stay as they were (this run wrote none)\n";
+      return;
+    }
     const std::string xml = sonarbench::sim::ErrorJunitXml(
         std::filesystem::path(args.scene).stem().string(), type, message);
     sonarbench::WriteFileAtomically((out.write_root() / "junit.xml").string(),
@@ -64,7 +70,7 @@ int Run(const RunArgs& args) {
   // Taken before any work: a run writes its junit.xml there even when the scene is refused.
   sim::OutputDirectory out(args.out, OneShotClaim("run", files, {args.scene}));
   try {
-    const sim::Scene scene = LoadScene(args.scene, args.budgets);
+    const sim::Scene scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
     sim::RunOptions options;
     options.seed = args.seed;
     options.threads = args.threads;

@@ -19,7 +19,7 @@ struct ScoreArgs {
 int Score(const ScoreArgs& args) {
   namespace sim = sonarbench::sim;
   sonarbench::CheckOutputDirectory(args.out);
-  const sim::Scene scene = LoadScene(args.scene, args.budgets);
+  const sim::Scene scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
   sim::CheckBudgets(scene, args.budgets);
   sim::OutputDirectory out(
       args.out, OneShotClaim("score", sim::kMapFileScoreOutputFiles, {args.map, args.scene}));

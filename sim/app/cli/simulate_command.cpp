@@ -21,7 +21,7 @@ struct SimulateArgs {
 
 int Simulate(const SimulateArgs& args) {
   namespace sim = sonarbench::sim;
-  const sim::Scene scene = LoadScene(args.scene, args.budgets);
+  const sim::Scene scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
   sim::DatasetOptions options;
   options.seed = args.seed;
   options.threads = args.threads;

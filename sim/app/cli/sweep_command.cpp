@@ -25,7 +25,7 @@ struct SweepArgs {
 int Sweep(const SweepArgs& args) {
   namespace sim = sonarbench::sim;
   sonarbench::CheckOutputDirectory(args.out);
-  const sim::Scene scene = LoadScene(args.scene, args.budgets);
+  const sim::Scene scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
   sim::StudyOptions options;
   options.seed = args.seed;
   options.sweeps = args.sweeps;

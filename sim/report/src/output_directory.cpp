@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -49,7 +50,7 @@ std::optional<json> ReadJson(const fs::path& file) {
   std::error_code error;
   if (!fs::is_regular_file(file, error)) return std::nullopt;
   try {
-    return json::parse(ReadFileBytes(file.string()));
+    return json::parse(ReadFileBytes(file.string(), kMaxJsonBytes));
   } catch (const std::exception&) {
     return std::nullopt;
   }
@@ -108,6 +109,23 @@ std::vector<std::string> SortedUnion(std::vector<std::string> a,
   std::sort(a.begin(), a.end());
   a.erase(std::unique(a.begin(), a.end()), a.end());
   return a;
+}
+
+// The pids the lock file's lines name ("sonarbench CMD, pid N on HOST, ..."): its writers since
+// the last one out emptied it.
+std::set<std::string> WriterPids(const std::string& text) {
+  std::set<std::string> pids;
+  for (std::size_t at = text.find(", pid "); at != std::string::npos;
+       at = text.find(", pid ", at + 6)) {
+    const std::size_t end = text.find_first_not_of("0123456789", at + 6);
+    if (end != at + 6 && end != std::string::npos) pids.insert(text.substr(at + 6, end - at - 6));
+  }
+  return pids;
+}
+
+bool IsFolder(const fs::path& path) {
+  std::error_code error;
+  return fs::is_directory(fs::symlink_status(path, error));
 }
 
 // Removes the empty folders on `relative`'s way up to `root` (never `root`).
@@ -213,6 +231,10 @@ void OutputDirectory::ResolveRoot() {
     created_ = true;
     root_ = fs::canonical(path);
   }
+  if (root_ == root_.root_path()) {
+    throw InputError(name_ + ": is the file system's root; expected a directory of its own for "
+                     "sonarbench's outputs (--out)");
+  }
 }
 
 // The directory opened and locked, its lock serialising the set-up: the caller closes it.
@@ -228,10 +250,7 @@ bool OutputDirectory::TakeRunLock() {
   // The lock file's lock is held for the run: exclusive by a one-shot writer, shared by the
   // shards of one configuration.
   lock_created_ = !Exists(root_ / kLockFile);
-  lock_fd_ = ::open((root_ / kLockFile).c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (lock_fd_ < 0) {
-    throw EnvironmentError(name_ + ": cannot write in it (" + std::strerror(errno) + ")");
-  }
+  OpenLockFile();
   if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
     const auto owned = ReadOwnership(root_);
     const bool same = claim_.mode == OutputMode::kResume && !claim_.force && owned &&
@@ -244,30 +263,48 @@ bool OutputDirectory::TakeRunLock() {
     }
     write_root_ = root_;  // a shard of the same run: the marker lists its files already
     lock_created_ = false;
+    WriteHolder(false);
     return false;
   }
   return true;
 }
 
+// Opens the lock file, never through a symlink and never one with another name (a hard link):
+// writing the holder's name would change a file elsewhere.
+void OutputDirectory::OpenLockFile() {
+  const std::string lock = name_ + "/" + kLockFile;
+  lock_fd_ = ::open((root_ / kLockFile).c_str(),
+                    O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK | O_NOCTTY, 0644);
+  if (lock_fd_ < 0 && errno == ELOOP) {
+    throw InputError(lock + " is a symlink: sonarbench writes nothing through one (remove it)");
+  }
+  if (lock_fd_ < 0) {
+    throw EnvironmentError(name_ + ": cannot write in it (" + std::strerror(errno) + ")");
+  }
+  struct stat info {};
+  std::string refused;
+  if (::fstat(lock_fd_, &info) != 0 || !S_ISREG(info.st_mode)) {
+    refused = lock + " is not a regular file: sonarbench did not make it (remove it)";
+  } else if (info.st_nlink != 1) {
+    refused = lock + " has another name (a hard link): writing it would change a file " +
+              "elsewhere; sonarbench did not make it (remove it)";
+  }
+  if (!refused.empty()) {
+    ::close(lock_fd_);  // never truncated on the way out
+    lock_fd_ = -1;
+    throw InputError(refused);
+  }
+}
+
 void OutputDirectory::ClaimFiles() {
   Ownership owned = ReadOwnership(root_).value_or(Ownership{});
-  CheckInputsAndCollisions(OwnedFiles(root_).value_or(std::vector<std::string>{}));
-  Claimed& mine = owned[claim_.command];
-  std::vector<std::string> outputs;
-  for (const std::string& file : mine.files) {
-    if (Exists(root_ / file)) outputs.push_back(file);
-  }
-  if (claim_.mode == OutputMode::kResume) {
-    if (claim_.force) {
-      RemoveFiles(outputs);
-      mine.files.clear();
-    } else if (mine.config_sha256 != claim_.config_sha256 && !outputs.empty()) {
-      throw InputError(name_ + ": holds sonarbench " + claim_.command +
-                       " outputs of another configuration (config_sha256 " + mine.config_sha256 +
-                       "); pass --force to replace them (only the files " + claim_.command +
-                       " listed in " + kMarkerFile + " are removed)");
-    }
-  }
+  // Every writer the lock file names is gone (this one holds its lock alone): their temporary
+  // files are never whole.
+  dead_writers_ = WriterPids(LockText());
+  const std::vector<std::string> listed = OwnedFiles(root_).value_or(std::vector<std::string>{});
+  CheckInputsAndCollisions(listed);
+  ClearStage(listed);
+  if (claim_.mode == OutputMode::kResume) ClaimResumable(owned);
   // A file this claim writes is this command's now, whichever wrote it before.
   for (auto& [command, claimed] : owned) {
     if (command == claim_.command) continue;
@@ -275,12 +312,53 @@ void OutputDirectory::ClaimFiles() {
       return std::find(claim_.files.begin(), claim_.files.end(), file) != claim_.files.end();
     });
   }
+  Claimed& mine = owned[claim_.command];
   mine = {claim_.config_sha256, SortedUnion(mine.files, claim_.files)};
   WriteMarker(owned);
   lock_created_ = false;  // listed in the marker now
-  WriteHolder();
-  // Temporary files of a killed writer are never whole.
   RemoveTemporaries({});
+  WriteHolder(true);
+}
+
+// A resumable command continues only its own outputs of the same configuration: outputs of
+// another configuration, or another command's in the way of this one's, are refused, or with
+// --force removed (the other command's whole claim: a dataset is replaced whole).
+void OutputDirectory::ClaimResumable(Ownership& owned) const {
+  std::vector<std::string> in_the_way;
+  std::vector<std::string> commands;
+  for (auto& [command, claimed] : owned) {
+    const bool mine = command == claim_.command;
+    bool blocks = false;
+    for (const std::string& file : claimed.files) {
+      if (!Exists(root_ / file)) continue;
+      const bool claimed_here =
+          std::find(claim_.files.begin(), claim_.files.end(), file) != claim_.files.end();
+      if ((mine && claimed.config_sha256 != claim_.config_sha256) || (!mine && claimed_here)) {
+        in_the_way.push_back(file);
+        blocks = true;
+      }
+    }
+    if (blocks || (mine && claim_.force)) commands.push_back(command);
+  }
+  if (in_the_way.empty() && !claim_.force) return;
+  if (!claim_.force) {
+    const bool own = commands.size() == 1 && commands.front() == claim_.command;
+    throw InputError(name_ + ": holds sonarbench " + Listed(commands) + " outputs " +
+                     (own ? "of another configuration (config_sha256 " +
+                                owned.at(claim_.command).config_sha256 + ")"
+                          : "that " + claim_.command + " would write (" + Listed(in_the_way) +
+                                ")") +
+                     "; pass --force to replace them (only the files sonarbench listed in " +
+                     kMarkerFile + " are removed)");
+  }
+  std::vector<std::string> remove;
+  for (const std::string& command : commands) {
+    for (const std::string& file : owned[command].files) {
+      if (Exists(root_ / file)) remove.push_back(file);
+    }
+    owned.erase(command);
+  }
+  RemoveFiles(remove);
 }
 
 void OutputDirectory::PrepareWriteRoot() {
@@ -299,6 +377,34 @@ void OutputDirectory::PrepareWriteRoot() {
   }
 }
 
+// What a killed one-shot writer staged: copies of files a marker lists, removed. Anything else
+// in the staging folder (or a staging folder in a directory sonarbench did not write) is the
+// user's, refused.
+void OutputDirectory::ClearStage(const std::vector<std::string>& listed) const {
+  const fs::path stage = root_ / kStageDir;
+  if (!Exists(stage)) return;
+  std::vector<std::string> foreign;
+  if (!IsFolder(stage) || !Exists(root_ / kMarkerFile)) {
+    foreign.push_back(kStageDir);
+  } else {
+    std::vector<std::string> staged;
+    for (const std::string& file : SortedUnion(listed, claim_.files)) {
+      staged.push_back(kStageDir + ("/" + file));
+    }
+    RemoveFiles(staged);
+    std::error_code error;
+    for (fs::recursive_directory_iterator it(stage, error), end; !error && it != end;
+         it.increment(error)) {
+      if (!it->is_directory()) foreign.push_back(fs::relative(it->path(), root_).generic_string());
+    }
+    if (foreign.empty()) fs::remove_all(stage, error);  // its empty folders only, by now
+  }
+  if (!foreign.empty()) {
+    throw InputError(name_ + ": holds files sonarbench did not write: " + Listed(foreign) +
+                     "; sonarbench never replaces them (move them or choose another --out)");
+  }
+}
+
 void OutputDirectory::CheckInputsAndCollisions(const std::vector<std::string>& owned) const {
   std::vector<std::string> foreign;
   const std::set<std::string> mine(owned.begin(), owned.end());
@@ -310,6 +416,16 @@ void OutputDirectory::CheckInputsAndCollisions(const std::vector<std::string>& o
     } else if (!mine.contains(file) && Exists(root_ / file)) {
       foreign.push_back(file);
     }
+  }
+  // A folder is never sonarbench's file, whatever an edited marker lists.
+  std::vector<std::string> folders;
+  for (const std::string& file : SortedUnion(owned, claim_.files)) {
+    if (IsFolder(root_ / file)) folders.push_back(file);
+  }
+  if (!folders.empty()) {
+    throw InputError(name_ + ": " + Listed(folders) + ", where sonarbench writes a file, is a " +
+                     "folder (the marker " + kMarkerFile + " may have been edited); sonarbench " +
+                     "never removes a folder (move it or choose another --out)");
   }
   std::sort(foreign.begin(), foreign.end());
   foreign.erase(std::unique(foreign.begin(), foreign.end()), foreign.end());
@@ -346,7 +462,9 @@ void OutputDirectory::RemoveFiles(const std::vector<std::string>& files) const {
 }
 
 void OutputDirectory::RemoveTemporaries(const std::vector<std::string>& files) const {
-  // "NAME.tmp.PID" beside a listed or given NAME: WriteFileAtomically's, of a writer that died.
+  // "NAME.tmp.PID" beside a listed or given NAME, of a writer the lock file names (one that
+  // died): WriteFileAtomically's. A file so named by anyone else stays.
+  if (dead_writers_.empty()) return;
   const auto listed = OwnedFiles(root_).value_or(std::vector<std::string>{});
   const std::vector<std::string> all = SortedUnion(files, listed);
   const std::set<std::string> names(all.begin(), all.end());
@@ -359,7 +477,7 @@ void OutputDirectory::RemoveTemporaries(const std::vector<std::string>& files) c
       const std::string name = it->path().filename().string();
       const auto at = name.rfind(".tmp.");
       if (at == std::string::npos || !names.contains((folder / name.substr(0, at)).string()) ||
-          name.find_first_not_of("0123456789", at + 5) != std::string::npos) {
+          !dead_writers_.contains(name.substr(at + 5))) {
         continue;
       }
       std::error_code ignored;
@@ -383,24 +501,49 @@ void OutputDirectory::WriteMarker(const Ownership& owned) const {
                       [&](std::ostream& out) { out << marker.dump(2) << "\n"; });
 }
 
-void OutputDirectory::WriteHolder() const {
+void OutputDirectory::WriteHolder(bool first) const {
   char host[256] = "?";
   ::gethostname(host, sizeof host - 1);
   const std::string text = "sonarbench " + claim_.command + ", pid " + std::to_string(::getpid()) +
                            " on " + host + ", config " + claim_.config_sha256.substr(0, 12) + "\n";
-  if (::ftruncate(lock_fd_, 0) != 0 ||
-      ::pwrite(lock_fd_, text.data(), text.size(), 0) != static_cast<ssize_t>(text.size())) {
+  // The first writer replaces the names of those before it (their temporaries are gone); each
+  // shard that joins adds its own line, under the directory's lock.
+  struct stat info {};
+  const off_t at = first || ::fstat(lock_fd_, &info) != 0 ? 0 : info.st_size;
+  if ((first && ::ftruncate(lock_fd_, 0) != 0) ||
+      ::pwrite(lock_fd_, text.data(), text.size(), at) != static_cast<ssize_t>(text.size())) {
     throw EnvironmentError(name_ + "/" + kLockFile + ": cannot be written (" +
                            std::strerror(errno) + ")");
   }
 }
 
+std::string OutputDirectory::LockText() const {
+  std::string text(4096, '\0');
+  const ssize_t n = ::pread(lock_fd_, text.data(), text.size(), 0);
+  text.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
+  return text;
+}
+
 std::string OutputDirectory::Holder() const {
-  char text[512] = {};
-  const ssize_t n = ::pread(lock_fd_, text, sizeof text - 1, 0);
-  std::string holder = n > 0 ? std::string(text, static_cast<std::size_t>(n)) : "";
-  while (!holder.empty() && holder.back() == '\n') holder.pop_back();
+  std::string holder = LockText().substr(0, 511);
+  holder = holder.substr(0, holder.find('\n'));
   return holder.empty() ? "holder unknown" : Quoted(holder, 200);
+}
+
+bool OutputDirectory::HoldsRecord() const {
+  const auto owned = ReadOwnership(root_);
+  return owned && owned->contains(claim_.command) && Exists(root_ / claim_.record) &&
+         !IsFolder(root_ / claim_.record);
+}
+
+void OutputDirectory::DiscardStaged() const {
+  if (claim_.mode != OutputMode::kReplace || write_root_ == root_) return;
+  for (const std::string& file : claim_.files) {
+    std::error_code ignored;
+    fs::remove(write_root_ / file, ignored);
+    RemoveEmptyParents(write_root_, file);
+  }
+  fs::create_directories(write_root_);
 }
 
 void OutputDirectory::Commit() {
@@ -468,10 +611,15 @@ void OutputDirectory::Release() noexcept {
       }
       ::rmdir(write_root_.c_str());
     }
-    // The last writer out leaves the lock file empty: the same inputs, the same bytes.
+    // The last writer out removes the temporaries of the shards that died before it, and leaves
+    // the lock file empty: the same inputs, the same bytes.
     const bool last = ::flock(lock_fd_, LOCK_EX | LOCK_NB) == 0;
-    if (last && !lock_created_ && ::ftruncate(lock_fd_, 0) != 0) {
-      // Only the holder's name is left in it.
+    if (last && !lock_created_) {
+      dead_writers_ = WriterPids(LockText());
+      RemoveTemporaries({});
+      if (::ftruncate(lock_fd_, 0) != 0) {
+        // Only the writers' names are left in it.
+      }
     }
     // A directory made for nothing goes again, unless another writer has joined.
     if (created_ && !committed_ && last) {

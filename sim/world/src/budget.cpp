@@ -175,6 +175,11 @@ void CheckBudgets(const Scene& scene, const Budgets& budgets) {
            e.truth_cells, "cells", budgets.max_cells, "--max-cells");
   }
   CheckMapCells(e.map_cells, budgets, scene.file);
+  const double beams = scene.sweeps * scene.sensor.geometry.BeamsPerSweep();
+  if (!(beams <= budgets.max_beams)) {
+    Refuse(scene.file + ": 'sweeps' " + std::to_string(scene.sweeps), "its sweeps make", beams,
+           "beams", budgets.max_beams, "--max-beams");
+  }
 }
 
 }  // namespace sonarbench::sim

@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -485,22 +486,82 @@ std::string Lowercase(std::string text) {
   return text;
 }
 
+// The triangles a mesh file holds, counted from its text without building them: an OBJ's faces
+// (n corners make n - 2), an STL's facets, a PLY's faces, a COLLADA file's primitives' counts.
+// Assimp makes at least this many (a polygon of n corners as n - 2).
+double CountTriangles(const std::string& bytes, const std::string& extension) {
+  const std::string lower = Lowercase(bytes.substr(0, 4096));
+  double triangles = 0.0;
+  if (extension == ".ply" || lower.starts_with("ply")) {
+    try {
+      const PlyHeader header = ReadPlyHeader(bytes, [](std::string what) { return InputError(what); });
+      for (const PlyElement& element : header.elements) {
+        if (element.name == "face") triangles += static_cast<double>(element.count);
+      }
+    } catch (const InputError&) {
+      // CheckPly reports it.
+    }
+  } else if (extension == ".dae" || lower.find("<collada") != std::string::npos) {
+    for (const std::string tag : {"triangles", "polylist", "polygons", "tristrips", "trifans"}) {
+      ForEachXmlElement(bytes, tag, [&](const XmlElement& element) {
+        const auto count = XmlAttribute(element.attributes, "count");
+        if (const auto n = count ? WholeNumber(*count) : std::nullopt) {
+          triangles += static_cast<double>(*n);
+        }
+      });
+    }
+  } else if (extension == ".stl" || lower.starts_with("solid")) {
+    std::uint32_t facets = 0;
+    if (bytes.size() >= 84) std::memcpy(&facets, bytes.data() + 80, 4);
+    if (bytes.size() == 84 + 50 * std::uint64_t{facets}) return facets;  // binary
+    for (std::size_t at = bytes.find("endfacet"); at != std::string::npos;
+         at = bytes.find("endfacet", at + 8)) {
+      ++triangles;
+    }
+  } else {
+    // OBJ, and what Assimp reads as it does: "f a b c ..." lines.
+    for (std::size_t at = 0; at < bytes.size();) {
+      std::size_t end = bytes.find('\n', at);
+      if (end == std::string::npos) end = bytes.size();
+      if (end - at > 1 && bytes[at] == 'f' && (bytes[at + 1] == ' ' || bytes[at + 1] == '\t')) {
+        std::istringstream corners(bytes.substr(at + 2, end - at - 2));
+        double n = 0;
+        for (std::string corner; corners >> corner;) ++n;
+        triangles += std::max(0.0, n - 2);
+      }
+      at = end + 1;
+    }
+  }
+  return triangles;
+}
+
 }  // namespace
 
-MeshFileData LoadMeshFile(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": no such mesh file");
-  // What Assimp cannot read safely is checked first, in the formats it reads by their content.
-  std::string start(4096, '\0');
-  start.resize(static_cast<std::size_t>(
-      std::ifstream(path, std::ios::binary).read(start.data(), 4096).gcount()));
+MeshFileData LoadMeshFile(const std::string& path, double max_triangles) {
+  std::error_code error;
+  if (!std::filesystem::exists(std::filesystem::symlink_status(path, error))) {
+    throw InputError(path + ": no such mesh file");
+  }
+  // What Assimp cannot read safely is checked first, in the formats it reads by their content;
+  // and what it would build is counted before it allocates.
+  std::string bytes = ReadFileBytes(path, kMaxMeshFileBytes);
   // Assimp picks a reader by the extension and then by the content: either sends a file here.
   const std::string extension = Lowercase(std::filesystem::path(path).extension().string());
-  const std::string lower = Lowercase(start);
+  const std::string lower = Lowercase(bytes.substr(0, 4096));
   if (extension == ".ply" || lower.starts_with("ply")) {
-    CheckPly(path, ReadFileBytes(path));
+    CheckPly(path, bytes);
   } else if (extension == ".dae" || lower.find("<collada") != std::string::npos) {
-    CheckCollada(path, ReadFileBytes(path));
+    CheckCollada(path, bytes);
   }
+  if (const double triangles = CountTriangles(bytes, extension); !(triangles <= max_triangles)) {
+    char text[96];
+    std::snprintf(text, sizeof text, "holds %.3g triangles, more than the %.3g", triangles,
+                  max_triangles);
+    throw InputError(path + ": " + text +
+                     " this run allows (--max-triangles raises the limit; expected a mesh this "
+                     "machine can hold)");
+  }
+  bytes = std::string();
   Assimp::Importer importer;
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
   // Points and lines have no surface to echo from.

@@ -252,10 +252,11 @@ std::string Resolve(const YamlReader& root, const std::string& file) {
   return resolved.lexically_normal().string();
 }
 
-Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain);
+Scene LoadSceneIn(const std::string& path, const Budgets& budgets,
+                  std::vector<std::string>& chain);
 
 // The scene that `root` extends, loaded (and its errors reported) first; none if it extends none.
-std::optional<Scene> LoadBase(YamlReader& root, const std::string& path,
+std::optional<Scene> LoadBase(YamlReader& root, const std::string& path, const Budgets& budgets,
                               std::vector<std::string>& chain) {
   std::string extends;
   root.Optional("extends", extends, NonEmpty());
@@ -264,14 +265,19 @@ std::optional<Scene> LoadBase(YamlReader& root, const std::string& path,
   if (extends.empty()) return std::nullopt;
   const std::string base_path = Resolve(root, extends);
   chain.push_back(std::filesystem::path(path).lexically_normal().string());
-  if (std::find(chain.begin(), chain.end(), base_path) != chain.end() ||
-      chain.size() > kMaxExtends) {
+  if (chain.size() > kMaxExtends) {
+    root.Fail("extends", "at most " + std::to_string(kMaxExtends) +
+                             " scenes extending one another (" + chain.front() + " extends " +
+                             std::to_string(chain.size()) + " deep before " + base_path + ")");
+    root.ThrowIfErrors();
+  }
+  if (std::find(chain.begin(), chain.end(), base_path) != chain.end()) {
     std::string loop;
     for (const std::string& file : chain) loop += file + " -> ";
     root.Fail("extends", "a scene outside the chain of extends (" + loop + base_path + ")");
     root.ThrowIfErrors();
   }
-  Scene base = LoadSceneIn(base_path, chain);
+  Scene base = LoadSceneIn(base_path, budgets, chain);
   chain.pop_back();
   return base;
 }
@@ -300,13 +306,13 @@ void ReadSceneKeys(YamlReader& root, bool has_base, Scene& scene) {
 // Reads the mesh files of meshes[first...] (resolved against `root`'s folder); their errors
 // name the scene file `path` and the mesh.
 void LoadMeshFiles(const YamlReader& root, const std::string& path, std::vector<MeshSpec>& meshes,
-                   std::size_t first) {
+                   std::size_t first, double max_triangles) {
   for (std::size_t i = first; i < meshes.size(); ++i) {
     MeshSpec& mesh = meshes[i];
     if (mesh.type != MeshSpec::Type::kFile) continue;
     mesh.file = Resolve(root, mesh.file);
     try {
-      MeshFileData data = LoadMeshFile(mesh.file);
+      MeshFileData data = LoadMeshFile(mesh.file, max_triangles);
       mesh.file_vertices = std::move(data.vertices);
       mesh.file_triangles = std::move(data.triangles);
     } catch (const InputError& e) {
@@ -348,9 +354,10 @@ std::optional<YamlReader> ReadSections(YamlReader& root, bool has_base, Scene& s
 }
 
 // LoadScene, with the files being extended (the chain) that led to `path`.
-Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
+Scene LoadSceneIn(const std::string& path, const Budgets& budgets,
+                  std::vector<std::string>& chain) {
   YamlReader root = YamlReader::FromFile(path);
-  const std::optional<Scene> base = LoadBase(root, path, chain);
+  const std::optional<Scene> base = LoadBase(root, path, budgets, chain);
   Scene scene = base ? *base : Scene{};
   scene.file = path;
   if (base) scene.extends.insert(scene.extends.begin(), base->file);
@@ -367,8 +374,8 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
 
   // Mesh files and the sensor model are their own files, read (and their errors reported) only
   // once the scene is sound; a base's were read with it.
-  LoadMeshFiles(root, path, scene.meshes, base_meshes);
-  LoadMeshFiles(root, path, scene.vehicle, base_vehicle);
+  LoadMeshFiles(root, path, scene.meshes, base_meshes, budgets.max_triangles);
+  LoadMeshFiles(root, path, scene.vehicle, base_vehicle, budgets.max_triangles);
   if (!base) {
     scene.sensor_model_file = Resolve(root, scene.sensor_model_file);
     scene.sensor = LoadSensorModel(scene.sensor_model_file);
@@ -384,9 +391,11 @@ Scene LoadSceneIn(const std::string& path, std::vector<std::string>& chain) {
 
 }  // namespace
 
-Scene LoadScene(const std::string& path) {
+Scene LoadScene(const std::string& path, const Budgets& budgets) {
   std::vector<std::string> chain;
-  return LoadSceneIn(path, chain);
+  Scene scene = LoadSceneIn(path, budgets, chain);
+  scene.budgets = budgets;
+  return scene;
 }
 
 }  // namespace sonarbench::sim

@@ -56,7 +56,7 @@ std::size_t FirstRecord(const std::string& file, char opcode) {
 // The chunk compression rosbag2 uses by default.
 TEST(Mcap, ReadsZstdChunks) {
   const test::TempDir dir;
-  const std::string plain = ReadFileBytes(Written(dir));
+  const std::string plain = ReadFileBytes(Written(dir), kMaxLogBytes);
   // Rewrite the first chunk (opcode 6) with its records zstd-compressed; the summary no longer
   // matches the file, so the footer's summary offset and CRC are zeroed (no summary).
   const std::size_t chunk = FirstRecord(plain, '\x06');
@@ -98,7 +98,7 @@ TEST(Mcap, ReadsZstdChunks) {
 
 TEST(Mcap, RefusesDamagedFilesNamingTheByte) {
   const test::TempDir dir;
-  const std::string good = ReadFileBytes(Written(dir));
+  const std::string good = ReadFileBytes(Written(dir), kMaxLogBytes);
   const auto bad = [&](const std::string& bytes, const std::vector<std::string>& parts) {
     const std::string path = test::WriteFile(dir, "bad.mcap", bytes);
     EXPECT_TRUE(
@@ -125,7 +125,7 @@ TEST(Mcap, RefusesAFileLargerThanTheLimitBeforeReadingIt) {
   const test::TempDir dir;
   const std::string path = Written(dir);
   EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)mapping::ReadMcap(path, 1000); },
-                                         {"bag.mcap", "more than the limit of 1000"}));
+                                         {"bag.mcap", "more than the 1000 bytes"}));
 }
 
 }  // namespace

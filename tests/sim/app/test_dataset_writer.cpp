@@ -158,8 +158,10 @@ TEST_F(TankDataset, ShardsAndResumedRunsGiveTheSameBytesAsOneRun) {
               (void)mapping::ReadDataset(split.string());
             }).find("no manifest.json"),
             std::string::npos);
-  // A run killed while writing leaves at most a temporary file: the rerun removes it.
+  // A run killed while writing leaves at most a temporary file, and its name in the lock file:
+  // the rerun removes it.
   std::ofstream(split / "beams/sweep_0001.bin.tmp.999") << "half";
+  std::ofstream(split / ".sonarbench.lock") << "sonarbench simulate, pid 999 on host, config c\n";
 
   const auto resumed = sim::SimulateDataset(*scene_, split.string(), {});
   EXPECT_TRUE(resumed.complete);

@@ -14,7 +14,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Bytes(const fs::path& path) { return ReadFileBytes(path.string()); }
+std::string Bytes(const fs::path& path) { return ReadFileBytes(path.string(), kMaxJsonBytes); }
 
 void Put(const fs::path& path, const std::string& text) {
   fs::create_directories(path.parent_path());
@@ -102,24 +102,72 @@ TEST(OutputDirectory, AnUncommittedRunLeavesTheEarlierOutputsWhole) {
   EXPECT_FALSE(fs::exists(dir.path() / OutputDirectory::kStageDir));
 }
 
-// A run killed while writing a staged file leaves "NAME.tmp.PID" in the stage (the release
-// that removes staged files never ran); the next run removes it with the stage's files and
-// commits. A file of the same pattern beside a name the command does not claim stays.
+// Writes what a writer of `claim` killed while staging leaves: the marker listing its files, its
+// name in the lock file, staged files and a staged temporary file.
+void LeaveAKilledRun(const fs::path& dir, const OutputClaim& claim) {
+  { const OutputDirectory out(dir.string(), claim); }
+  const fs::path stage = dir / OutputDirectory::kStageDir;
+  Put(stage / "report.json", "staged");
+  Put(stage / "map.bt.tmp.4242", "half of a map");
+  Put(stage / "sub" / "item.json.tmp.17", "half of an item");
+  Put(dir / OutputDirectory::kLockFile, "sonarbench test, pid 4242 on host, config a\n"
+                                        "sonarbench test, pid 17 on host, config a\n");
+}
+
+// A run killed while writing a staged file leaves "NAME.tmp.PID" and staged files in the stage
+// (the release that removes them never ran); the next run removes them and commits.
 TEST(OutputDirectory, AKilledRunsStagedTemporaryIsRemovedByTheNext) {
   test::TempDir dir;
   const OutputClaim claim = Claim(OutputMode::kReplace);
   const fs::path stage = dir.path() / OutputDirectory::kStageDir;
-  Put(stage / "map.bt.tmp.4242", "half of a map");
-  Put(stage / "sub" / "item.json.tmp.17", "half of an item");
-  Put(stage / "notes.txt.tmp.5", "not a claimed name");
+  LeaveAKilledRun(dir.path(), claim);
   OutputDirectory out(dir.path().string(), claim);
   EXPECT_FALSE(fs::exists(stage / "map.bt.tmp.4242"));
   EXPECT_FALSE(fs::exists(stage / "sub" / "item.json.tmp.17"));
-  EXPECT_EQ(Bytes(stage / "notes.txt.tmp.5"), "not a claimed name");
-  fs::remove(stage / "notes.txt.tmp.5");
+  EXPECT_FALSE(fs::exists(stage / "report.json"));
   WriteAll(out, claim, "second");
   out.Commit();
   for (const std::string& file : claim.files) EXPECT_EQ(Bytes(dir.path() / file), "second");
+  EXPECT_FALSE(fs::exists(stage));
+}
+
+// Another command (of another claim) finds a killed run's stage: it clears it too, and commits.
+TEST(OutputDirectory, AKilledRunsStageDoesNotStopAnotherCommand) {
+  test::TempDir dir;
+  LeaveAKilledRun(dir.path(), Claim(OutputMode::kReplace));
+  OutputClaim other = Claim(OutputMode::kReplace);
+  other.command = "other";
+  other.files = {"other.json"};
+  other.record = "other.json";
+  OutputDirectory out(dir.path().string(), other);
+  Put(out.write_root() / "other.json", "other");
+  out.Commit();
+  EXPECT_EQ(Bytes(dir.path() / "other.json"), "other");
+  EXPECT_FALSE(fs::exists(dir.path() / OutputDirectory::kStageDir));
+}
+
+// A file in the stage no marker lists, or a stage in a directory sonarbench did not write, is
+// the user's: refused by name, left as it was.
+TEST(OutputDirectory, AStagingFolderOfTheUsersIsRefused) {
+  test::TempDir dir;
+  const fs::path stage = dir.path() / OutputDirectory::kStageDir;
+  Put(stage / "notes.txt", "the user's");
+  EXPECT_NE(test::InputErrorOf([&] {
+              const OutputDirectory out(dir.path().string(), Claim(OutputMode::kReplace));
+            }).find("did not write: .sonarbench-stage"),
+            std::string::npos);
+  {
+    OutputDirectory out(dir.path().string() + "/b", Claim(OutputMode::kReplace));
+    WriteAll(out, Claim(OutputMode::kReplace), "first");
+    out.Commit();
+  }
+  Put(dir.path() / "b" / OutputDirectory::kStageDir / "notes.txt", "the user's");
+  EXPECT_NE(test::InputErrorOf([&] {
+              const OutputDirectory out((dir.path() / "b").string(), Claim(OutputMode::kReplace));
+            }).find("did not write: .sonarbench-stage/notes.txt"),
+            std::string::npos);
+  EXPECT_EQ(Bytes(stage / "notes.txt"), "the user's");
+  EXPECT_EQ(Bytes(dir.path() / "b" / OutputDirectory::kStageDir / "notes.txt"), "the user's");
 }
 
 TEST(OutputDirectory, ACommitLeavesNoFileOfTheEarlierRun) {
@@ -174,7 +222,9 @@ TEST(OutputDirectory, ForceRemovesOnlyListedFilesNeverATree) {
   }
   Put(dir.path() / "sub/mine.txt", "the user's");
   Put(dir.path() / "map.bt.tmp.123", "a half-written temporary file");
+  Put(dir.path() / OutputDirectory::kLockFile, "sonarbench test, pid 123 on host, config a\n");
   Put(dir.path() / "thesis.tmp.1", "the user's too");
+  Put(dir.path() / "report.json.tmp.99", "the user's, named as a temporary file");
   claim.config_sha256 = "b";
   EXPECT_NE(test::InputErrorOf([&] {
               const OutputDirectory out(dir.path().string(), claim);
@@ -189,6 +239,7 @@ TEST(OutputDirectory, ForceRemovesOnlyListedFilesNeverATree) {
   EXPECT_FALSE(fs::exists(dir.path() / "map.bt.tmp.123"));
   EXPECT_EQ(Bytes(dir.path() / "sub/mine.txt"), "the user's");
   EXPECT_EQ(Bytes(dir.path() / "thesis.tmp.1"), "the user's too");
+  EXPECT_EQ(Bytes(dir.path() / "report.json.tmp.99"), "the user's, named as a temporary file");
   // The marker now lists only what this claim may write.
   EXPECT_EQ(*OwnedFiles(dir.path()),
             (std::vector<std::string>{OutputDirectory::kMarkerFile, OutputDirectory::kLockFile,

@@ -146,7 +146,7 @@ TEST(MeshFile, MissingOrUnreadableFilesNameTheFile) {
 }
 
 // The shipped PLY file's text.
-std::string QuayWallPly() { return ReadFileBytes(test::SourcePath("scenes/meshes/quay_wall.ply")); }
+std::string QuayWallPly() { return ReadFileBytes(test::SourcePath("scenes/meshes/quay_wall.ply"), kMaxMeshFileBytes); }
 
 // Assimp 5.2 loops for ever on a PLY header without end_header, aborts on a body shorter than the
 // header's counts, on a face of no vertices or on a form feed inside a number (it ends a line
@@ -264,7 +264,7 @@ TEST(MeshFile, BinaryPlyOfEitherOrderLoadsAsTheAscii) {
 // <instance_geometry> had no url.
 TEST(MeshFile, ColladaInstancesMustNameAnElementOfTheFile) {
   test::TempDir dir;
-  const std::string dae = ReadFileBytes(test::SourcePath("scenes/meshes/crate.dae"));
+  const std::string dae = ReadFileBytes(test::SourcePath("scenes/meshes/crate.dae"), kMaxMeshFileBytes);
   for (const auto& [from, to, expected] : std::vector<std::array<std::string, 3>>{
            {"url=\"#Scene\"", "url=\"#Nope\"",
             ":32: not a readable COLLADA file: <instance_visual_scene> refers to '#Nope'"},
@@ -303,7 +303,7 @@ TEST(MeshFile, ColladaInstancesMustNameAnElementOfTheFile) {
 
 TEST(MeshFile, ColladaFilesAssimpCannotReadAreClearErrors) {
   test::TempDir dir;
-  const std::string dae = ReadFileBytes(test::SourcePath("scenes/meshes/crate.dae"));
+  const std::string dae = ReadFileBytes(test::SourcePath("scenes/meshes/crate.dae"), kMaxMeshFileBytes);
   const std::size_t list = dae.find("<p>0 2 3 ");
   ASSERT_NE(list, std::string::npos);
   for (const std::string item : {"x", "1.5", "-1", "4000000000"}) {

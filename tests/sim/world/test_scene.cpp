@@ -369,7 +369,7 @@ TEST(SceneFile, VehiclePartsAreReadAndRefusedWithReasons) {
 
 TEST(SceneFile, MissingFileIsAnInputError) {
   EXPECT_TRUE(ThrowsInputErrorWith([] { (void)sim::LoadScene("/nonexistent/scene.yaml"); },
-                                   {"/nonexistent/scene.yaml", "cannot open"}));
+                                   {"/nonexistent/scene.yaml", "cannot be read (No such file or directory)"}));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <ostream>
 #include <string>
@@ -20,7 +21,23 @@ void CheckOutputDirectory(const std::string& dir);
 /// it cannot be (a file in the way, no permission).
 void CreateOutputDirectory(const std::string& dir);
 
-/// The whole content of `path`; throws InputError naming it when it cannot be read.
-[[nodiscard]] std::string ReadFileBytes(const std::string& path);
+/// The most the readers take from one file, checked before they allocate (bytes).
+/// A YAML file: a scene, a sensor model, a mapping configuration (yaml-cpp takes ~100x its size).
+inline constexpr std::uint64_t kMaxYamlBytes = std::uint64_t{2} << 20;
+/// A JSON record: a dataset's manifest, an output directory's marker (nlohmann takes ~10-20x).
+inline constexpr std::uint64_t kMaxJsonBytes = std::uint64_t{16} << 20;
+/// A log (.mat or MCAP) by default: the file and what it decompresses to, together.
+inline constexpr std::uint64_t kMaxLogBytes = std::uint64_t{384} << 20;
+
+/// Throws InputError naming `path` unless it is a regular file of at most `max_bytes` bytes: a
+/// FIFO, device, socket or directory is refused by its type, never read. Returns its size.
+std::uint64_t CheckInputFile(const std::string& path, std::uint64_t max_bytes);
+
+/// The whole content of `path`, checked as CheckInputFile does (on the opened descriptor, which
+/// never blocks on a FIFO); throws InputError naming it when it cannot be read.
+[[nodiscard]] std::string ReadFileBytes(const std::string& path, std::uint64_t max_bytes);
+
+/// `bytes` for a message: "1.5 MiB", "312 bytes".
+[[nodiscard]] std::string ByteCount(std::uint64_t bytes);
 
 }  // namespace sonarbench

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -16,10 +17,13 @@ namespace sonarbench::mapping {
 /// not a .mat, the variable or a field is absent, a value has the wrong shape or class, or an
 /// intensity is not an integer in 0..255. A beam whose bin count differs from the log's usual
 /// count (the last, truncated ping of a log) is kept as it is; `truncated_beams` counts them.
+/// A file over `max_bytes`, or a v5 file whose compressed elements inflate past it with the
+/// file's own bytes, is refused before the allocation; so is a FIFO, device or directory.
 struct MatLog {
   std::vector<Beam> beams;
   std::size_t truncated_beams = 0;
 };
-[[nodiscard]] MatLog ReadMatLog(const std::string& path);
+[[nodiscard]] MatLog ReadMatLog(const std::string& path,
+                                std::uint64_t max_bytes = std::uint64_t{384} << 20);
 
 }  // namespace sonarbench::mapping

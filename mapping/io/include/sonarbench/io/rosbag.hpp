@@ -46,7 +46,7 @@ struct RosbagReadOptions {
   /// No transforms: every beam at the identity pose (a static sonar, as a .mat log is).
   bool static_sonar = false;
   /// Bytes the file and its decompressed chunks may take.
-  std::uint64_t max_bytes = std::uint64_t{4} << 30;
+  std::uint64_t max_bytes = std::uint64_t{384} << 20;
 };
 
 struct RosbagBeams {

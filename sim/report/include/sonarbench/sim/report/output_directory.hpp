@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,11 @@ class OutputDirectory {
   /// staged file outside the claim.
   void Commit();
 
+  /// kReplace: removes what this run staged, so a Commit moves only what is staged after.
+  void DiscardStaged() const;
+  /// Whether the directory holds this command's record (a complete earlier result).
+  [[nodiscard]] bool HoldsRecord() const;
+
  private:
   void Open();
   // Open's steps: the root made or found; the directory's lock for the set-up; the run's lock
@@ -85,14 +91,18 @@ class OutputDirectory {
   void ResolveRoot();
   [[nodiscard]] int LockDirectory() const;
   [[nodiscard]] bool TakeRunLock();
+  void OpenLockFile();
   void ClaimFiles();
+  void ClaimResumable(Ownership& owned) const;
+  void ClearStage(const std::vector<std::string>& listed) const;
   void PrepareWriteRoot();
   void Release() noexcept;
   void CheckInputsAndCollisions(const std::vector<std::string>& owned) const;
   void RemoveFiles(const std::vector<std::string>& files) const;
   void RemoveTemporaries(const std::vector<std::string>& files) const;
   void WriteMarker(const Ownership& owned) const;
-  void WriteHolder() const;
+  void WriteHolder(bool first) const;
+  [[nodiscard]] std::string LockText() const;
   [[nodiscard]] std::string Holder() const;
 
   std::string name_;
@@ -103,6 +113,9 @@ class OutputDirectory {
   bool created_ = false;
   bool lock_created_ = false;
   bool committed_ = false;
+  // The pids of the writers before this one that the lock file names (all gone): whose
+  // temporary files may be removed.
+  std::set<std::string> dead_writers_;
 };
 
 /// The claims an output directory's marker records (or, for a dataset written before markers,

@@ -11,12 +11,14 @@ namespace sonarbench::sim {
 struct Scene;
 
 /// What one run may build, checked from the scene before anything is allocated. The command
-/// line's --max-triangles and --max-cells raise them.
+/// line's --max-triangles, --max-cells and --max-beams raise them.
 struct Budgets {
   /// Triangles of every mesh and vehicle part (Embree and the meshes take ~100 bytes each).
   double max_triangles = 2e7;
   /// Cells of the ground truth, and of the map (OctoMap takes ~20-80 bytes a cell).
   double max_cells = 1e8;
+  /// Beams of the trajectory, sweeps x beams per sweep (a run holds each, ~600 bytes).
+  double max_beams = 2e6;
 };
 
 /// The estimates a budget is checked against.

@@ -18,7 +18,12 @@ struct MeshFileData {
 /// Loads every mesh of an OBJ, STL, PLY or COLLADA (.dae) file with Assimp: polygons
 /// triangulated, node transforms applied, points and lines ignored. COLLADA's up_axis is ignored
 /// (sonarbench's world is z-up, like Gazebo's; rotate a y-up file with the scene's rpy_deg).
-/// Throws InputError naming the file when it cannot be read or holds no triangle.
-[[nodiscard]] MeshFileData LoadMeshFile(const std::string& path);
+/// Throws InputError naming the file when it cannot be read (a FIFO, device or directory is
+/// refused by its type; a file over kMaxMeshFileBytes by its size), holds no triangle, or holds
+/// more than `max_triangles` (counted from the file before Assimp builds anything).
+[[nodiscard]] MeshFileData LoadMeshFile(const std::string& path, double max_triangles = 2e7);
+
+/// The largest mesh file read (bytes).
+inline constexpr std::uint64_t kMaxMeshFileBytes = std::uint64_t{1} << 30;
 
 }  // namespace sonarbench::sim

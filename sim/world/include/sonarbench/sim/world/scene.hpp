@@ -153,6 +153,8 @@ struct Scene {
 ///   the base's;
 /// - `criteria`: `expect` replaces the base's, and `metrics`, when given, replace its metrics
 ///   whole (absent, they stay).
-[[nodiscard]] Scene LoadScene(const std::string& path);
+/// Mesh files over `budgets.max_triangles` are refused before they are built; the scene keeps
+/// `budgets`.
+[[nodiscard]] Scene LoadScene(const std::string& path, const Budgets& budgets = {});
 
 }  // namespace sonarbench::sim
