@@ -4,6 +4,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <ext/stdio_filebuf.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -24,24 +26,26 @@ std::string Reason() { return errno != 0 ? std::strerror(errno) : "write failed"
 
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
   const std::string temp = path + ".tmp." + std::to_string(::getpid());
+  // A new file, never one there already nor through a symlink: nothing else is truncated.
+  const int fd =
+      ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC | O_NOCTTY, 0666);
+  if (fd < 0) throw EnvironmentError(path + ": cannot be written (" + temp + ": " + Reason() + ")");
   try {
     {
+      __gnu_cxx::stdio_filebuf<char> buffer(fd, std::ios::out | std::ios::binary, 1 << 16);
+      std::ostream out(&buffer);
       errno = 0;
-      std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-      if (!out) throw EnvironmentError(path + ": cannot be written (" + Reason() + ")");
       write(out);
       out.flush();
       if (!out) throw EnvironmentError(path + ": cannot be written (" + Reason() + ")");
-      out.close();
-      if (!out) throw EnvironmentError(path + ": cannot be written (" + Reason() + ")");
+      if (::fsync(fd) != 0) {
+        throw EnvironmentError(path + ": cannot be written (fsync: " + Reason() + ")");
+      }
+      errno = 0;
+      if (buffer.close() == nullptr) {
+        throw EnvironmentError(path + ": cannot be written (" + Reason() + ")");
+      }
     }
-    const int fd = ::open(temp.c_str(), O_RDONLY);
-    if (fd < 0 || ::fsync(fd) != 0) {
-      const std::string reason = std::strerror(errno);
-      if (fd >= 0) ::close(fd);
-      throw EnvironmentError(path + ": cannot be written (fsync: " + reason + ")");
-    }
-    ::close(fd);
     std::error_code error;
     std::filesystem::rename(temp, path, error);
     if (error) throw EnvironmentError(path + ": cannot be written (" + error.message() + ")");
