@@ -28,9 +28,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto path = SceneFolder() / "fuzzed.yaml";
   fuzz::WriteBytes(path, fuzz::AsText(data, size));
   return fuzz::KeepsTheContract([&] {
-    sim::Scene scene = sim::LoadScene(path.string());
-    scene.budgets.max_triangles = 5e3;
-    scene.budgets.max_cells = 1e6;
+    sim::Budgets budgets;
+    budgets.max_triangles = 5e3;
+    budgets.max_cells = 1e6;
+    budgets.max_beams = 1e4;
+    sim::Scene scene = sim::LoadScene(path.string(), budgets);
     (void)sim::BuildSceneMeshes(scene);
     (void)sim::BuildVehicleMeshes(scene);
   });

@@ -21,8 +21,8 @@ run_one() {
   local dict=()
   case "$name" in scene | sensor_model | criteria) dict=(-dict="$here/dict/yaml.dict") ;; esac
   # A finding: a crash, a sanitizer report, a leak, an input slower than 1 s, an allocation over
-  # 1 GB, or the process past 2 GB.
-  if "$build/fuzz/fuzz_$name" "${dict[@]}" -timeout=1 -malloc_limit_mb=1024 -rss_limit_mb=2048 \
+  # 512 MB, or the process past 512 MB.
+  if "$build/fuzz/fuzz_$name" "${dict[@]}" -timeout=1 -malloc_limit_mb=512 -rss_limit_mb=512 \
       -max_total_time="$seconds" -runs="$runs" -seed="${SEED:-0}" -print_final_stats=1 \
       -artifact_prefix="$out/" "$out/new" "$here/corpus/$name" > "$out/log" 2>&1; then
     status=ok

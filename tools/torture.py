@@ -4,13 +4,14 @@
     python3 tools/torture.py build/sim/sonarbench [--trials N] [--seed S] [--keep DIR]
 
 For `run`, `simulate`, `import` and `sweep`, each trial starts the command (into an empty
-directory, or over a complete output of another seed), kills it with SIGKILL at a random moment,
+directory, or over a complete output of another seed; `import --force` over a simulated
+dataset), kills it with SIGKILL at a random moment,
 then checks that the record a reader trusts (report.json, manifest.json, study.json) is either
 absent or whole: every file it names has the sha256 it states. A rerun must then finish (resuming
 or replacing) with the bytes of an uninterrupted run. Then: two `simulate` runs of different seeds
 started at once into one directory (one configuration wins; the other exits 2 naming it), and,
 where this machine lets us mount a tmpfs, a full disk and a read-only one (exit 2 with the OS's
-reason, nothing trusted left behind). Exits 1 on the first broken promise, 0 otherwise.
+reason, nothing trusted left behind; a rerun that fills the disk leaves the last result whole). Exits 1 on the first broken promise, 0 otherwise.
 """
 import argparse
 import hashlib
@@ -102,10 +103,12 @@ def kill_trials(sonarbench, kind, scene, work, trials, rng):
     expected = fingerprint(kind, reference)
     for trial in range(trials):
         out = work / f"{kind}-{trial}"
-        over_old = trial % 2 == 1 and kind != "import"
+        over_old = trial % 2 == 1
         if over_old:
-            code, text = run(command(sonarbench, kind, scene, out, 2))
-            check(code in (0, 1), f"{kind}: the run of seed 2 failed: {text}")
+            # An import replaces another command's dataset (with --force) and keeps none of it.
+            old = "simulate" if kind == "import" else kind
+            code, text = run(command(sonarbench, old, scene, out, 2))
+            check(code in (0, 1), f"{kind}: the {old} of seed 2 failed: {text}")
         process = subprocess.Popen(command(sonarbench, kind, scene, out, 1, force=over_old),
                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         time.sleep(rng.uniform(0.0, 1.1 * full))
@@ -154,6 +157,33 @@ def mount_tmpfs(path, options):
     done = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(path)],
                           capture_output=True, text=True)
     return done.returncode == 0, done.stderr.strip()
+
+
+def rerun_on_a_full_disk(sonarbench, scene, work):
+    """A rerun that fills the disk: the last complete result stays, byte for byte."""
+    reference = work / "run-reference"
+    size = sum(p.stat().st_size for p in reference.rglob("*") if p.is_file())
+    disk = work / "rerun-disk"
+    ok, why = mount_tmpfs(disk, f"size={size * 3 // 2 // 1024 + 64}k")
+    if not ok:
+        print(f"rerun on a full disk: skipped: cannot mount a tmpfs here ({why})")
+        return
+    try:
+        out = disk / "run"
+        code, text = run(command(sonarbench, "run", scene, out, 1))
+        check(code in (0, 1), f"run on a disk of 1.5 results: exit {code}: {text}")
+        before = fingerprint("run", out)
+        files = {p.name: sha256(p) for p in out.iterdir() if p.is_file()}
+        code, text = run(command(sonarbench, "run", scene, out, 8))
+        check(code == 2 and "No space left on device" in text,
+              f"a rerun on a full disk: exit {code}: {text}")
+        check(fingerprint("run", out) == before and
+              {p.name: sha256(p) for p in out.iterdir() if p.is_file()} == files,
+              "a rerun that filled the disk changed the last complete result")
+        check(not (out / ".sonarbench-stage").exists(), "a rerun on a full disk left its stage")
+        print("rerun on a full disk: exit 2 with the OS's reason, the last result byte for byte")
+    finally:
+        subprocess.run(["umount", str(disk)], capture_output=True)
 
 
 def full_and_read_only_disks(sonarbench, scene, work):
@@ -206,6 +236,8 @@ def main():
             concurrent_writers(args.sonarbench, str(scene), work, args.trials * 2)
         if not args.only or "disk" in args.only:
             full_and_read_only_disks(args.sonarbench, str(scene), work)
+            if (work / "run-reference").exists():
+                rerun_on_a_full_disk(args.sonarbench, str(scene), work)
     except Broken as broken:
         print(f"BROKEN: {broken}", file=sys.stderr)
         return 1

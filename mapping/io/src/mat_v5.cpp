@@ -229,28 +229,45 @@ class Walker {
     return tag;
   }
 
+  // The element a compressed one holds: its size counted first (inflated into a scratch buffer),
+  // checked against what is left of the budget, then inflated into exactly that much.
   std::string Inflate(const std::string& compressed) const {
+    std::string scratch(1 << 20, '\0');
+    const std::uint64_t size = InflateInto(compressed, scratch, true);
+    if (size > left_) {
+      throw fail_("its compressed elements inflate to more than the " + ByteCount(left_) +
+                  " left of what sonarbench reads from one log (import's --max-input-mb raises "
+                  "it)");
+    }
+    std::string out(size, '\0');
+    (void)InflateInto(compressed, out, false);
+    left_ -= size;
+    return out;
+  }
+
+  // Inflates `compressed` into `out` (over and over when `count_only`, which stops past left_);
+  // returns the bytes it inflates to.
+  std::uint64_t InflateInto(const std::string& compressed, std::string& out,
+                            bool count_only) const {
     z_stream stream{};
     if (inflateInit(&stream) != Z_OK) throw fail_("zlib cannot start");
-    std::string out;
     stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data()));
     stream.avail_in = static_cast<uInt>(compressed.size());
     int status = Z_OK;
-    while (status == Z_OK && stream.total_out <= left_) {
-      out.resize(out.size() + (1 << 20));
-      stream.next_out = reinterpret_cast<Bytef*>(out.data() + stream.total_out);
-      stream.avail_out = 1 << 20;
+    std::uint64_t total = 0;
+    while (status == Z_OK && (!count_only || total <= left_)) {
+      const std::size_t at = count_only ? 0 : static_cast<std::size_t>(total);
+      stream.next_out = reinterpret_cast<Bytef*>(out.data() + at);
+      stream.avail_out = static_cast<uInt>(std::min<std::size_t>(out.size() - at, 1 << 20));
+      if (stream.avail_out == 0) break;
+      const uInt room = stream.avail_out;
       status = inflate(&stream, Z_NO_FLUSH);
+      total += room - stream.avail_out;
     }
     inflateEnd(&stream);
-    if (stream.total_out > left_) {
-      throw fail_("its compressed elements inflate to more than the " + ByteCount(left_) +
-                  " left of what sonarbench reads from one log (import's --max-input-mb raises it)");
-    }
-    out.resize(stream.total_out);
-    left_ -= out.size();
+    if (count_only && total > left_) return total;
     if (status != Z_STREAM_END) throw fail_("a compressed element does not inflate whole");
-    return out;
+    return total;
   }
 
   // One element and, if it is an array (miMATRIX), what it holds.
