@@ -221,7 +221,7 @@ def special_files(sb, work):
     for i in range(1998, -1, -1):
         (chain / f"s{i}.yaml").write_text(f"extends: s{i + 1}.yaml\nname: s{i}\n")
     refused(sb, "an extends chain 2000 deep", "simulate", chain / "s0.yaml", "--out", work / "c",
-            expect="at most 8 scenes extending one another")
+            expect="expected at most 8 scenes extending one another")
     refused(sb, "--out /", "simulate", scene, "--out", "/", expect="is the file system's root")
     print(f"special files: {len(cases)} FIFOs, devices and folders refused by type; an extends "
           "chain 2000 deep and --out / refused by name")

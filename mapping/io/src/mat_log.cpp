@@ -142,7 +142,8 @@ MatLog ReadV5Log(const std::string& path, const std::string& bytes, std::uint64_
   const mat_v5::Fail corrupt = [&](const std::string& what) {
     return fail("a corrupt MAT file (" + what + ")");
   };
-  std::optional<std::string> variable = mat_v5::CheckFile(bytes, "parsedData", corrupt, max_bytes - bytes.size());
+  std::optional<std::string> variable =
+      mat_v5::CheckFile(bytes, "parsedData", corrupt, max_bytes - bytes.size());
   if (!variable) throw fail(kNoParsedData);
   const std::optional<mat_v5::StructArray> read =
       mat_v5::ReadStructArray(std::move(*variable), corrupt);

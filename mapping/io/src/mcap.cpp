@@ -6,8 +6,8 @@
 #include <array>
 #include <cstring>
 #include <filesystem>
-#include <limits>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <string_view>
 

@@ -46,7 +46,9 @@ std::string Number(double value) {
 std::optional<std::string> StoredConfig(const fs::path& file) {
   if (!fs::is_regular_file(file)) return std::nullopt;
   try {
-    return json::parse(ReadFileBytes(file.string(), kMaxJsonBytes)).at("config_sha256").get<std::string>();
+    return json::parse(ReadFileBytes(file.string(), kMaxJsonBytes))
+        .at("config_sha256")
+        .get<std::string>();
   } catch (const std::exception&) {
     return std::nullopt;
   }

@@ -232,7 +232,8 @@ void OutputDirectory::ResolveRoot() {
     root_ = fs::canonical(path);
   }
   if (root_ == root_.root_path()) {
-    throw InputError(name_ + ": is the file system's root; expected a directory of its own for "
+    throw InputError(name_ +
+                     ": is the file system's root; expected a directory of its own for "
                      "sonarbench's outputs (--out)");
   }
 }
@@ -343,13 +344,13 @@ void OutputDirectory::ClaimResumable(Ownership& owned) const {
   if (in_the_way.empty() && !claim_.force) return;
   if (!claim_.force) {
     const bool own = commands.size() == 1 && commands.front() == claim_.command;
-    throw InputError(name_ + ": holds sonarbench " + Listed(commands) + " outputs " +
-                     (own ? "of another configuration (config_sha256 " +
-                                owned.at(claim_.command).config_sha256 + ")"
-                          : "that " + claim_.command + " would write (" + Listed(in_the_way) +
-                                ")") +
-                     "; pass --force to replace them (only the files sonarbench listed in " +
-                     kMarkerFile + " are removed)");
+    throw InputError(
+        name_ + ": holds sonarbench " + Listed(commands) + " outputs " +
+        (own ? "of another configuration (config_sha256 " + owned.at(claim_.command).config_sha256 +
+                   ")"
+             : "that " + claim_.command + " would write (" + Listed(in_the_way) + ")") +
+        "; pass --force to replace them (only the files sonarbench listed in " + kMarkerFile +
+        " are removed)");
   }
   std::vector<std::string> remove;
   for (const std::string& command : commands) {

@@ -494,7 +494,8 @@ double CountTriangles(const std::string& bytes, const std::string& extension) {
   double triangles = 0.0;
   if (extension == ".ply" || lower.starts_with("ply")) {
     try {
-      const PlyHeader header = ReadPlyHeader(bytes, [](std::string what) { return InputError(what); });
+      const PlyHeader header =
+          ReadPlyHeader(bytes, [](std::string what) { return InputError(what); });
       for (const PlyElement& element : header.elements) {
         if (element.name == "face") triangles += static_cast<double>(element.count);
       }

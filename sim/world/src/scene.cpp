@@ -252,8 +252,7 @@ std::string Resolve(const YamlReader& root, const std::string& file) {
   return resolved.lexically_normal().string();
 }
 
-Scene LoadSceneIn(const std::string& path, const Budgets& budgets,
-                  std::vector<std::string>& chain);
+Scene LoadSceneIn(const std::string& path, const Budgets& budgets, std::vector<std::string>& chain);
 
 // The scene that `root` extends, loaded (and its errors reported) first; none if it extends none.
 std::optional<Scene> LoadBase(YamlReader& root, const std::string& path, const Budgets& budgets,
@@ -266,7 +265,7 @@ std::optional<Scene> LoadBase(YamlReader& root, const std::string& path, const B
   const std::string base_path = Resolve(root, extends);
   chain.push_back(std::filesystem::path(path).lexically_normal().string());
   if (chain.size() > kMaxExtends) {
-    root.Fail("extends", "at most " + std::to_string(kMaxExtends) +
+    root.Fail("extends", "expected at most " + std::to_string(kMaxExtends) +
                              " scenes extending one another (" + chain.front() + " extends " +
                              std::to_string(chain.size()) + " deep before " + base_path + ")");
     root.ThrowIfErrors();

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 #include <matio.h>
+#include <zlib.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -314,6 +315,36 @@ TEST(MatLog, AnArrayLargerThanItsBytesIsRefused) {
   test::WriteFile(dir, "huge.mat", mat);
   EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
             path + ": 'parsedData' is not a struct array");
+}
+
+// A compressed element is measured before it is inflated: one that inflates past what is left of
+// the budget (after the file's own bytes) is refused; the same file under a budget that holds it
+// is read on to its layout.
+TEST(MatLog, ACompressedElementPastTheBudgetIsRefusedBeforeItIsInflated) {
+  test::TempDir dir;
+  std::string mat(116, ' ');
+  mat.replace(0, 10, "MATLAB 5.0");
+  mat += std::string(8, '\0') + std::string("\x00\x01IM", 4);
+  const std::string zeros(4 << 20, '\0');
+  std::string packed(compressBound(zeros.size()), '\0');
+  uLongf packed_size = packed.size();
+  ASSERT_EQ(compress(reinterpret_cast<Bytef*>(packed.data()), &packed_size,
+                     reinterpret_cast<const Bytef*>(zeros.data()), zeros.size()),
+            Z_OK);
+  packed.resize(packed_size);
+  const std::uint32_t tag[2] = {15, static_cast<std::uint32_t>(packed.size())};  // miCOMPRESSED
+  mat.append(reinterpret_cast<const char*>(tag), 8);
+  mat += packed;
+  const std::string path = test::WriteFile(dir, "bomb.mat", mat);
+  EXPECT_TRUE(test::ThrowsInputErrorWith(
+      [&] { (void)mapping::ReadMatLog(path, std::uint64_t{2} << 20); },
+      {"bomb.mat: a corrupt MAT file (its compressed elements inflate to more than the"}));
+  EXPECT_FALSE(test::InputErrorOf([&] {
+                 (void)mapping::ReadMatLog(path, std::uint64_t{8} << 20);
+               }).find("inflate to more than") != std::string::npos);
+  EXPECT_TRUE(test::ThrowsInputErrorWith(
+      [&] { (void)mapping::ReadMatLog(path, 1000); },
+      {"bomb.mat: holds", "more than the 1000 bytes sonarbench reads from such a file"}));
 }
 
 }  // namespace

@@ -110,8 +110,9 @@ void LeaveAKilledRun(const fs::path& dir, const OutputClaim& claim) {
   Put(stage / "report.json", "staged");
   Put(stage / "map.bt.tmp.4242", "half of a map");
   Put(stage / "sub" / "item.json.tmp.17", "half of an item");
-  Put(dir / OutputDirectory::kLockFile, "sonarbench test, pid 4242 on host, config a\n"
-                                        "sonarbench test, pid 17 on host, config a\n");
+  Put(dir / OutputDirectory::kLockFile,
+      "sonarbench test, pid 4242 on host, config a\n"
+      "sonarbench test, pid 17 on host, config a\n");
 }
 
 // A run killed while writing a staged file leaves "NAME.tmp.PID" and staged files in the stage
@@ -265,6 +266,104 @@ TEST(OutputDirectory, ForceRemovesOnlyTheSameCommandsFiles) {
   ASSERT_TRUE(owned);
   EXPECT_EQ(owned->at("simulate").files.size(), dataset.files.size());
   EXPECT_EQ(owned->at("sweep").config_sha256, "c");
+}
+
+// A resume continues only the same command's files: another command's in the way are refused,
+// and --force replaces that command's output whole (none of it left beside the new one).
+TEST(OutputDirectory, AResumeNeverContinuesAnotherCommandsFiles) {
+  test::TempDir dir;
+  OutputClaim simulated = Claim(OutputMode::kResume, "a");
+  simulated.command = "simulate";
+  simulated.files.push_back("truth/occupancy.bt");
+  { WriteAll(OutputDirectory(dir.path().string(), simulated), simulated, "simulated"); }
+  OutputClaim imported = Claim(OutputMode::kResume, "b");
+  imported.command = "import";
+  const std::string error =
+      test::InputErrorOf([&] { const OutputDirectory out(dir.path().string(), imported); });
+  EXPECT_NE(error.find("holds sonarbench simulate outputs that import would write (map.bt"),
+            std::string::npos)
+      << error;
+  for (const std::string& file : simulated.files) EXPECT_EQ(Bytes(dir.path() / file), "simulated");
+  imported.force = true;
+  { const OutputDirectory out(dir.path().string(), imported); }
+  for (const std::string& file : simulated.files) EXPECT_FALSE(fs::exists(dir.path() / file));
+  const auto owned = ReadOwnership(dir.path());
+  ASSERT_TRUE(owned);
+  EXPECT_FALSE(owned->contains("simulate"));
+  EXPECT_EQ(owned->at("import").config_sha256, "b");
+}
+
+// A folder where sonarbench writes a file (an edited marker that lists one) is refused before
+// --force removes anything.
+TEST(OutputDirectory, AFolderAnEditedMarkerListsIsRefusedBeforeAnythingIsRemoved) {
+  test::TempDir dir;
+  OutputClaim claim = Claim(OutputMode::kResume, "a");
+  { WriteAll(OutputDirectory(dir.path().string(), claim), claim, "a"); }
+  const fs::path marker = dir.path() / OutputDirectory::kMarkerFile;
+  auto edited = nlohmann::json::parse(Bytes(marker));
+  edited["outputs"]["test"]["files"].push_back("sub");
+  Put(marker, edited.dump());
+  claim.force = true;
+  claim.config_sha256 = "b";
+  const std::string error =
+      test::InputErrorOf([&] { const OutputDirectory out(dir.path().string(), claim); });
+  EXPECT_NE(error.find("sub, where sonarbench writes a file, is a folder"), std::string::npos)
+      << error;
+  for (const std::string& file : claim.files) EXPECT_EQ(Bytes(dir.path() / file), "a");
+}
+
+// A lock file that is a symlink (dangling or not) or a hard link is refused: the file it names is
+// never truncated or made.
+TEST(OutputDirectory, ALinkedLockFileIsRefusedAndNeverWritten) {
+  test::TempDir dir;
+  const fs::path precious = dir.path() / "precious.txt";
+  Put(precious, "precious");
+  const fs::path out = dir.path() / "out";
+  fs::create_directories(out);
+  const fs::path lock = out / OutputDirectory::kLockFile;
+  for (const char* kind : {"symlink", "hard link", "dangling"}) {
+    fs::remove(lock);
+    if (std::string(kind) == "hard link") {
+      fs::create_hard_link(precious, lock);
+    } else {
+      fs::create_symlink(std::string(kind) == "dangling" ? dir.path() / "made.txt" : precious,
+                         lock);
+    }
+    const std::string error = test::InputErrorOf(
+        [&] { const OutputDirectory o(out.string(), Claim(OutputMode::kReplace)); });
+    EXPECT_NE(error.find(std::string(kind) == "hard link" ? "hard link" : "is a symlink"),
+              std::string::npos)
+        << kind << ": " << error;
+    EXPECT_EQ(Bytes(precious), "precious") << kind;
+    EXPECT_FALSE(fs::exists(dir.path() / "made.txt")) << kind;
+    EXPECT_FALSE(fs::exists(out / OutputDirectory::kMarkerFile)) << kind;
+  }
+}
+
+TEST(OutputDirectory, TheFileSystemsRootIsRefused) {
+  EXPECT_NE(test::InputErrorOf([] {
+              const OutputDirectory out("/", Claim(OutputMode::kResume));
+            }).find("is the file system's root"),
+            std::string::npos);
+}
+
+// A run that fails after staging keeps the last complete result: DiscardStaged empties the stage
+// and HoldsRecord tells that result is there.
+TEST(OutputDirectory, AFailedRunCanLeaveTheLastResultWhole) {
+  test::TempDir dir;
+  const OutputClaim claim = Claim(OutputMode::kReplace);
+  {
+    OutputDirectory out(dir.path().string(), claim);
+    EXPECT_FALSE(out.HoldsRecord());
+    WriteAll(out, claim, "first");
+    out.Commit();
+  }
+  OutputDirectory out(dir.path().string(), claim);
+  Put(out.write_root() / "map.bt", "half of the second");
+  out.DiscardStaged();
+  EXPECT_FALSE(fs::exists(out.write_root() / "map.bt"));
+  EXPECT_TRUE(out.HoldsRecord());
+  for (const std::string& file : claim.files) EXPECT_EQ(Bytes(dir.path() / file), "first");
 }
 
 TEST(OutputDirectory, NothingIsWrittenOrRemovedThroughASymlinkedFolder) {

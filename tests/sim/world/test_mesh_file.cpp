@@ -1,4 +1,5 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <array>
 #include <cstdint>
@@ -133,6 +134,45 @@ TEST(MeshPreflight, RefusesNonFiniteVerticesAndDropsZeroAreaTriangles) {
             std::string::npos);
 }
 
+// A mesh file's triangles are counted from its text before Assimp builds them: past the budget it
+// is refused with the count, in each format; within it, it loads.
+TEST(MeshFile, TrianglesPastTheBudgetAreRefusedBeforeTheMeshIsBuilt) {
+  test::TempDir dir;
+  std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n";
+  for (int i = 0; i < 100; ++i) obj += "f 1 2 4 3\n";  // quads: two triangles each
+  const std::string quads = test::WriteFile(dir, "quads.obj", obj);
+  EXPECT_TRUE(test::ThrowsInputErrorWith(
+      [&] { (void)LoadMeshFile(quads, 199); },
+      {"quads.obj: holds 200 triangles, more than the 199", "--max-triangles"}));
+  EXPECT_EQ(LoadMeshFile(quads, 200).triangles.size(), 200u);
+  for (const auto& [file, triangles] :
+       std::vector<std::pair<std::string, std::size_t>>{{"scenes/meshes/pipe.stl", 0},
+                                                        {"scenes/meshes/crate.dae", 0},
+                                                        {"scenes/meshes/quay_wall.ply", 0},
+                                                        {"scenes/meshes/rock.obj", 0}}) {
+    const std::string path = test::SourcePath(file);
+    const std::size_t built = LoadMeshFile(path).triangles.size();
+    EXPECT_TRUE(test::ThrowsInputErrorWith(
+        [&] { (void)LoadMeshFile(path, static_cast<double>(built) - 1); },
+        {"triangles, more than"}))
+        << file << " (" << built << " triangles)";
+    EXPECT_EQ(LoadMeshFile(path, static_cast<double>(built)).triangles.size(), built) << file;
+  }
+}
+
+// A FIFO, a folder or a device where a mesh file goes is refused by its type, not called missing.
+TEST(MeshFile, SpecialFilesAreRefusedByTheirType) {
+  test::TempDir dir;
+  const auto fifo = dir.path() / "rock.obj";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)LoadMeshFile(fifo.string()); },
+                                         {"rock.obj: is a FIFO (expected a regular file)"}));
+  EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)LoadMeshFile(dir.path().string()); },
+                                         {"is a directory"}));
+  EXPECT_TRUE(test::ThrowsInputErrorWith([] { (void)LoadMeshFile("/dev/zero"); },
+                                         {"is a character device"}));
+}
+
 TEST(MeshFile, MissingOrUnreadableFilesNameTheFile) {
   test::TempDir dir;
   EXPECT_NE(test::InputErrorOf([] {
@@ -146,7 +186,9 @@ TEST(MeshFile, MissingOrUnreadableFilesNameTheFile) {
 }
 
 // The shipped PLY file's text.
-std::string QuayWallPly() { return ReadFileBytes(test::SourcePath("scenes/meshes/quay_wall.ply"), kMaxMeshFileBytes); }
+std::string QuayWallPly() {
+  return ReadFileBytes(test::SourcePath("scenes/meshes/quay_wall.ply"), kMaxMeshFileBytes);
+}
 
 // Assimp 5.2 loops for ever on a PLY header without end_header, aborts on a body shorter than the
 // header's counts, on a face of no vertices or on a form feed inside a number (it ends a line
@@ -264,7 +306,8 @@ TEST(MeshFile, BinaryPlyOfEitherOrderLoadsAsTheAscii) {
 // <instance_geometry> had no url.
 TEST(MeshFile, ColladaInstancesMustNameAnElementOfTheFile) {
   test::TempDir dir;
-  const std::string dae = ReadFileBytes(test::SourcePath("scenes/meshes/crate.dae"), kMaxMeshFileBytes);
+  const std::string dae =
+      ReadFileBytes(test::SourcePath("scenes/meshes/crate.dae"), kMaxMeshFileBytes);
   for (const auto& [from, to, expected] : std::vector<std::array<std::string, 3>>{
            {"url=\"#Scene\"", "url=\"#Nope\"",
             ":32: not a readable COLLADA file: <instance_visual_scene> refers to '#Nope'"},
@@ -303,7 +346,8 @@ TEST(MeshFile, ColladaInstancesMustNameAnElementOfTheFile) {
 
 TEST(MeshFile, ColladaFilesAssimpCannotReadAreClearErrors) {
   test::TempDir dir;
-  const std::string dae = ReadFileBytes(test::SourcePath("scenes/meshes/crate.dae"), kMaxMeshFileBytes);
+  const std::string dae =
+      ReadFileBytes(test::SourcePath("scenes/meshes/crate.dae"), kMaxMeshFileBytes);
   const std::size_t list = dae.find("<p>0 2 3 ");
   ASSERT_NE(list, std::string::npos);
   for (const std::string item : {"x", "1.5", "-1", "4000000000"}) {

@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -12,6 +14,7 @@
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
+#include "sonarbench/sim/world/budget.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 #include "sonarbench/sim/world/sensor_model.hpp"
 #include "test_util.hpp"
@@ -368,8 +371,51 @@ TEST(SceneFile, VehiclePartsAreReadAndRefusedWithReasons) {
 }
 
 TEST(SceneFile, MissingFileIsAnInputError) {
-  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)sim::LoadScene("/nonexistent/scene.yaml"); },
-                                   {"/nonexistent/scene.yaml", "cannot be read (No such file or directory)"}));
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [] { (void)sim::LoadScene("/nonexistent/scene.yaml"); },
+      {"/nonexistent/scene.yaml", "cannot be read (No such file or directory)"}));
+}
+
+// A FIFO or a device as the scene or its base is refused by its type (never waited on or read
+// for ever); a scene past 2 MiB by its size; a chain of extends past 8 says so.
+TEST(SceneFile, SpecialOrHugeFilesAndDeepChainsAreRefusedByName) {
+  test::TempDir dir;
+  const auto fifo = dir.path() / "fifo.yaml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(fifo.string()); },
+                                   {"fifo.yaml: is a FIFO (expected a regular file)"}));
+  const std::string zero = test::WriteFile(dir, "zero.yaml", "extends: /dev/zero\nname: z\n");
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(zero); },
+                                   {"/dev/zero: is a character device"}));
+  const std::string big = test::WriteFile(dir, "big.yaml", std::string(3 << 20, '#'));
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadScene(big); },
+                                   {"big.yaml: holds 3 MiB, more than the 2 MiB"}));
+  (void)test::WriteFile(dir, "s20.yaml",
+                        "extends: " + test::SourcePath("scenes/cras-tank.yaml") + "\nname: s\n");
+  for (int i = 19; i >= 0; --i) {
+    std::ostringstream name, text;
+    name << "s" << i << ".yaml";
+    text << "extends: s" << i + 1 << ".yaml\nname: s\n";
+    (void)test::WriteFile(dir, name.str(), text.str());
+  }
+  EXPECT_TRUE(
+      ThrowsInputErrorWith([&] { (void)sim::LoadScene((dir.path() / "s0.yaml").string()); },
+                           {"key 'extends': expected at most 8 scenes extending one another"}));
+  EXPECT_NO_THROW((void)sim::LoadScene((dir.path() / "s13.yaml").string()));
+}
+
+// The sweeps' beams are counted against --max-beams before anything is built.
+TEST(SceneFile, SweepsPastTheBeamBudgetAreRefused) {
+  test::TempDir dir;
+  const std::string path = test::WriteFile(
+      dir, "long.yaml",
+      "extends: " + test::SourcePath("scenes/cras-tank.yaml") + "\nname: s\nsweeps: 100000\n");
+  sim::Scene scene = sim::LoadScene(path);
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [&] { sim::CheckBudgets(scene, scene.budgets); },
+      {"long.yaml: 'sweeps' 100000", "2e+07 beams, more than the 2e+06", "--max-beams"}));
+  scene.budgets.max_beams = 2e7;
+  EXPECT_NO_THROW(sim::CheckBudgets(scene, scene.budgets));
 }
 
 }  // namespace

@@ -37,7 +37,7 @@ std::uint64_t CheckInputFile(const std::string& path, std::uint64_t max_bytes);
 /// never blocks on a FIFO); throws InputError naming it when it cannot be read.
 [[nodiscard]] std::string ReadFileBytes(const std::string& path, std::uint64_t max_bytes);
 
-/// `bytes` for a message: "1.5 MiB", "312 bytes".
+/// `bytes` for a message: "1.5 MiB", "2047 bytes" (exact below 10 KiB).
 [[nodiscard]] std::string ByteCount(std::uint64_t bytes);
 
 }  // namespace sonarbench
