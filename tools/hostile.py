@@ -11,7 +11,8 @@ go, an extends chain 2000 deep, and inputs that would exhaust memory (/dev/zero,
 triangles than --max-triangles), then every file of fuzz/corpus/ through its command. Each of
 these runs under a 2 GB address-space limit (`ulimit -v 2000000`) and must exit 0, 1 or 2, never 3;
 each refusal within 2 s at a peak of at most 512 MB (--sanitized: no limit, no time or peak
-asserted, as AddressSanitizer reserves its shadow memory). Exits 1 on the first broken promise.
+asserted, as AddressSanitizer reserves its shadow memory). Each group of cases stops at its first
+broken promise; exits 1 when any group found one.
 """
 import argparse
 import hashlib
@@ -414,16 +415,20 @@ def main():
     sb = Runner(args.sonarbench, args.sanitized)
     work = Path(args.keep or tempfile.mkdtemp(prefix="sonarbench-hostile-"))
     work.mkdir(parents=True, exist_ok=True)
+    broken = 0
     try:
         for case in (import_over_simulate, linked_locks, special_files, memory_bombs,
                      failed_rerun_keeps_the_last_result, corpus):
-            case(sb, work)
-    except Broken as broken:
-        print(f"BROKEN: {broken}", file=sys.stderr)
-        return 1
+            try:
+                case(sb, work)
+            except Broken as why:
+                print(f"BROKEN: {case.__name__}: {why}", file=sys.stderr)
+                broken += 1
     finally:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
+    if broken:
+        return 1
     print("hostile: every check held")
     return 0
 
