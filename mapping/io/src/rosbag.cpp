@@ -269,6 +269,17 @@ const McapChannel& SonarChannel(const McapFile& file, const std::string& path,
       found.push_back(&c);
     }
   }
+  if (found.empty() && !topic.empty()) {
+    std::string topics;
+    for (const McapChannel& c : file.channels) {
+      const bool sonar =
+          types.count(c.schema_id) && types.at(c.schema_id) == ros2::kProjectedSonarImage;
+      if (sonar) topics += (topics.empty() ? "" : ", ") + c.topic;
+    }
+    throw InputError(path + ": no topic named " + Quoted(topic) + "; the bag's " +
+                     ros2::kProjectedSonarImage +
+                     " topics: " + (topics.empty() ? std::string("none") : topics));
+  }
   if (found.size() != 1) {
     std::string topics;
     for (const McapChannel* c : found) topics += " " + c->topic;

@@ -6,6 +6,7 @@
 
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/sim/report/scenario_report.hpp"
 
 namespace sonarbench::app {
 
@@ -16,6 +17,82 @@ std::string MetricsLine(const sonarbench::sim::MapMetrics& m) {
        << "/" << m.observable_cells << "), coverage " << m.coverage << " ("
        << m.known_observable_cells << "/" << m.observable_cells << ")";
   return line.str();
+}
+
+namespace {
+
+// The edit distance between `a` and `b` (insertions, deletions, substitutions).
+std::size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// "--out", the option of `command` nearest `given` (at most two edits; `given` itself when the
+// command has it), or "".
+std::string NearestOption(const CLI::App& command, const std::string& given) {
+  std::string nearest;
+  std::size_t best = 3;
+  for (const CLI::Option* option : command.get_options()) {
+    for (const std::string& name : option->get_lnames()) {
+      const std::size_t d = EditDistance(given, "--" + name);
+      if (d < best) best = d, nearest = "--" + name;
+    }
+  }
+  return nearest;
+}
+
+}  // namespace
+
+std::string ParseErrorMessage(const CLI::App& cli, const CLI::ParseError& error, int argc,
+                              char** argv) {
+  const auto parsed = cli.get_subcommands();
+  const CLI::App& command = parsed.empty() ? cli : *parsed.front();
+  const std::string name = parsed.empty() ? "" : command.get_name();
+  std::string what = error.what();
+  if (!what.empty()) what[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(what[0])));
+  // An option the command does not have, named with the nearest it has.
+  std::string hint;
+  for (int i = 1; i < argc && hint.empty(); ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--", 0) != 0 || arg == "--") continue;
+    const std::string option = arg.substr(0, arg.find('='));
+    const std::string nearest = NearestOption(command, option);
+    if (nearest == option) continue;
+    hint = option + " is no option of " + (name.empty() ? "sonarbench" : name) +
+           (nearest.empty() ? "" : "; did you mean " + nearest + "?") + "; ";
+  }
+  return "sonarbench: error: " + (name.empty() ? "" : name + ": ") + what + " (" + hint +
+         "sonarbench " + (name.empty() ? "" : name + " ") + "--help)";
+}
+
+std::string Count(std::size_t n, const std::string& noun) {
+  return std::to_string(n) + " " + noun + (n == 1 ? "" : "s");
+}
+
+std::string Seconds3(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3f", seconds);
+  return text;
+}
+
+std::string DetectionLine(const mapping::MapperConfig& config) {
+  const nlohmann::json mapping = sim::MapperConfigJson(config);
+  const nlohmann::json& detection = mapping["detection"];
+  std::string line = detection.value("method", "?");
+  if (line == "threshold") line += " " + detection["threshold"].dump();
+  return line + ", at most " + detection["max_obstacles"].dump() +
+         " echoes a beam (later echoes: " + detection.value("later_echoes", "?") + "), " +
+         mapping.value("occupancy", "?") + " at " + mapping["resolution_m"].dump() + " m";
 }
 
 void PrintVerdict(const std::string& name, const sonarbench::sim::Verdict& v) {

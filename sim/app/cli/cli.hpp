@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/eval/verdict.hpp"
@@ -96,6 +97,16 @@ class ProgressLine {
 
 /// "occupied precision P (tp/occupied), recall R (..), coverage C (..)": a map's scores.
 [[nodiscard]] std::string MetricsLine(const sim::MapMetrics& m);
+/// A command line CLI11 refused, as one line: "sonarbench: error: COMMAND: what (did you mean
+/// --out?; sonarbench COMMAND --help)", an unknown option matched to the nearest the command has.
+[[nodiscard]] std::string ParseErrorMessage(const CLI::App& cli, const CLI::ParseError& error,
+                                            int argc, char** argv);
+/// "1 sweep", "3 sweeps": `n` and the noun, plural unless one.
+[[nodiscard]] std::string Count(std::size_t n, const std::string& noun);
+/// A duration for the terminal: "0.045", three decimals [s].
+[[nodiscard]] std::string Seconds3(double seconds);
+/// "threshold 70, two strongest echoes, ..." : the detection a map used, for the terminal.
+[[nodiscard]] std::string DetectionLine(const mapping::MapperConfig& config);
 /// Prints the verdict's warnings, "PASS|FAIL NAME: M/N criteria met" and each reason.
 void PrintVerdict(const std::string& name, const sim::Verdict& v);
 /// What a one-shot command (run, map, fidelity) claims in its --out: `files`, the first of them the

@@ -73,7 +73,7 @@ int Import(const ImportArgs& args) {
     return 0;
   }
   std::cout << log.beams.size() << " beams (" << log.truncated_beams << " truncated) in "
-            << summary.sweeps_total << " sweeps\nwrote " << args.out << "/manifest.json\n";
+            << Count(summary.sweeps_total, "sweep") << "\nwrote " << args.out << "/manifest.json\n";
   return 0;
 }
 

@@ -37,8 +37,9 @@ int main(int argc, char** argv) {
                 << "; the commands are " << names << " (sonarbench --help)\n";
       return app::kExitBadInput;
     }
-    const int code = cli.exit(e);
-    return code == 0 ? 0 : app::kExitBadInput;
+    if (e.get_exit_code() == 0) return cli.exit(e);  // --help, --version
+    std::cerr << app::ParseErrorMessage(cli, e, argc, argv) << "\n";
+    return app::kExitBadInput;
   }
   try {
     for (const app::Command& command : commands) {

@@ -69,11 +69,17 @@ int Map(const MapArgs& args) {
   out.Commit();
   const auto& t = result.totals;
   std::cout << result.beams << " beams (" << result.truncated_beams << " truncated) in "
-            << result.sweeps << " sweeps; " << t.beams_with_obstacle << " with an obstacle\n";
+            << Count(result.sweeps, "sweep") << "; " << t.beams_with_obstacle
+            << " with an obstacle\n"
+            << "detection: " << DetectionLine(config)
+            << (args.scene.empty() && args.mapping.empty()
+                    ? " (the mapper's defaults; --scene or --mapping sets them)\n"
+                    : "\n");
   for (const std::string& warning : result.warnings) std::cout << "warning: " << warning << "\n";
   if (result.metrics)
     std::cout << "against " << args.scene << ": " << MetricsLine(*result.metrics) << "\n";
-  std::cout << "timing [s]: import " << result.import_s << ", map " << result.map_s << "\n"
+  std::cout << "timing [s]: import " << Seconds3(result.import_s) << ", map "
+            << Seconds3(result.map_s) << "\n"
             << "wrote " << args.out << "/report.json, report.html"
             << (result.verdict ? ", junit.xml, map_side.png, certainty.png, certainty.csv" : "")
             << ", map.bt, map.ot, map_top.png, polar.png, fan.png\n";

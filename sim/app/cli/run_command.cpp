@@ -25,8 +25,9 @@ void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::Sc
   const auto& t = r.timings;
   std::cout << "beams " << r.beams << ", seed " << r.seed << ", threads " << r.threads << "\n"
             << MetricsLine(r.metrics) << "\n"
-            << "timing [s]: scene " << t.build_scene_s << ", simulate " << t.simulate_s << ", map "
-            << t.map_s << ", ground truth " << t.ground_truth_s << ", score " << t.score_s << "\n"
+            << "timing [s]: scene " << Seconds3(t.build_scene_s) << ", simulate "
+            << Seconds3(t.simulate_s) << ", map " << Seconds3(t.map_s) << ", ground truth "
+            << Seconds3(t.ground_truth_s) << ", score " << Seconds3(t.score_s) << "\n"
             << "wrote " << out << "/report.json, junit.xml, report.html, map.bt and images\n";
   for (const auto& mesh : r.meshes) {
     if (mesh.check.zero_area_triangles > 0) {

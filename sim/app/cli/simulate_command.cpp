@@ -40,7 +40,7 @@ int Simulate(const SimulateArgs& args) {
     return 0;
   }
   std::cout << "shard " << options.shard.index + 1 << "/" << options.shard.count << ": wrote "
-            << summary.sweeps_written << " sweeps, skipped " << summary.sweeps_skipped
+            << Count(summary.sweeps_written, "sweep") << ", skipped " << summary.sweeps_skipped
             << " already complete, of " << summary.sweeps_total << "\n";
   if (summary.complete) {
     std::cout << "wrote " << args.out << "/manifest.json (config "

@@ -77,12 +77,13 @@ OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sw
   return claim;
 }
 
-// Readies an owned dataset directory for `config`. Returns true when a complete dataset of that
-// very configuration is already there (nothing to do).
-bool PrepareDirectory(const OutputDirectory& out, const std::string& config) {
+// Readies an owned dataset directory for `config` (truth/ only when `simulated`). Returns true when
+// a complete dataset of that very configuration is already there (nothing to do).
+bool PrepareDirectory(const OutputDirectory& out, const std::string& config, bool simulated) {
   const fs::path& root = out.root();
   if (StoredConfig(root / "manifest.json") == config) return true;
-  for (const char* sub : {"beams", "images", "truth", "poses"}) fs::create_directories(root / sub);
+  for (const char* sub : {"beams", "images", "poses"}) fs::create_directories(root / sub);
+  if (simulated) fs::create_directories(root / "truth");
   if (!fs::exists(root / kPartialMarker)) {
     WriteText(root / kPartialMarker,
               json{{"format", mapping::kDatasetFormat}, {"config_sha256", config}}.dump(2) + "\n");
@@ -344,7 +345,7 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
       DatasetClaim("simulate", summary.config_sha256, summary.sweeps_total, true, options.force);
   claim.inputs = SceneInputFiles(scene);
   const OutputDirectory out(dir, claim);
-  if (PrepareDirectory(out, summary.config_sha256)) {
+  if (PrepareDirectory(out, summary.config_sha256, true)) {
     summary.complete = summary.already_complete = true;
     return summary;
   }
@@ -405,7 +406,7 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& 
       DatasetClaim("import", summary.config_sha256, summary.sweeps_total, false, force);
   claim.inputs = {log_path};
   const OutputDirectory out(dir, claim);
-  if (PrepareDirectory(out, summary.config_sha256)) {
+  if (PrepareDirectory(out, summary.config_sha256, false)) {
     summary.complete = summary.already_complete = true;
     return summary;
   }

@@ -197,6 +197,7 @@ std::string LogMapHtml(const LogMapResult& result, const Scene* scene,
                      {"import [s]", Seconds(result.import_s)},
                      {"map [s]", Seconds(result.map_s)}},
                     false);
+  html << MappingHtml(result.mapper->config());
   if (scene) html << "<p>Scored against scene <code>" << XmlEscape(scene->file) << "</code>.</p>\n";
   for (const std::string& warning : result.warnings) {
     html << "<p class=\"acceptable\">" << XmlEscape(warning) << "</p>\n";

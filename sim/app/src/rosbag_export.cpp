@@ -56,12 +56,13 @@ void WriteRosbagFile(const mapping::RosbagContent& bag, const std::string& path,
     if (!fs::is_regular_file(path, error)) {
       throw InputError(path + ": exists and is not a file; choose another --out");
     }
-    if (!force) throw InputError(path + ": exists; pass --force to replace it");
     if (mapping::McapLibrary(path).value_or("").rfind("sonarbench", 0) != 0) {
       throw InputError(path +
-                       ": exists and is not an MCAP file sonarbench wrote; --force "
-                       "replaces only those: choose another --out");
+                       ": exists and is not an MCAP file sonarbench wrote; sonarbench never "
+                       "replaces it (--force neither): choose another --out");
     }
+    if (!force)
+      throw InputError(path + ": exists (a bag sonarbench wrote); pass --force to replace it");
   }
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty()) CheckOutputDirectory(parent.string());

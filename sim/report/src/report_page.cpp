@@ -191,6 +191,22 @@ std::string TableHtml(const std::string& heading,
   return html.str();
 }
 
+std::string MappingHtml(const mapping::MapperConfig& config) {
+  std::vector<std::pair<std::string, std::string>> rows;
+  const auto add = [&rows](const std::string& key, const nlohmann::json& v) {
+    rows.emplace_back(key, v.is_string() ? v.get<std::string>() : v.dump());
+  };
+  const nlohmann::json mapping = MapperConfigJson(config);
+  const nlohmann::json& detection = mapping.at("detection");
+  for (auto it = mapping.cbegin(); it != mapping.cend(); ++it) {
+    if (it.key() != "detection") add(it.key(), it.value());
+  }
+  for (auto it = detection.cbegin(); it != detection.cend(); ++it) {
+    add("detection." + it.key(), it.value());
+  }
+  return TableHtml("Mapping", rows, false);
+}
+
 std::string ImagesHtmlAndEnd(const std::vector<ReportImage>& images) {
   std::ostringstream html;
   html << "<h2>Images</h2>\n";

@@ -373,6 +373,54 @@ TEST(Cli, ScoreRefusesMapsItCannotScoreAndWritesNothing) {
 // sonarbench writes only into what it owns: a user's files of its outputs' names are refused by
 // name and left as they were, --force or not; --force never removes a tree or an input; a
 // symlinked --out is followed, not replaced.
+// The messages a newcomer meets: an unknown option named with the nearest the command has, a
+// file export never replaces said at once (not "pass --force"), a topic a bag lacks with the
+// topics it has, the detection `map` used without a scene, counts in the singular.
+TEST(Cli, MessagesNameWhatToDoNext) {
+  namespace fs = std::filesystem;
+  test::TempDir dir;
+  const auto scene = TankSceneWithCriteria(dir.path(), "");
+  std::string output;
+  EXPECT_EQ(
+      RunCli("simulate " + scene.string() + " --outt " + (dir.path() / "d").string(), &output), 2);
+  EXPECT_NE(output.find("sonarbench: error: simulate: "), std::string::npos) << output;
+  EXPECT_NE(output.find("--outt is no option of simulate; did you mean --out?"), std::string::npos)
+      << output;
+  const auto ds = dir.path() / "ds";
+  ASSERT_EQ(RunCli("simulate " + scene.string() + " --out " + ds.string(), &output), 0) << output;
+  EXPECT_NE(output.find("wrote 1 sweep, skipped 0"), std::string::npos) << output;
+  const auto mine = dir.path() / "mine.mcap";
+  std::ofstream(mine) << "my notes";
+  EXPECT_EQ(RunCli("export " + ds.string() + " --out " + mine.string(), &output), 2);
+  EXPECT_NE(output.find("not an MCAP file sonarbench wrote; sonarbench never replaces it"),
+            std::string::npos)
+      << output;
+  EXPECT_EQ(output.find("pass --force"), std::string::npos) << output;
+  const auto bag = dir.path() / "ds.mcap";
+  ASSERT_EQ(RunCli("export " + ds.string() + " --out " + bag.string(), &output), 0) << output;
+  EXPECT_EQ(RunCli("export " + ds.string() + " --out " + bag.string(), &output), 2);
+  EXPECT_NE(output.find("a bag sonarbench wrote); pass --force"), std::string::npos) << output;
+  EXPECT_EQ(RunCli("import " + bag.string() + " --topic /nope --out " + (dir.path() / "i").string(),
+                   &output),
+            2);
+  EXPECT_NE(output.find("no topic named '/nope'; the bag's "
+                        "marine_acoustic_msgs/msg/ProjectedSonarImage topics: /sonar/image"),
+            std::string::npos)
+      << output;
+  const auto imported = dir.path() / "imported";
+  ASSERT_EQ(RunCli("import " + test::RealLogPath() + " --out " + imported.string(), &output), 0);
+  EXPECT_FALSE(fs::exists(imported / "truth"));  // an imported log has no truth
+  const auto map = dir.path() / "map";
+  ASSERT_EQ(RunCli("map " + imported.string() + " --out " + map.string(), &output), 0) << output;
+  EXPECT_NE(output.find("detection: threshold 70, at most 2 echoes a beam (later echoes: "
+                        "strongest), arc_marking at 0.05 m (the mapper's defaults; --scene or "
+                        "--mapping sets them)"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(ReadFile(map / "report.html").find("<td>detection.threshold</td><td>70</td>"),
+            std::string::npos);
+}
+
 TEST(Cli, NeverReplacesOrRemovesWhatItDidNotWrite) {
   namespace fs = std::filesystem;
   test::TempDir dir;

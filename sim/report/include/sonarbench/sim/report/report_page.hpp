@@ -11,6 +11,7 @@
 
 #include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/mapping/detail/key_set.hpp"
+#include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/eval/verdict.hpp"
 #include "sonarbench/sim/world/scene.hpp"
@@ -60,6 +61,9 @@ void WriteReportImages(const std::string& dir, const std::vector<ReportImage>& i
 [[nodiscard]] std::string TableHtml(const std::string& heading,
                                     const std::vector<std::pair<std::string, std::string>>& rows,
                                     bool numeric);
+/// "Mapping": every parameter of `config` (the detection's as "detection.KEY"), as report.json's
+/// "mapping" names them.
+[[nodiscard]] std::string MappingHtml(const mapping::MapperConfig& config);
 /// The images, embedded, each with its caption; then the end of the page.
 [[nodiscard]] std::string ImagesHtmlAndEnd(const std::vector<ReportImage>& images);
 
