@@ -96,11 +96,18 @@ std::string DetectionLine(const mapping::MapperConfig& config) {
 }
 
 void PrintVerdict(const std::string& name, const sonarbench::sim::Verdict& v) {
+  using sonarbench::sim::CriterionStatus;
   std::size_t met = 0;
-  for (const auto& c : v.results) met += c.status != sonarbench::sim::CriterionStatus::kFail;
+  std::size_t not_applicable = 0;
+  for (const auto& c : v.results) {
+    not_applicable += c.status == CriterionStatus::kNotApplicable;
+    met += c.status == CriterionStatus::kPass || c.status == CriterionStatus::kAcceptable;
+  }
   for (const auto& w : v.warnings) std::cout << "warning: " << w << "\n";
-  std::cout << (v.passed ? "PASS " : "FAIL ") << name << ": " << met << "/" << v.results.size()
-            << " criteria met" << (v.expect_fail ? " (the scene expects a failure)" : "") << "\n";
+  std::cout << (v.passed ? "PASS " : "FAIL ") << name << ": " << met << "/"
+            << v.results.size() - not_applicable << " criteria met"
+            << (not_applicable ? ", " + std::to_string(not_applicable) + " not applicable" : "")
+            << (v.expect_fail ? " (the scene expects a failure)" : "") << "\n";
   for (const auto& reason : v.reasons) std::cout << "  " << reason << "\n";
 }
 

@@ -221,7 +221,8 @@ void CountCells(const MapCells& cells, const mapping::KeySet& truth,
   }
   m.coverage_absolute = Ratio(known_truth, truth.size());
   for (const auto& key : cells.free) m.free_on_surface_cells += truth.contains(key) ? 1 : 0;
-  m.free_accuracy = cells.free.empty() ? 0.0 : 1.0 - Ratio(m.free_on_surface_cells, m.free_cells);
+  // Not applicable (NaN, null in report.json) to a map of occupied cells only.
+  m.free_accuracy = cells.free.empty() ? NAN : 1.0 - Ratio(m.free_on_surface_cells, m.free_cells);
 }
 
 // Recall of one mesh's own observable cells.

@@ -41,6 +41,8 @@ const char* StatusName(CriterionStatus status) {
       return "acceptable";
     case CriterionStatus::kFail:
       return "fail";
+    case CriterionStatus::kNotApplicable:
+      return "not_applicable";
   }
   return "?";
 }
@@ -81,6 +83,19 @@ double MetricValue(const MapMetrics& metrics, const std::string& name) {
   return NAN;
 }
 
+namespace {
+
+// Whether the map can be judged on `metric`: free_accuracy needs free cells.
+bool Applies(const MapMetrics& metrics, const std::string& metric) {
+  return metric != "free_accuracy" || metrics.free_cells > 0;
+}
+
+std::string NotApplicableWhy(const std::string& metric) {
+  return metric == "free_accuracy" ? "the map holds no free cells" : "";
+}
+
+}  // namespace
+
 Verdict Evaluate(const Criteria& criteria, const MapMetrics& metrics) {
   Verdict verdict;
   verdict.expect_fail = criteria.expect_fail;
@@ -94,6 +109,14 @@ Verdict Evaluate(const Criteria& criteria, const MapMetrics& metrics) {
     if (c.min) margin = std::min(margin, r.actual - *c.min);
     if (c.max) margin = std::min(margin, *c.max - r.actual);
     r.margin = margin;
+    if (!Applies(metrics, c.metric)) {
+      r.status = CriterionStatus::kNotApplicable;
+      r.margin = NAN;
+      verdict.warnings.push_back(c.metric + ": not applicable (" + NotApplicableWhy(c.metric) +
+                                 "); it does not decide the verdict");
+      verdict.results.push_back(r);
+      continue;
+    }
     if (std::isnan(r.actual)) {
       r.status = CriterionStatus::kFail;
     } else if (Within(r.actual, c.min, c.max)) {

@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -25,7 +26,10 @@ std::string CriteriaTestCases(const std::string& classname, const Verdict& v,
     cases << "    <testcase classname=\"" << classname << "\" name=\""
           << XmlEscape(r.criterion.metric) << "\" time=\"0\">\n";
     const bool counts = r.status == CriterionStatus::kFail && !r.criterion.optional;
-    if (counts && !v.expect_fail) {
+    if (r.status == CriterionStatus::kNotApplicable) {
+      cases << "      <skipped message=\"" << XmlEscape(r.criterion.metric)
+            << ": not applicable to this map\"/>\n";
+    } else if (counts && !v.expect_fail) {
       ++failures;
       cases << "      <failure type=\"criterion\" message=\"" << XmlEscape(Describe(r)) << "\"/>\n";
     } else {
@@ -162,8 +166,9 @@ std::string MetricsHtml(const MapMetrics& m) {
   std::ostringstream html;
   html << "<h2>Metrics</h2>\n<table><tr><th>metric</th><th>value</th><th>definition</th></tr>\n";
   for (const MetricInfo& info : KnownMetrics()) {
+    const double value = MetricValue(m, info.name);
     html << "<tr><td>" << info.name << "</td><td class=\"n\">"
-         << FormatMetricValue(MetricValue(m, info.name)) << "</td><td>"
+         << (std::isnan(value) ? "not applicable" : FormatMetricValue(value)) << "</td><td>"
          << HtmlEscape(info.definition) << "</td></tr>\n";
   }
   for (const auto& r : m.per_mesh) {
@@ -239,12 +244,14 @@ std::string ScoredJunitXml(const Scene& scene, const std::string& first_case,
         << "    </testcase>\n"
         << CriteriaTestCases(classname, v, failures);
   const std::size_t tests = v.results.size() + 1;
+  std::size_t skipped = 0;
+  for (const CriterionResult& r : v.results) skipped += r.status == CriterionStatus::kNotApplicable;
   std::ostringstream xml;
   xml << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       << "<testsuites name=\"sonarbench\" tests=\"" << tests << "\" failures=\"" << failures
       << "\" errors=\"0\" time=\"" << Seconds(seconds) << "\">\n"
       << "  <testsuite name=\"" << suite << "\" tests=\"" << tests << "\" failures=\"" << failures
-      << "\" errors=\"0\" skipped=\"0\" time=\"" << Seconds(seconds) << "\">\n"
+      << "\" errors=\"0\" skipped=\"" << skipped << "\" time=\"" << Seconds(seconds) << "\">\n"
       << "    <properties>\n";
   for (const auto& [name, value] : properties) {
     xml << "      <property name=\"" << XmlEscape(name) << "\" value=\"" << XmlEscape(value)

@@ -343,6 +343,30 @@ TEST(Cli, ScoreScoresAMapFileAsRunScoresItsOwnMap) {
   EXPECT_NE(ReadFile(score / "junit.xml").find("<failure type=\"criterion\""), std::string::npos);
 }
 
+// A map of exactly the tank's surfaces, occupied cells only (the simulated dataset's truth, as a
+// mapper that exports no free cells writes), passes: free_accuracy is not applicable, not 0.
+TEST(Cli, ScoreJudgesAMapWithoutFreeCellsOnWhatItHolds) {
+  test::TempDir dir;
+  const auto scene =
+      TankSceneWithCriteria(dir.path(),
+                            "criteria:\n  metrics:\n    occupied_precision: {min: 0.99}\n"
+                            "    free_accuracy: {min: 0.9}\n");
+  std::string output;
+  const auto ds = dir.path() / "ds";
+  ASSERT_EQ(RunCli("simulate " + scene.string() + " --out " + ds.string(), &output), 0) << output;
+  const auto out = dir.path() / "score";
+  EXPECT_EQ(RunCli("score " + (ds / "truth/occupancy.bt").string() + " --scene " + scene.string() +
+                       " --out " + out.string(),
+                   &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("PASS cras-tank: 1/1 criteria met, 1 not applicable"), std::string::npos)
+      << output;
+  EXPECT_NE(ReadFile(out / "junit.xml").find("skipped=\"1\""), std::string::npos);
+  const auto report = nlohmann::json::parse(ReadFile(out / "report.json"));
+  EXPECT_TRUE(report["metrics"]["free_accuracy"].is_null());
+}
+
 TEST(Cli, ScoreRefusesMapsItCannotScoreAndWritesNothing) {
   test::TempDir dir;
   const auto scene = TankSceneWithCriteria(dir.path(), "");

@@ -49,6 +49,30 @@ TEST(Verdict, StatusAndMarginFollowTheBounds) {
   EXPECT_FALSE(Evaluate(c, undefined).passed);  // a NaN never passes
 }
 
+// A map without free cells (a mapper that exports occupied cells only) cannot be judged on
+// free_accuracy: not applicable, said so, never deciding; with free cells it decides as before.
+TEST(Verdict, FreeAccuracyOfAMapWithoutFreeCellsIsNotApplicable) {
+  const Criteria c = ParseCriteria(
+      "metrics:\n"
+      "  occupied_recall: {min: 0.5}\n"
+      "  free_accuracy: {min: 0.9}\n");
+  MapMetrics occupied_only = Metrics(0.6, 0.9);
+  occupied_only.free_accuracy = NAN;
+  occupied_only.free_cells = 0;
+  const Verdict v = Evaluate(c, occupied_only);
+  EXPECT_TRUE(v.passed);
+  EXPECT_EQ(v.results[1].status, CriterionStatus::kNotApplicable);
+  ASSERT_EQ(v.warnings.size(), 1u);
+  EXPECT_NE(v.warnings[0].find("free_accuracy: not applicable (the map holds no free cells)"),
+            std::string::npos);
+  MapMetrics with_free = occupied_only;
+  with_free.free_cells = 10;
+  with_free.free_accuracy = 0.5;
+  const Verdict judged = Evaluate(c, with_free);
+  EXPECT_FALSE(judged.passed);
+  EXPECT_EQ(judged.results[1].status, CriterionStatus::kFail);
+}
+
 TEST(Verdict, OptionalFailuresWarnAndExpectFailInverts) {
   const Criteria optional = ParseCriteria("metrics: {occupied_recall: {min: 0.5, optional: true}}");
   const Verdict v = Evaluate(optional, Metrics(0.1, 0));

@@ -11,7 +11,9 @@ namespace sonarbench::sim {
 /// The value of a criterion's metric, NaN when the metrics do not hold it.
 [[nodiscard]] double MetricValue(const MapMetrics& metrics, const std::string& name);
 
-enum class CriterionStatus { kPass, kAcceptable, kFail };
+/// kNotApplicable: the map cannot be judged on the metric (free_accuracy of a map without free
+/// cells, as mappers that export occupied cells only write): reported, never deciding.
+enum class CriterionStatus { kPass, kAcceptable, kFail, kNotApplicable };
 [[nodiscard]] const char* StatusName(CriterionStatus status);
 
 struct CriterionResult {
