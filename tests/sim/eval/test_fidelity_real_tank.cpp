@@ -93,8 +93,7 @@ struct RealTank {
 // 0.616-0.642 / 0.521-0.545 / 0.413-0.445; the sweep-to-sweep spread 2.27-2.30, at 4.5-5 m
 // 2.26-2.45 times its 0.4-1.5 m one (the real log's 2.17); the walls' median strongest echo 151;
 // the bands within 9.4 of the real ones (2.5-3 m, lit by the walls' glint), 3.0-4.0 on average; the
-// near range's mean 14.0-15.2 and spread across head angles 20.4-22.2 (earlier figures:
-// docs/history.md). Every value it reports lies on the real log's grid. Each bound sits outside
+// near range's mean 14.0-15.2 and spread across head angles 20.4-22.2 (docs/fidelity.md). Every value it reports lies on the real log's grid. Each bound sits outside
 // that spread and inside what a lost piece of the model gives (docs/fidelity.md; the bands' average
 // 7.1 and 11.0 with the gain 2 dB under and over): the self-reflection under the speckle (mean 120,
 // ping spread 1.2), one look of speckle (0.70 and contrast 0.51), no own share (0.90 / 0.75 / 0.59
