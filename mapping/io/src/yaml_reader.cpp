@@ -297,6 +297,13 @@ void YamlReader::ThrowIfErrors() const {
   throw InputError(message);
 }
 
+std::string YamlReader::WhereOf(const std::string& key) const {
+  for (const auto& item : node_) {
+    if (item.first.Scalar() == key) return Where(item.second);
+  }
+  return state_->file;
+}
+
 std::string YamlReader::Directory() const {
   return std::filesystem::path(state_->file).parent_path().string();
 }

@@ -43,6 +43,7 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
     }
   } else if (m.type == MeshSpec::Type::kFile) {
     node.Required("file", m.file, NonEmpty());
+    m.file_where = node.WhereOf("file");
     node.Optional("scale", m.scale,
                   YamlReader::Check<std::array<double, 3>>(
                       [](const std::array<double, 3>& s) -> std::optional<std::string> {
@@ -245,11 +246,16 @@ void ReadNavigation(YamlReader& nav, NavigationError& n) {
   nav.RejectUnknownKeys();
 }
 
-// `file` as named in the YAML file `root`: relative to that file's folder.
 std::string Resolve(const YamlReader& root, const std::string& file) {
-  std::filesystem::path resolved(file);
-  if (resolved.is_relative()) resolved = std::filesystem::path(root.Directory()) / resolved;
-  return resolved.lexically_normal().string();
+  return ResolveScenePath(root.file(), file);
+}
+
+// Said beside a file the scene names that is not there.
+std::string WhereLooked(const std::string& resolved) {
+  std::error_code error;
+  if (std::filesystem::exists(std::filesystem::symlink_status(resolved, error))) return "";
+  return " (a relative path is read from the scene file's folder, then from sonarbench's own: " +
+         std::string(SONARBENCH_DATA_DIR) + ")";
 }
 
 Scene LoadSceneIn(const std::string& path, const Budgets& budgets, std::vector<std::string>& chain);
@@ -302,10 +308,10 @@ void ReadSceneKeys(YamlReader& root, bool has_base, Scene& scene) {
   }
 }
 
-// Reads the mesh files of meshes[first...] (resolved against `root`'s folder); their errors
-// name the scene file `path` and the mesh.
-void LoadMeshFiles(const YamlReader& root, const std::string& path, std::vector<MeshSpec>& meshes,
-                   std::size_t first, double max_triangles) {
+// Reads the mesh files of meshes[first...] (resolved as ResolveScenePath does); each error,
+// naming where the scene names the file and the mesh, goes to `errors`.
+void LoadMeshFiles(const YamlReader& root, std::vector<MeshSpec>& meshes, std::size_t first,
+                   double max_triangles, std::vector<std::string>& errors) {
   for (std::size_t i = first; i < meshes.size(); ++i) {
     MeshSpec& mesh = meshes[i];
     if (mesh.type != MeshSpec::Type::kFile) continue;
@@ -315,7 +321,8 @@ void LoadMeshFiles(const YamlReader& root, const std::string& path, std::vector<
       mesh.file_vertices = std::move(data.vertices);
       mesh.file_triangles = std::move(data.triangles);
     } catch (const InputError& e) {
-      throw InputError(path + ": mesh '" + mesh.name + "': " + e.what());
+      errors.push_back(mesh.file_where + ": mesh '" + mesh.name + "': " + e.what() +
+                       WhereLooked(mesh.file));
     }
   }
 }
@@ -371,13 +378,24 @@ Scene LoadSceneIn(const std::string& path, const Budgets& budgets,
   root.RejectUnknownKeys();
   root.ThrowIfErrors();
 
-  // Mesh files and the sensor model are their own files, read (and their errors reported) only
-  // once the scene is sound; a base's were read with it.
-  LoadMeshFiles(root, path, scene.meshes, base_meshes, budgets.max_triangles);
-  LoadMeshFiles(root, path, scene.vehicle, base_vehicle, budgets.max_triangles);
+  // Mesh files and the sensor model are their own files, read (and their errors reported, all
+  // at once) only once the scene is sound; a base's were read with it.
+  std::vector<std::string> errors;
+  LoadMeshFiles(root, scene.meshes, base_meshes, budgets.max_triangles, errors);
+  LoadMeshFiles(root, scene.vehicle, base_vehicle, budgets.max_triangles, errors);
   if (!base) {
     scene.sensor_model_file = Resolve(root, scene.sensor_model_file);
-    scene.sensor = LoadSensorModel(scene.sensor_model_file);
+    try {
+      scene.sensor = LoadSensorModel(scene.sensor_model_file);
+    } catch (const InputError& e) {
+      errors.push_back(root.WhereOf("sensor_model") + ": sensor_model: " + e.what() +
+                       WhereLooked(scene.sensor_model_file));
+    }
+  }
+  if (!errors.empty()) {
+    std::string all = errors.front();
+    for (std::size_t i = 1; i < errors.size(); ++i) all += "\n" + errors[i];
+    throw InputError(all);
   }
   if (T_vehicle_sonar) scene.sensor.geometry.T_vehicle_sonar = *T_vehicle_sonar;
   if (acoustics) {
@@ -389,6 +407,17 @@ Scene LoadSceneIn(const std::string& path, const Budgets& budgets,
 }
 
 }  // namespace
+
+std::string ResolveScenePath(const std::string& scene_file, const std::string& file) {
+  namespace fs = std::filesystem;
+  const fs::path named(file);
+  if (!named.is_relative()) return named.lexically_normal().string();
+  const fs::path beside = (fs::path(scene_file).parent_path() / named).lexically_normal();
+  std::error_code error;
+  if (fs::exists(beside, error)) return beside.string();
+  const fs::path shipped = (fs::path(SONARBENCH_DATA_DIR) / named).lexically_normal();
+  return fs::exists(shipped, error) ? shipped.string() : beside.string();
+}
 
 Scene LoadScene(const std::string& path, const Budgets& budgets) {
   std::vector<std::string> chain;

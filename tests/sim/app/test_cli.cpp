@@ -168,7 +168,7 @@ TEST(Cli, BadMeshFilesExitTwoNamingSceneMeshAndFile) {
   EXPECT_EQ(
       RunCli("run " + scene_with("missing.stl") + " --out " + (dir.path() / "o").string(), &output),
       2);
-  EXPECT_NE(output.find("scene.yaml: mesh 'rock': " + (dir.path() / "missing.stl").string() +
+  EXPECT_NE(output.find("scene.yaml:5:41: mesh 'rock': " + (dir.path() / "missing.stl").string() +
                         ": no such mesh file"),
             std::string::npos)
       << output;

@@ -404,6 +404,38 @@ TEST(SceneFile, SpecialOrHugeFilesAndDeepChainsAreRefusedByName) {
   EXPECT_NO_THROW((void)sim::LoadScene((dir.path() / "s13.yaml").string()));
 }
 
+// A relative path is the scene file's folder's, then sonarbench's own: a scene saved anywhere
+// names the shipped model and meshes. What cannot be read is reported at once, each with the
+// scene's line and column and the path as resolved.
+TEST(SceneFile, PathsResolveBesideTheSceneThenInSonarbenchsFolder) {
+  test::TempDir dir;
+  const std::string ok = test::WriteFile(
+      dir, "ok.yaml",
+      "name: s\nsensor_model: sensor-models/shad-micron.yaml\nsweeps: 1\n"
+      "materials:\n  - {name: m, reflectivity: 0.3}\n"
+      "meshes:\n  - {name: rock, type: file, file: scenes/meshes/rock.obj, material: m}\n"
+      "trajectory: {type: static, position_m: [0, 0, 1]}\n");
+  const sim::Scene scene = sim::LoadScene(ok);
+  EXPECT_EQ(scene.sensor_model_file, test::SourcePath("sensor-models/shad-micron.yaml"));
+  EXPECT_EQ(scene.meshes[0].file, test::SourcePath("scenes/meshes/rock.obj"));
+  const std::string bad =
+      test::WriteFile(dir, "bad.yaml",
+                      "name: s\nsensor_model: models/none.yaml\nsweeps: 1\n"
+                      "materials:\n  - {name: m, reflectivity: 0.3}\n"
+                      "meshes:\n  - {name: a, type: file, file: a.obj, material: m}\n"
+                      "  - {name: b, type: file, file: b.stl, material: m}\n"
+                      "trajectory: {type: static, position_m: [0, 0, 1]}\n");
+  const std::string error = test::InputErrorOf([&] { (void)sim::LoadScene(bad); });
+  const std::string folder = dir.path().string();
+  for (const std::string& part :
+       {bad + ":7:33: mesh 'a': " + folder + "/a.obj: no such mesh file",
+        bad + ":8:33: mesh 'b': " + folder + "/b.stl: no such mesh file",
+        bad + ":2:15: sensor_model: " + folder + "/models/none.yaml: cannot be read",
+        std::string("then from sonarbench's own")}) {
+    EXPECT_NE(error.find(part), std::string::npos) << part << "\n" << error;
+  }
+}
+
 // The sweeps' beams are counted against --max-beams before anything is built.
 TEST(SceneFile, SweepsPastTheBeamBudgetAreRefused) {
   test::TempDir dir;

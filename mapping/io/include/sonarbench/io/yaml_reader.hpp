@@ -65,6 +65,8 @@ class YamlReader {
   [[nodiscard]] const std::string& file() const { return state_->file; }
   /// The directory of the file, for resolving relative paths in it.
   [[nodiscard]] std::string Directory() const;
+  /// "FILE:LINE:COLUMN" of `key`'s value in this mapping (the file alone when it has none).
+  [[nodiscard]] std::string WhereOf(const std::string& key) const;
 
  private:
   struct State {

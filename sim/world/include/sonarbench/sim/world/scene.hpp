@@ -60,9 +60,11 @@ struct MeshSpec {
   double amplitude_m = 0.0;
   double wavelength_m = 5.0;
   double roughness_m = 0.0;
-  /// kFile: the mesh file (resolved against the scene file's directory), the scale applied to
-  /// its coordinates along its own x, y, z before the pose, and its triangles as loaded.
+  /// kFile: the mesh file (resolved as ResolveScenePath does), where the scene names it
+  /// ("FILE:LINE:COLUMN", for messages), the scale applied to its coordinates along its own x,
+  /// y, z before the pose, and its triangles as loaded.
   std::string file;
+  std::string file_where;
   std::array<double, 3> scale{1, 1, 1};
   std::vector<Eigen::Vector3d> file_vertices;
   std::vector<std::array<std::uint32_t, 3>> file_triangles;
@@ -153,6 +155,11 @@ struct Scene {
 ///   the base's;
 /// - `criteria`: `expect` replaces the base's, and `metrics`, when given, replace its metrics
 ///   whole (absent, they stay).
+/// A path `file` a scene (or sensor model) names: relative to the folder of `scene_file`; a
+/// relative path not found there is looked up in sonarbench's own folder (its sensor-models/ and
+/// scenes/meshes/), so a scene saved anywhere can name the shipped models and meshes.
+[[nodiscard]] std::string ResolveScenePath(const std::string& scene_file, const std::string& file);
+
 /// Mesh files over `budgets.max_triangles` are refused before they are built; the scene keeps
 /// `budgets`.
 [[nodiscard]] Scene LoadScene(const std::string& path, const Budgets& budgets = {});
