@@ -91,8 +91,8 @@ def measured(sb, what, *args, expect=""):
     """A refusal in its own process, so its peak is its own: exit 2, <= 2 s, <= 512 MB."""
     # RUSAGE_CHILDREN's peak is the largest of any child so far: measure in a fresh interpreter.
     probe = subprocess.run(
-        [sys.executable, __file__, "--probe", sb.sonarbench, *(["--sanitized"] if sb.sanitized
-                                                             else []), "--", *map(str, args)],
+        [sys.executable, __file__, "--probe", *(["--sanitized"] if sb.sanitized else []),
+         sb.sonarbench, "--", *map(str, args)],
         capture_output=True, text=True, timeout=120)
     check(probe.returncode == 0, f"{what}: the probe failed: {probe.stderr[-400:]}")
     result = json.loads(probe.stdout)
