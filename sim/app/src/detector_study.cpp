@@ -101,13 +101,20 @@ void WritePlot(const std::string& path, const std::vector<DetectorRow>& rows, bo
     auto [it, added] = order.emplace(name, series.size());
     if (added) series.push_back({name, colours[series.size() % colours.size()], {}, {}});
     const MapMetrics& m = log ? *row.log : row.scene;
-    series[it->second].x.push_back(m.recall_within[1]);
-    series[it->second].y.push_back(m.precision_within[1]);
+    PlotSeries& s = series[it->second];
+    s.x.push_back(m.recall_within[1]);
+    s.y.push_back(m.precision_within[1]);
+    // Each point says what it is: a threshold, or an echo rule.
+    s.labels.push_back(d.method == Detection::Method::kThreshold
+                           ? std::to_string(static_cast<int>(d.threshold))
+                       : d.max_obstacles == 1 ? "first"
+                                              : mapping::LaterEchoesName(d.later_echoes));
   }
   WritePng(path,
-           RenderLinePlot(std::string("Detectors on the ") + (log ? "log" : "simulated scene") +
-                              ": precision against recall, 1 cell of tolerance",
-                          "recall (1 cell)", "precision (1 cell)", series, false, 0.0, 1.0));
+           RenderLinePlot(std::string("Detectors, ") + (log ? "the log" : "the simulated scene") +
+                              ": precision against recall (1 cell of tolerance)",
+                          "recall (1 cell)", "precision (1 cell)", series, false, 0.0, 1.0,
+                          std::pair{0.0, 1.0}));
 }
 
 }  // namespace

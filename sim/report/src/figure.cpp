@@ -130,6 +130,25 @@ cv::Mat Legend(const std::vector<std::pair<cv::Vec3b, std::string>>& entries) {
   return image;
 }
 
+void AppendScaleBar(cv::Mat& side, double metres_per_pixel) {
+  if (!(metres_per_pixel > 0.0)) return;
+  const int width = std::max(side.cols, 160);
+  const double most = (width - 24) * metres_per_pixel;
+  const double decade = std::pow(10.0, std::floor(std::log10(most)));
+  const double length = most >= 5.0 * decade   ? 5.0 * decade
+                        : most >= 2.0 * decade ? 2.0 * decade
+                                               : decade;
+  const int pixels = std::max(1, static_cast<int>(std::lround(length / metres_per_pixel)));
+  cv::Mat grown(side.rows + 48, width, CV_8UC3, kWhite);
+  if (!side.empty()) side.copyTo(grown(cv::Rect(0, 0, side.cols, side.rows)));
+  const int y = side.rows + 36;
+  cv::line(grown, {4, y}, {4 + pixels, y}, kBlack, 3);
+  cv::line(grown, {4, y - 6}, {4, y + 4}, kBlack, 1);
+  cv::line(grown, {4 + pixels, y - 6}, {4 + pixels, y + 4}, kBlack, 1);
+  Text(grown, Number(length) + " m", 4, y - 10, 0.42);
+  side = grown;
+}
+
 void DrawScaleBar(cv::Mat& panel, double metres_per_pixel) {
   if (!(metres_per_pixel > 0.0) || panel.cols < 40) return;
   // The largest 1, 2 or 5 × 10^k metres within a fifth of the panel.

@@ -37,5 +37,8 @@ struct Axis {
 /// Draws a bar of a round length (about a fifth of the panel's width) with its length in metres
 /// in the panel's lower left corner; `metres_per_pixel` is the panel's scale.
 void DrawScaleBar(cv::Mat& panel, double metres_per_pixel);
+/// Adds below `side` (a legend) a scale bar for a map of `metres_per_pixel` (none when 0): the
+/// largest 1, 2 or 5 × 10^k metres that fits its width.
+void AppendScaleBar(cv::Mat& side, double metres_per_pixel);
 
 }  // namespace sonarbench::sim::figure

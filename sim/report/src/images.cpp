@@ -235,6 +235,33 @@ ViewLabels LabelView(const MapCells& map, const mapping::KeySet& truth,
   return out;
 }
 
+const cv::Vec3b kSonarColour(0, 220, 255);
+
+// The sonar's cells on the map scaled `scale` pixels a cell: a cross at the first, a dot at each
+// other in the view (a side view's slab, a top view's every one). Whether any was drawn.
+bool DrawSonar(cv::Mat& colour, const MapView& view, const ViewLabels& labels, int scale) {
+  const int v = view.kind == MapView::Kind::kTop ? 1 : 2;
+  const cv::Scalar yellow(kSonarColour[0], kSonarColour[1], kSonarColour[2]);
+  bool drawn = false;
+  for (std::size_t i = 0; i < view.sonar.size(); ++i) {
+    const octomap::OcTreeKey& k = view.sonar[i];
+    if (view.kind == MapView::Kind::kSide &&
+        std::abs(static_cast<int>(k[1]) - static_cast<int>(view.slab_key)) > view.slab_half_cells) {
+      continue;
+    }
+    const cv::Point p((k[0] - labels.lo_u) * scale + scale / 2,
+                      (labels.hi_v - k[v]) * scale + scale / 2);
+    if (p.x < 0 || p.y < 0 || p.x >= colour.cols || p.y >= colour.rows) continue;
+    if (i == 0) {
+      cv::drawMarker(colour, p, yellow, cv::MARKER_CROSS, 16, 2);
+    } else {
+      cv::circle(colour, p, 2, yellow, cv::FILLED);
+    }
+    drawn = true;
+  }
+  return drawn;
+}
+
 }  // namespace
 
 cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
@@ -271,13 +298,15 @@ cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
   const double res = view.resolution_m > 0.0 ? view.resolution_m : 1.0;
   const char* unit = view.resolution_m > 0.0 ? " [m]" : " [cells]";
   auto metres = [&](int key) { return (key - 32768) * res; };
-  figure::DrawScaleBar(colour, view.resolution_m > 0.0 ? res / scale : 0.0);
+  if (DrawSonar(colour, view, labels, scale)) legend.emplace_back(kSonarColour, "sonar (x: start)");
+  cv::Mat side = figure::Legend(legend);
+  figure::AppendScaleBar(side, view.resolution_m > 0.0 ? res / scale : 0.0);
   const figure::Axis x{metres(labels.lo_u), metres(labels.hi_u + 1), std::string("x") + unit, {}};
   const figure::Axis y{metres(labels.lo_v),
                        metres(labels.hi_v + 1),
                        std::string(view.kind == MapView::Kind::kTop ? "y" : "z") + unit,
                        {}};
-  return figure::Framed(colour, view.title, x, y, figure::Legend(legend));
+  return figure::Framed(colour, view.title, x, y, side);
 }
 
 namespace {
@@ -305,8 +334,9 @@ std::vector<double> XTicks(const std::vector<double>& xs, bool log2_x,
 
 namespace {
 
+// The plot area's frame in every plot; the legend's rows (kLegendRow each) go below it.
 constexpr int kPlotWidth = 720, kPlotHeight = 470, kPlotLeft = 80, kPlotRight = 20, kPlotTop = 50,
-              kPlotBottom = 60;
+              kPlotBottom = 60, kLegendRow = 18;
 
 // Where a plot's values fall in its image.
 struct PlotScale {
@@ -322,20 +352,12 @@ struct PlotScale {
   }
 };
 
-// Each series' points (a marker each, up to 64, or always when unjoined), joined by a line only
-// when its x values increase, and its legend entry in the lower right, where coverage-like
-// curves that rise to 1 leave room.
+// Each series' points (a marker each, up to 64, or always when unjoined, with its label), joined
+// by a line only when its x values increase, and its legend entry below the axes.
 void DrawSeries(cv::Mat& img, const std::vector<PlotSeries>& series, const PlotScale& scale) {
   constexpr std::size_t kMaxMarkers = 64;
-  int legend_y = kPlotHeight - kPlotBottom - 12 - 18 * (static_cast<int>(series.size()) - 1);
-  // The entries' text ends 8 pixels inside the plot's right edge, however long the longest.
-  int text_width = 0;
-  for (const auto& s : series) {
-    int baseline = 0;
-    text_width = std::max(
-        text_width, cv::getTextSize(s.name, cv::FONT_HERSHEY_SIMPLEX, 0.42, 1, &baseline).width);
-  }
-  const int text_x = std::max(kPlotLeft + 40, kPlotWidth - kPlotRight - 8 - text_width);
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  int legend_y = kPlotHeight + 8;
   for (const auto& s : series) {
     const bool joined = std::adjacent_find(s.x.begin(), s.x.end(),
                                            [](double a, double b) { return b <= a; }) == s.x.end();
@@ -343,18 +365,21 @@ void DrawSeries(cv::Mat& img, const std::vector<PlotSeries>& series, const PlotS
       const cv::Point p = scale.At(s.x[i], s.y[i]);
       if (s.x.size() <= kMaxMarkers || !joined) {
         cv::circle(img, p, 3, s.colour, cv::FILLED, cv::LINE_AA);
+        if (i < s.labels.size()) {
+          cv::putText(img, s.labels[i], {p.x + 5, p.y - 5}, font, 0.35, s.colour, 1, cv::LINE_AA);
+        }
       }
       if (i > 0 && joined) {
         cv::line(img, scale.At(s.x[i - 1], s.y[i - 1]), p, s.colour, 2, cv::LINE_AA);
       }
     }
+    const int text_x = kPlotLeft + 40;
     cv::circle(img, {text_x - 18, legend_y - 4}, 3, s.colour, cv::FILLED, cv::LINE_AA);
     if (joined) {
       cv::line(img, {text_x - 30, legend_y - 4}, {text_x - 5, legend_y - 4}, s.colour, 2);
     }
-    cv::putText(img, s.name, {text_x, legend_y}, cv::FONT_HERSHEY_SIMPLEX, 0.42,
-                cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-    legend_y += 18;
+    cv::putText(img, s.name, {text_x, legend_y}, font, 0.42, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    legend_y += kLegendRow;
   }
 }
 
@@ -362,9 +387,11 @@ void DrawSeries(cv::Mat& img, const std::vector<PlotSeries>& series, const PlotS
 
 cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
                        const std::string& y_label, const std::vector<PlotSeries>& series,
-                       bool log2_x, double y_min, std::optional<double> y_max) {
+                       bool log2_x, double y_min, std::optional<double> y_max,
+                       std::optional<std::pair<double, double>> x_range) {
   constexpr std::size_t kMaxValueTicks = 16;  // more x values: round ticks
-  cv::Mat img(kPlotHeight, kPlotWidth, CV_8UC3, cv::Scalar(255, 255, 255));
+  const int legend_height = kLegendRow * static_cast<int>(series.size()) + 8;
+  cv::Mat img(kPlotHeight + legend_height, kPlotWidth, CV_8UC3, cv::Scalar(255, 255, 255));
   std::vector<double> xs;
   double top = y_max.value_or(y_min);
   for (const auto& s : series) {
@@ -382,12 +409,15 @@ cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
   const double y_step = round.size() > 1 ? round[1] - round[0] : (top - y_min) / 4.0;
   if (!y_max) top = y_min + std::ceil((top - y_min) / y_step - 1e-9) * y_step;
   PlotScale scale{0.0, 1.0, y_min, top, log2_x};
-  scale.x0 = scale.Fx(xs.front());
-  scale.x1 = xs.size() > 1 ? scale.Fx(xs.back()) : scale.x0 + 1.0;
+  scale.x0 = scale.Fx(x_range ? x_range->first : xs.front());
+  scale.x1 = x_range         ? scale.Fx(x_range->second)
+             : xs.size() > 1 ? scale.Fx(xs.back())
+                             : scale.x0 + 1.0;
+  if (x_range) xs = {x_range->first, x_range->second};  // a continuous axis: round ticks
   const cv::Scalar black(0, 0, 0), grey(200, 200, 200);
   const int font = cv::FONT_HERSHEY_SIMPLEX;
   const int bottom = kPlotHeight - kPlotBottom;
-  for (double x : XTicks(xs, log2_x, kMaxValueTicks)) {
+  for (double x : XTicks(xs, log2_x, x_range ? 1 : kMaxValueTicks)) {
     const int u = scale.At(x, y_min).x;
     cv::line(img, {u, kPlotTop}, {u, bottom}, grey, 1);
     char text[32];
@@ -405,7 +435,16 @@ cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
     cv::putText(img, text, {8, v + 4}, font, 0.42, black, 1, cv::LINE_AA);
   }
   cv::rectangle(img, {kPlotLeft, kPlotTop}, {kPlotWidth - kPlotRight, bottom}, black, 1);
-  cv::putText(img, title, {kPlotLeft, 18}, font, 0.55, black, 1, cv::LINE_AA);
+  // The title at its size, or smaller until it fits the image.
+  double title_scale = 0.55;
+  int baseline = 0;
+  while (title_scale > 0.3 &&
+         cv::getTextSize(title, font, title_scale, 1, &baseline).width > kPlotWidth - 16) {
+    title_scale -= 0.05;
+  }
+  const int title_width = cv::getTextSize(title, font, title_scale, 1, &baseline).width;
+  cv::putText(img, title, {std::min(kPlotLeft, kPlotWidth - 8 - title_width), 18}, font,
+              title_scale, black, 1, cv::LINE_AA);
   cv::putText(img, x_label, {kPlotLeft + 180, kPlotHeight - 18}, font, 0.5, black, 1, cv::LINE_AA);
   cv::putText(img, y_label, {8, kPlotTop - 6}, font, 0.45, black, 1, cv::LINE_AA);
   DrawSeries(img, series, scale);

@@ -83,11 +83,17 @@ std::vector<ReportImage> MapTruthImages(const octomap::OcTree& map, const mappin
                                         const mapping::KeySet& observable,
                                         const mapping::KeySet& detector_ghosts,
                                         const Eigen::Vector3d& side_slice_m,
-                                        const std::string& name) {
+                                        const std::string& name,
+                                        const std::vector<Eigen::Vector3d>& sonar_path_m) {
   const MapCells cells = CollectMapCells(map);
   MapView top;
   top.resolution_m = map.getResolution();
   top.title = name + ": map against truth, from above";
+  for (const Eigen::Vector3d& p : sonar_path_m)
+    top.sonar.push_back(map.coordToKey(p.x(), p.y(), p.z()));
+  if (top.sonar.empty()) {
+    top.sonar.push_back(map.coordToKey(side_slice_m.x(), side_slice_m.y(), side_slice_m.z()));
+  }
   MapView side = top;
   side.kind = MapView::Kind::kSide;
   side.slab_key = map.coordToKey(side_slice_m.x(), side_slice_m.y(), side_slice_m.z())[1];

@@ -11,6 +11,7 @@
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/report/report_page.hpp"
+#include "sonarbench/sim/sonar/simulation.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -144,6 +145,15 @@ double TotalSeconds(const StageTimings& t) {
   return t.build_scene_s + t.simulate_s + t.map_s + t.ground_truth_s + t.score_s;
 }
 
+// Where the sonar was (the true path), every tenth beam: what the map views mark.
+std::vector<Eigen::Vector3d> SonarPath(const Scene& scene, std::size_t beams) {
+  std::vector<Eigen::Vector3d> path;
+  for (std::size_t b = 0; b < beams; b += 10) {
+    path.push_back(ScheduleBeam(scene, b).pose.T_world_sonar.translation());
+  }
+  return path;
+}
+
 std::vector<ReportImage> RenderImages(const Scene& scene, const ScenarioResult& result) {
   const std::string name = scene.name + ", seed " + std::to_string(result.seed);
   std::vector<ReportImage> images(2);
@@ -152,7 +162,8 @@ std::vector<ReportImage> RenderImages(const Scene& scene, const ScenarioResult& 
       [&] { images[1] = FanImage(result.first_sweep, name); },
       [&] {
         map_images = MapTruthImages(result.mapper->tree(), result.truth, result.observable,
-                                    result.detector_ghosts, result.sonar_start_m, name);
+                                    result.detector_ghosts, result.sonar_start_m, name,
+                                    SonarPath(scene, result.beams));
       },
       [&] { images[0] = PolarImage(result.first_sweep, name); }};
   RunTasks(result.threads, tasks);

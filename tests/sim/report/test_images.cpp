@@ -117,5 +117,55 @@ TEST(RenderMapView, TheDetectorsGhostsAreDrawnApartFromTheOtherFalsePositives) {
   EXPECT_EQ(CountColour(split, green), CountColour(plain, green));
 }
 
+// The sonar is marked where it was (a cross, yellow, listed in the legend); the scale bar goes
+// beside the map with the legend: the map's own pixels stay the cells' colours.
+TEST(RenderMapView, TheSonarIsMarkedAndTheScaleBarCoversNoCell) {
+  const auto key = [](int x, int y) {
+    return octomap::OcTreeKey(static_cast<octomap::key_type>(32768 + x),
+                              static_cast<octomap::key_type>(32768 + y), 32768);
+  };
+  MapCells map;
+  // A map filling its whole frame: every cell occupied, 40 x 40.
+  for (int x = 0; x < 40; ++x) {
+    for (int y = 0; y < 40; ++y) map.occupied.insert(key(x, y));
+  }
+  MapView top;
+  top.resolution_m = 0.05;
+  top.title = "test";
+  const cv::Mat bare = RenderMapView(map, {}, {}, top);
+  const cv::Vec3b white(255, 255, 255), yellow(0, 220, 255);
+  EXPECT_EQ(CountColour(bare, yellow), 0);
+  top.sonar.push_back(key(20, 20));
+  const cv::Mat marked = RenderMapView(map, {}, {}, top);
+  EXPECT_GT(CountColour(marked, yellow), 16);  // the cross and the legend's swatch
+  // The map is 800 pixels square at 20 per cell: every pixel but the cross's stays white
+  // (occupied), none black (a scale bar's) inside it.
+  int black = 0;
+  for (int r = 0; r < 800; ++r) {
+    for (int c = 0; c < 800; ++c) {
+      black += bare.at<cv::Vec3b>(46 + r, 78 + c) == cv::Vec3b(0, 0, 0);  // figure's frame
+    }
+  }
+  EXPECT_EQ(black, 0);
+  EXPECT_GT(CountColour(bare, white), 800 * 800 - 1);
+}
+
+// The legend lies below the axes (a row a series), so it covers no point; a point's label is
+// drawn beside it in the series' colour.
+TEST(RenderLinePlot, TheLegendIsBelowTheAxesAndPointsCarryTheirLabels) {
+  const PlotSeries a{"a", {200, 80, 0}, {0.1, 0.9}, {0.9, 0.9}};
+  PlotSeries b{"b", {30, 30, 220}, {0.5}, {0.5}};
+  const cv::Mat one = RenderLinePlot("t", "x", "y", {a}, false, 0.0, 1.0, std::pair{0.0, 1.0});
+  const cv::Mat two = RenderLinePlot("t", "x", "y", {a, b}, false, 0.0, 1.0, std::pair{0.0, 1.0});
+  EXPECT_EQ(two.rows - one.rows, 18);
+  const auto inked = [](const cv::Mat& image) {
+    return image.rows * image.cols - CountColour(image, cv::Vec3b(255, 255, 255));
+  };
+  b.labels = {"110"};
+  const cv::Mat labelled =
+      RenderLinePlot("t", "x", "y", {a, b}, false, 0.0, 1.0, std::pair{0.0, 1.0});
+  EXPECT_GT(inked(labelled), inked(two) + 20);
+}
+
 }  // namespace
 }  // namespace sonarbench::sim

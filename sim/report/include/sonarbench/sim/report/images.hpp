@@ -47,32 +47,39 @@ struct MapView {
   /// The cells' edge [m], for the axes and the scale bar (0: axes in cells).
   double resolution_m = 0.0;
   std::string title;
+  /// The cells the sonar was in, in time order: a cross marks the first, dots the rest.
+  std::vector<octomap::OcTreeKey> sonar;
 };
 
 /// Renders the map against the truth, whole pixels per cell with the longer side at least 800
 /// pixels: green where a pixel's cells hold a true positive, magenta where a false positive is
 /// one of `detector_ghosts` (and none is true), red where only other false positives, blue where
 /// observable truth the map missed, grey where only free cells, black unknown. With an empty
-/// `truth` (a real log), occupied cells are white. Framed with the view's title, axes in metres,
-/// a scale bar and a legend of the colours shown.
+/// `truth` (a real log), occupied cells are white; the sonar's cells in yellow. Framed with the
+/// view's title, axes in metres, and beside the map a legend of the colours shown and a scale bar.
 [[nodiscard]] cv::Mat RenderMapView(const MapCells& map, const mapping::KeySet& truth,
                                     const mapping::KeySet& observable, const MapView& view,
                                     const mapping::KeySet& detector_ghosts = {});
 
-/// One line of a plot: its legend name, colour (BGR) and points.
+/// One line of a plot: its legend name, colour (BGR), points and, optionally, a short label
+/// beside each point (a threshold, a rule).
 struct PlotSeries {
   std::string name;
   cv::Scalar colour;
   std::vector<double> x;
   std::vector<double> y;
+  std::vector<std::string> labels = {};
 };
 /// Renders a plot with axes, ticks at the x values of the series (log2 scale when `log2_x`; over
-/// 16 x values on a linear scale, about ten round ticks), a marker at each point of a series of
-/// up to 64, joined by a line only when its x values increase, five y ticks from `y_min` to the
-/// data's maximum (or `y_max` when it is set), a title, axis labels and a legend.
-[[nodiscard]] cv::Mat RenderLinePlot(const std::string& title, const std::string& x_label,
-                                     const std::string& y_label,
-                                     const std::vector<PlotSeries>& series, bool log2_x,
-                                     double y_min, std::optional<double> y_max = std::nullopt);
+/// 16 x values on a linear scale, or when `x_range` sets a continuous axis, about ten round
+/// ticks), a marker at each point of a series of up to 64 (with its label), joined by a line only
+/// when its x values increase, five y ticks from `y_min` to the data's maximum (or `y_max` when it
+/// is set), a title (made smaller until it fits), axis labels and the legend below the axes,
+/// where it covers no data.
+[[nodiscard]] cv::Mat RenderLinePlot(
+    const std::string& title, const std::string& x_label, const std::string& y_label,
+    const std::vector<PlotSeries>& series, bool log2_x, double y_min,
+    std::optional<double> y_max = std::nullopt,
+    std::optional<std::pair<double, double>> x_range = std::nullopt);
 
 }  // namespace sonarbench::sim
