@@ -2,7 +2,7 @@
 """Mutation testing of the mapping library and the scoring: do the tests catch a wrong mapper?
 
 Each mutant below is one operator or constant change to mapping/ (the OctoMap file reader in
-mapping/io/ included) or sim/eval/src/score.cpp and ground_truth.cpp. The
+io/ included) or sim/eval/src/score.cpp and ground_truth.cpp. The
 tool copies the source tree to WORK, builds it once, then applies the mutants one at a time,
 rebuilds and runs the suites that cover that code, fastest first, stopping at the first that
 fails. A mutant is killed when a suite fails (or runs past its timeout), survives when all pass.
@@ -110,25 +110,25 @@ MUTANTS = [
      "(cells.occupied.contains(key) && cells.free.contains(key))", None),
     ("score-within-k", "sim/eval/src/score.cpp",
      "for (int k = 1; k < 3; ++k)", "for (int k = 1; k < 2; ++k)", None),
-    ("octomap-depth", "mapping/io/src/octomap_file.cpp",
+    ("octomap-depth", "io/src/octomap_file.cpp",
      "if (depth > kTreeDepth) {", "if (depth > kTreeDepth + 1) {", None),
-    ("octomap-trailing", "mapping/io/src/octomap_file.cpp",
+    ("octomap-trailing", "io/src/octomap_file.cpp",
      "if (in.peek() != std::char_traits<char>::eof()) {", "if (false) {", None),
-    ("octomap-leaf-cells", "mapping/io/src/octomap_file.cpp",
+    ("octomap-leaf-cells", "io/src/octomap_file.cpp",
      "3 * (kTreeDepth - depth)", "3 * (kTreeDepth - depth - 1)", None),
-    ("octomap-inner-code", "mapping/io/src/octomap_file.cpp",
+    ("octomap-inner-code", "io/src/octomap_file.cpp",
      "inner[i] = code == 3;", "inner[i] = code == 2;", None),
-    ("mcap-chunk-crc", "mapping/io/src/mcap.cpp",
+    ("mcap-chunk-crc", "io/src/mcap.cpp",
      "if (crc != 0 && Crc32(plain) != crc)", "if (false && Crc32(plain) != crc)", None),
-    ("mcap-closing-magic", "mapping/io/src/mcap.cpp",
+    ("mcap-closing-magic", "io/src/mcap.cpp",
      "if (file_.size() - end != kMagicSize ||", "if (false &&", None),
-    ("mcap-summary-crc", "mapping/io/src/mcap.cpp",
+    ("mcap-summary-crc", "io/src/mcap.cpp",
      "crc_end = offset + 1 + 8 + 8 + 8;", "crc_end = offset + 1 + 8 + 8;", None),
-    ("rosbag-bins-equal", "mapping/io/src/rosbag.cpp",
+    ("rosbag-bins-equal", "io/src/rosbag.cpp",
      "> 1e-3 * d) {", "> 1e3 * d) {", None),
-    ("rosbag-interpolate", "mapping/io/src/rosbag.cpp",
+    ("rosbag-interpolate", "io/src/rosbag.cpp",
      "(1 - s) * a.translation()", "s * a.translation()", None),
-    ("rosbag-head-angle", "mapping/io/src/rosbag.cpp",
+    ("rosbag-head-angle", "io/src/rosbag.cpp",
      "if (a < 0.0) a += kTwoPi;", "if (a < -1.0) a += kTwoPi;", None),
     ("wedge-outer-cone", "mapping/src/beam_wedge.cpp",
      "std::tan(0.5 * sensor.beam_width_vertical_rad) / std::cos(a);",
