@@ -30,5 +30,5 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     name = rest.substr(0, eol);
     rest.remove_prefix(std::min(eol + 1, rest.size()));
   }
-  return fuzz::KeepsTheContract([&] { (void)mapping::ReadDataset(dir.string()); });
+  return fuzz::KeepsTheContract([&] { (void)io::ReadDataset(dir.string()); });
 }

@@ -8,5 +8,5 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto path = fuzz::ScratchDir() / "log.mat";
   fuzz::WriteBytes(path, fuzz::AsText(data, size));
   return fuzz::KeepsTheContract(
-      [&] { (void)mapping::ReadMatLog(path.string(), std::uint64_t{64} << 20); });
+      [&] { (void)io::ReadMatLog(path.string(), std::uint64_t{64} << 20); });
 }

@@ -8,7 +8,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto path = fuzz::ScratchDir() / "map.bt";
   fuzz::WriteBytes(path, fuzz::AsText(data, size));
   return fuzz::KeepsTheContract([&] {
-    const auto tree = mapping::ReadOcTreeFile(path.string(), 1e6);
+    const auto tree = io::ReadOcTreeFile(path.string(), 1e6);
     std::size_t occupied = 0;
     for (auto it = tree->begin_leafs(); it != tree->end_leafs(); ++it) {
       occupied += tree->isNodeOccupied(*it);

@@ -8,15 +8,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace sonarbench;
   const auto path = fuzz::ScratchDir() / "bag.mcap";
   fuzz::WriteBytes(path, fuzz::AsText(data, size));
-  mapping::RosbagReadOptions options;
+  io::RosbagReadOptions options;
   options.max_bytes = std::uint64_t{16} << 20;
-  const auto check = [](const mapping::RosbagBeams& read) {
+  const auto check = [](const io::RosbagBeams& read) {
     for (const mapping::Beam& beam : read.beams) {
       if (!(beam.bin_size_m > 0.0) || !(beam.head_angle_rad >= 0.0)) __builtin_trap();
     }
   };
   options.static_sonar = true;
-  fuzz::KeepsTheContract([&] { check(mapping::ReadRosbag(path.string(), options)); });
+  fuzz::KeepsTheContract([&] { check(io::ReadRosbag(path.string(), options)); });
   options.static_sonar = false;
-  return fuzz::KeepsTheContract([&] { check(mapping::ReadRosbag(path.string(), options)); });
+  return fuzz::KeepsTheContract([&] { check(io::ReadRosbag(path.string(), options)); });
 }

@@ -17,7 +17,7 @@
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
 namespace {
 
 static_assert(std::endian::native == std::endian::little,
@@ -177,11 +177,11 @@ std::string Sha256OfFile(const std::string& path) {
 }
 
 nlohmann::json SensorGeometryJson(const SensorGeometry& g) {
-  return {{"beam_width_horizontal_deg", g.beam_width_horizontal_rad / kDegToRad},
-          {"beam_width_vertical_deg", g.beam_width_vertical_rad / kDegToRad},
+  return {{"beam_width_horizontal_deg", g.beam_width_horizontal_rad / mapping::kDegToRad},
+          {"beam_width_vertical_deg", g.beam_width_vertical_rad / mapping::kDegToRad},
           {"num_bins", g.num_bins},
           {"bin_size_m", g.bin_size_m},
-          {"step_angle_deg", g.step_angle_rad / kDegToRad},
+          {"step_angle_deg", g.step_angle_rad / mapping::kDegToRad},
           {"beams_per_second", g.beams_per_second},
           {"self_reflection_range_m", g.self_reflection_range_m}};
 }
@@ -280,4 +280,4 @@ Dataset ReadDataset(const std::string& dir) {
   return dataset;
 }
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

@@ -3,7 +3,7 @@
 #include <array>
 #include <string>
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
 
 const char* IntegrationName(Integration integration) {
   return integration == Integration::kExact ? "exact" : "rays";
@@ -99,9 +99,9 @@ MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
 
 SensorGeometry ReadSensorGeometry(YamlReader& node) {
   SensorGeometry g;
-  double width_h_deg = g.beam_width_horizontal_rad / kDegToRad;
-  double width_v_deg = g.beam_width_vertical_rad / kDegToRad;
-  double step_deg = g.step_angle_rad / kDegToRad;
+  double width_h_deg = g.beam_width_horizontal_rad / mapping::kDegToRad;
+  double width_v_deg = g.beam_width_vertical_rad / mapping::kDegToRad;
+  double step_deg = g.step_angle_rad / mapping::kDegToRad;
   node.Required("beam_width_horizontal_deg", width_h_deg, InRange(0.1, 90.0));
   node.Required("beam_width_vertical_deg", width_v_deg, InRange(0.1, 90.0));
   node.Required("num_bins", g.num_bins, IntInRange(1, 100000));
@@ -115,18 +115,18 @@ SensorGeometry ReadSensorGeometry(YamlReader& node) {
     mounting->Optional("position_m", position);
     mounting->Optional("rpy_deg", rpy_deg);
     mounting->RejectUnknownKeys();
-    g.T_vehicle_sonar =
-        PoseFromXyzRpy({position[0], position[1], position[2]},
-                       Eigen::Vector3d(rpy_deg[0], rpy_deg[1], rpy_deg[2]) * kDegToRad);
+    g.T_vehicle_sonar = mapping::PoseFromXyzRpy(
+        {position[0], position[1], position[2]},
+        Eigen::Vector3d(rpy_deg[0], rpy_deg[1], rpy_deg[2]) * mapping::kDegToRad);
   }
   node.RejectUnknownKeys();
-  g.beam_width_horizontal_rad = width_h_deg * kDegToRad;
-  g.beam_width_vertical_rad = width_v_deg * kDegToRad;
-  g.step_angle_rad = step_deg * kDegToRad;
+  g.beam_width_horizontal_rad = width_h_deg * mapping::kDegToRad;
+  g.beam_width_vertical_rad = width_v_deg * mapping::kDegToRad;
+  g.step_angle_rad = step_deg * mapping::kDegToRad;
   if (g.self_reflection_range_m >= g.MaxRangeM()) {
     node.Fail("self_reflection_range_m", "a range below num_bins * bin_size_m");
   }
   return g;
 }
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

@@ -16,7 +16,7 @@
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
 namespace {
 
 constexpr const char* kNoParsedData =
@@ -119,7 +119,7 @@ MatLog ReadBeams(const std::string& path, std::size_t count, const FieldOf& fiel
   for (std::size_t i = 0; i < count; ++i) {
     Beam beam;
     beam.time_s = scalar(i, "time");
-    beam.head_angle_rad = scalar(i, "angle") * kDegToRad;
+    beam.head_angle_rad = scalar(i, "angle") * mapping::kDegToRad;
     beam.bin_size_m = scalar(i, "step_dist");
     if (beam.bin_size_m <= 0.0) {
       throw fail("beam " + std::to_string(i) + ", field 'step_dist': expected a range > 0 m");
@@ -183,4 +183,4 @@ MatLog ReadMatLog(const std::string& path, std::uint64_t max_bytes) {
   });
 }
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

@@ -12,7 +12,7 @@
 
 #include "sonarbench/mapping/atomic_file.hpp"
 
-namespace sonarbench::mapping::mat_v5 {
+namespace sonarbench::io::mat_v5 {
 namespace {
 
 // The bytes of one value of a MAT data type (miINT8 ... miUINT64, miUTF8..32); 0 for others.
@@ -418,4 +418,4 @@ std::optional<StructArray> ReadStructArray(std::string variable, const Fail& fai
   return Walker(fail).Struct(std::move(variable));
 }
 
-}  // namespace sonarbench::mapping::mat_v5
+}  // namespace sonarbench::io::mat_v5

@@ -12,7 +12,7 @@
 
 #include "sonarbench/mapping/error.hpp"
 
-namespace sonarbench::mapping::mat_v5 {
+namespace sonarbench::io::mat_v5 {
 
 using Fail = std::function<InputError(const std::string&)>;
 
@@ -60,4 +60,4 @@ struct StructArray {
 /// A struct array variable (one CheckFile returned) read in place; nullopt for another class.
 [[nodiscard]] std::optional<StructArray> ReadStructArray(std::string variable, const Fail& fail);
 
-}  // namespace sonarbench::mapping::mat_v5
+}  // namespace sonarbench::io::mat_v5

@@ -14,7 +14,7 @@
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
 namespace {
 
 constexpr std::size_t kMagicSize = 8;
@@ -479,4 +479,4 @@ McapFile ReadMcap(const std::string& path, std::uint64_t max_bytes) {
   return Reader(path, max_bytes).Read();
 }
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

@@ -9,7 +9,7 @@
 
 #include "sonarbench/mapping/error.hpp"
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
 namespace {
 
 constexpr int kTreeDepth = 16;          // OctoMap's levels below the root
@@ -254,4 +254,4 @@ std::unique_ptr<octomap::OcTree> ReadOcTreeFile(const std::string& path, double 
   return tree;
 }
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

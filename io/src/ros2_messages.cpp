@@ -6,7 +6,7 @@
 
 #include "sonarbench/mapping/error.hpp"
 
-namespace sonarbench::mapping::ros2 {
+namespace sonarbench::io::ros2 {
 namespace {
 
 // CDR (XCDR1, little-endian): a 4-byte encapsulation header, then each primitive aligned to its
@@ -255,4 +255,4 @@ std::vector<TransformStamped> DecodeTfMessage(std::string_view cdr, const std::s
   return transforms;
 }
 
-}  // namespace sonarbench::mapping::ros2
+}  // namespace sonarbench::io::ros2

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-namespace sonarbench::mapping::ros2 {
+namespace sonarbench::io::ros2 {
 
 struct Header {
   std::int32_t sec = 0;
@@ -56,4 +56,4 @@ inline constexpr const char* kPoseStamped = "geometry_msgs/msg/PoseStamped";
 /// The `ros2msg` definition of `type` (one of the three above) with its dependencies.
 [[nodiscard]] std::string Definition(const std::string& type);
 
-}  // namespace sonarbench::mapping::ros2
+}  // namespace sonarbench::io::ros2

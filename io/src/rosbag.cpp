@@ -10,7 +10,7 @@
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/mapping/error.hpp"
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
 namespace {
 
 constexpr const char* kWorldFrame = "map";
@@ -49,7 +49,7 @@ ros2::ProjectedSonarImage ImageMessage(const Beam& beam, const RosbagContent& ba
   m.sound_speed = bag.sound_speed_m_s;
   m.tx_beamwidths = {static_cast<float>(bag.sensor.beam_width_vertical_rad)};
   m.rx_beamwidths = {static_cast<float>(bag.sensor.beam_width_horizontal_rad)};
-  m.beam_directions = {SonarRayDirection(beam.head_angle_rad, 0.0)};
+  m.beam_directions = {mapping::SonarRayDirection(beam.head_angle_rad, 0.0)};
   for (std::size_t k = 0; k < beam.intensities.size(); ++k) {
     m.ranges.push_back(static_cast<float>(beam.BinCentreRange(k)));
   }
@@ -210,8 +210,9 @@ double HeadAngle(const Eigen::Vector3d& d) {
 void CheckWidth(const std::vector<float>& widths, double expected, const char* field,
                 const std::string& where) {
   if (!widths.empty() && !(std::abs(widths[0] - expected) <= kWidthTolerance)) {
-    throw InputError(where + "ping_info." + field + " is " + std::to_string(widths[0] / kDegToRad) +
-                     "°; the sensor model's is " + std::to_string(expected / kDegToRad) +
+    throw InputError(where + "ping_info." + field + " is " +
+                     std::to_string(widths[0] / mapping::kDegToRad) + "°; the sensor model's is " +
+                     std::to_string(expected / mapping::kDegToRad) +
                      "° (pass --sensor with this sonar's model)");
   }
 }
@@ -377,4 +378,4 @@ RosbagBeams ReadRosbag(const std::string& path, const RosbagReadOptions& options
   return Counted(std::move(out), options.sensor);
 }
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

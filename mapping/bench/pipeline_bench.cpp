@@ -261,7 +261,7 @@ void PrintTimes(const std::vector<Variant>& variants, const std::vector<double>&
 }
 
 // The whole mapper with each key set, and in exact mode, against the naive pipeline (Table 1).
-int PipelineTable(const MatLog& log, const SensorGeometry& sensor, const MapperConfig& config,
+int PipelineTable(const io::MatLog& log, const SensorGeometry& sensor, const MapperConfig& config,
                   int cores, int repeats, bool exact_only) {
   BatchStats totals;
   BatchStats exact_totals;
@@ -325,8 +325,8 @@ int PipelineTable(const MatLog& log, const SensorGeometry& sensor, const MapperC
 }
 
 // The key sets' work inside the mapper, replayed alone.
-int SetTable(const MatLog& log, const SensorGeometry& sensor, const MapperConfig& config, int cores,
-             int repeats) {
+int SetTable(const io::MatLog& log, const SensorGeometry& sensor, const MapperConfig& config,
+             int cores, int repeats) {
   const auto streams = RecordSetStreams(log.beams, sensor, config, cores);
   std::size_t inserts = 0;
   std::size_t batches = 0;
@@ -397,7 +397,7 @@ int Main(int argc, char** argv) {
       return 2;
     }
   }
-  const MatLog log = ReadMatLog(path);
+  const io::MatLog log = io::ReadMatLog(path);
   const SensorGeometry sensor;
   const int cores = omp_get_max_threads();
   std::printf("log %s: %zu beams; resolution %.3f m; %d x %d rays per beam; %d cores\n",

@@ -28,11 +28,11 @@ TEST(BeamFile, RoundTripsAndRejectsDamage) {
   beams[1].time_s = 1.5;
   beams[1].bin_size_m = 0.0125;  // no bins: a beam cut short
   std::stringstream file;
-  mapping::WriteBeamFile(file, beams);
+  io::WriteBeamFile(file, beams);
   const std::string bytes = file.str();
   EXPECT_EQ(bytes.size(), 8u + 4u + 2 * (3 * 8u + 4u) + 3u);
   std::istringstream in(bytes);
-  const auto back = mapping::ReadBeamFile(in, "f.bin");
+  const auto back = io::ReadBeamFile(in, "f.bin");
   ASSERT_EQ(back.size(), 2u);
   EXPECT_EQ(back[0].time_s, 1.25);
   EXPECT_EQ(back[0].head_angle_rad, 0.5);
@@ -41,36 +41,34 @@ TEST(BeamFile, RoundTripsAndRejectsDamage) {
 
   std::istringstream truncated(bytes.substr(0, bytes.size() - 1));
   EXPECT_NE(test::InputErrorOf([&] {
-              (void)mapping::ReadBeamFile(truncated, "f.bin");
+              (void)io::ReadBeamFile(truncated, "f.bin");
             }).find("f.bin: truncated in the header of beam 1"),
             std::string::npos);
   std::istringstream trailing(bytes + "x");
-  EXPECT_NE(test::InputErrorOf([&] {
-              (void)mapping::ReadBeamFile(trailing, "f.bin");
-            }).find("bytes after"),
-            std::string::npos);
-  std::istringstream wrong("PNG....");
   EXPECT_NE(
-      test::InputErrorOf([&] { (void)mapping::ReadBeamFile(wrong, "f.bin"); }).find("SBBEAMS1"),
+      test::InputErrorOf([&] { (void)io::ReadBeamFile(trailing, "f.bin"); }).find("bytes after"),
       std::string::npos);
+  std::istringstream wrong("PNG....");
+  EXPECT_NE(test::InputErrorOf([&] { (void)io::ReadBeamFile(wrong, "f.bin"); }).find("SBBEAMS1"),
+            std::string::npos);
 }
 
 // A manifest without its list of files is bad input, named as such, like every other key.
 TEST(Dataset, AManifestWithoutItsListOfFilesIsRefused) {
   test::TempDir dir;
-  nlohmann::json manifest = {{"format", mapping::kDatasetFormat},
-                             {"schema_version", mapping::kDatasetSchemaVersion},
+  nlohmann::json manifest = {{"format", io::kDatasetFormat},
+                             {"schema_version", io::kDatasetSchemaVersion},
                              {"sweeps", 0},
-                             {"sensor", mapping::SensorGeometryJson(mapping::SensorGeometry{})}};
+                             {"sensor", io::SensorGeometryJson(mapping::SensorGeometry{})}};
   for (const nlohmann::json& files : {nlohmann::json(), nlohmann::json::object()}) {
     if (!files.is_null()) manifest["files"] = files;
     const std::string path = test::WriteFile(dir, "manifest.json", manifest.dump());
-    EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadDataset(dir.path().string()); }),
+    EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadDataset(dir.path().string()); }),
               path + ": key 'files': expected a list of {path, sha256, bytes}");
   }
   // A number past a double's range is bad JSON as a syntax error is.
   const std::string path = test::WriteFile(dir, "manifest.json", R"({"sweeps": 1e999})");
-  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadDataset(dir.path().string()); }),
+  EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadDataset(dir.path().string()); }),
             path +
                 ": not valid JSON: [json.exception.out_of_range.406] number overflow parsing "
                 "'1e999'");
@@ -78,39 +76,36 @@ TEST(Dataset, AManifestWithoutItsListOfFilesIsRefused) {
   test::WriteFile(dir, "manifest.json", manifest.dump());
   fs::create_directories(dir.path() / "poses");
   test::WriteFile(dir, "poses/sonar.tum", "");
-  EXPECT_TRUE(mapping::ReadDataset(dir.path().string()).beams.empty());
+  EXPECT_TRUE(io::ReadDataset(dir.path().string()).beams.empty());
 }
 
 TEST(Tum, RoundTripsAPoseAndNamesTheBadLine) {
   test::TempDir dir;
   Eigen::Isometry3d pose = mapping::PoseFromXyzRpy({1, -2, 0.5}, {0.1, -0.2, 2.5});
   const auto path = dir.path() / "p.tum";
-  std::ofstream(path) << "# comment\n" << mapping::TumLine(3.5, pose);
-  const auto back = mapping::ReadTum(path.string());
+  std::ofstream(path) << "# comment\n" << io::TumLine(3.5, pose);
+  const auto back = io::ReadTum(path.string());
   ASSERT_EQ(back.size(), 1u);
   EXPECT_EQ(back[0].time_s, 3.5);
   EXPECT_TRUE(back[0].pose.isApprox(pose, 1e-8));
-  std::ofstream(path) << mapping::TumLine(0, pose) << "1 2 3\n";
-  EXPECT_NE(test::InputErrorOf([&] {
-              (void)mapping::ReadTum(path.string());
-            }).find("p.tum:2: expected 8"),
-            std::string::npos);
+  std::ofstream(path) << io::TumLine(0, pose) << "1 2 3\n";
+  EXPECT_NE(
+      test::InputErrorOf([&] { (void)io::ReadTum(path.string()); }).find("p.tum:2: expected 8"),
+      std::string::npos);
   // A damaged line is quoted printable and short: its bytes as \xNN, cut after 80.
   std::ofstream(path) << "0 0.1 0.4\xfa" << std::string(5000, '7') << "\n";
-  const std::string damaged = test::InputErrorOf([&] { (void)mapping::ReadTum(path.string()); });
+  const std::string damaged = test::InputErrorOf([&] { (void)io::ReadTum(path.string()); });
   EXPECT_NE(damaged.find("got '0 0.1 0.4\\xfa777"), std::string::npos) << damaged;
   EXPECT_NE(damaged.find("7777'..."), std::string::npos) << damaged;
   EXPECT_LT(damaged.size(), path.string().size() + 200) << damaged;
   std::ofstream(path) << "0 0 0 0 0 0 0 2\n";
-  EXPECT_NE(test::InputErrorOf([&] { (void)mapping::ReadTum(path.string()); }).find("norm"),
+  EXPECT_NE(test::InputErrorOf([&] { (void)io::ReadTum(path.string()); }).find("norm"),
             std::string::npos);
 }
 
 TEST(Sha256, MatchesFips180Vectors) {
-  EXPECT_EQ(mapping::Sha256("abc"),
-            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
-  EXPECT_EQ(mapping::Sha256(""),
-            "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(io::Sha256("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(io::Sha256(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
 }
 
 }  // namespace

@@ -52,7 +52,7 @@ TEST(MatLog, CorruptOrMissingFilesAreClearErrors) {
   std::ofstream(garbage) << "MATLAB 5.0 MAT-file, but not really";
   for (const std::string& path : {garbage, (dir.path() / "absent.mat").string()}) {
     try {
-      (void)mapping::ReadMatLog(path);
+      (void)io::ReadMatLog(path);
       ADD_FAILURE() << "no error for " << path;
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
@@ -65,7 +65,7 @@ TEST(MatLog, TruncatedCopyOfTheRealLogIsAClearError) {
   test::TempDir dir;
   const std::string cut = (dir.path() / "cut.mat").string();
   WriteChangedRealLog(cut, [](std::vector<char>& bytes) { bytes.resize(bytes.size() / 2); });
-  EXPECT_THROW((void)mapping::ReadMatLog(cut), InputError);
+  EXPECT_THROW((void)io::ReadMatLog(cut), InputError);
 }
 
 // One byte changed inside the compressed log, found by flipping bytes: at offset 299 libmatio sized
@@ -82,7 +82,7 @@ TEST(MatLog, CorruptCopiesOfTheRealLogAreClearErrors) {
       ASSERT_EQ(static_cast<unsigned char>(bytes.at(at)), before);
       bytes[at] = static_cast<char>(after);
     });
-    EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(bad); }),
+    EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadMatLog(bad); }),
               bad + ": a corrupt MAT file (a compressed element does not inflate whole)");
   }
 }
@@ -127,7 +127,7 @@ TEST(MatLog, WhatLibmatioWritesIsRead) {
     Mat_VarWrite(mat, data, compression);
     Mat_VarFree(data);
     Mat_Close(mat);
-    const mapping::MatLog log = mapping::ReadMatLog(path);
+    const io::MatLog log = io::ReadMatLog(path);
     ASSERT_EQ(log.beams.size(), 2u);
     EXPECT_EQ(log.beams[1].intensities, (std::vector<std::uint8_t>{0, 10, 20, 30, 255}));
     EXPECT_DOUBLE_EQ(log.beams[1].head_angle_rad, 1.8 * std::numbers::pi / 180.0);
@@ -137,7 +137,7 @@ TEST(MatLog, WhatLibmatioWritesIsRead) {
 // A v5 log is read without libmatio: every beam as libmatio reads it from the real log.
 TEST(MatLog, TheRealLogReadsAsLibmatioReadsIt) {
   REQUIRE_REAL_LOG();
-  const mapping::MatLog log = mapping::ReadMatLog(RealLogPath());
+  const io::MatLog log = io::ReadMatLog(RealLogPath());
   mat_t* mat = Mat_Open(RealLogPath().c_str(), MAT_ACC_RDONLY);
   ASSERT_NE(mat, nullptr);
   matvar_t* data = Mat_VarRead(mat, "parsedData");
@@ -210,7 +210,7 @@ TEST(MatLog, FieldsOfAnyRealNumericClassAreRead) {
   WriteLog(path, {Mat_VarCreate(nullptr, MAT_C_UINT8, MAT_T_UINT8, 2, three, u8, 0),
                   Mat_VarCreate(nullptr, MAT_C_INT16, MAT_T_INT16, 2, three, i16, 0),
                   Mat_VarCreate(nullptr, MAT_C_SINGLE, MAT_T_SINGLE, 2, three, single, 0)});
-  const mapping::MatLog log = mapping::ReadMatLog(path);
+  const io::MatLog log = io::ReadMatLog(path);
   ASSERT_EQ(log.beams.size(), 3u);
   EXPECT_EQ(log.beams[0].intensities, (std::vector<std::uint8_t>{0, 128, 255}));
   EXPECT_EQ(log.beams[1].intensities, (std::vector<std::uint8_t>{1, 2, 255}));
@@ -229,13 +229,13 @@ TEST(MatLog, AFieldMissingOrOutOfRangeIsNamedWithItsBeam) {
   double low[2] = {1.0, 2.0};
   auto u16 = [&] { return Mat_VarCreate(nullptr, MAT_C_UINT16, MAT_T_UINT16, 2, two, high, 0); };
   WriteLog(path, {Mat_VarCreate(nullptr, MAT_C_DOUBLE, MAT_T_DOUBLE, 2, two, low, 0), u16()});
-  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+  EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadMatLog(path); }),
             path + ": beam 1, field 'intensities', bin 1: expected an integer in 0..255");
   WriteLog(path, {Mat_VarCreate(nullptr, MAT_C_INT64, MAT_T_INT64, 2, two, wide, 0)});
-  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+  EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadMatLog(path); }),
             path + ": beam 0, field 'intensities', bin 0: expected an integer in 0..255");
   WriteLog(path, {u16()}, {"time", "step_dist", "intensities"});
-  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+  EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadMatLog(path); }),
             path + ": beam 0, field 'angle': missing");
 }
 
@@ -251,7 +251,7 @@ TEST(MatLog, AStructArrayWithoutFieldsIsRefused) {
   Mat_VarFree(data);
   Mat_Close(mat);
   EXPECT_EQ(
-      test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+      test::InputErrorOf([&] { (void)io::ReadMatLog(path); }),
       path + ": 'parsedData' has no fields (expected time, angle, step_dist and intensities)");
 }
 
@@ -263,7 +263,7 @@ TEST(MatLog, AFileWithoutAV5OrV73HeaderNeverReachesLibmatio) {
   shifted += "MATLAB 5.0 MAT-file";
   shifted.resize(164, ' ');
   const std::string path = test::WriteFile(dir, "shifted.mat", shifted);
-  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+  EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadMatLog(path); }),
             path +
                 ": not a MAT v5 or v7.3 file (no MAT header in its first 128 bytes; expected "
                 "the .mat log of pings)");
@@ -271,7 +271,7 @@ TEST(MatLog, AFileWithoutAV5OrV73HeaderNeverReachesLibmatio) {
   big_endian.replace(0, 10, "MATLAB 5.0");
   big_endian.replace(124, 4, std::string("\x01\0MI", 4));
   test::WriteFile(dir, "shifted.mat", big_endian);
-  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+  EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadMatLog(path); }),
             path + ": a big-endian MAT file (expected a little-endian v5 or v7.3 .mat log)");
 }
 
@@ -292,13 +292,13 @@ TEST(MatLog, AnArrayLargerThanItsBytesIsRefused) {
   u32(9), u32(8), mat += std::string("\0\0\0\0\0\0\xf0\x3f", 8);  // one double, 1.0
   const std::string path = test::WriteFile(dir, "huge.mat", mat);
   EXPECT_EQ(
-      test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+      test::InputErrorOf([&] { (void)io::ReadMatLog(path); }),
       path + ": a corrupt MAT file (an array of 2000000000 elements holds 8 bytes of values)");
   // A sparse array is refused before libmatio sizes it by its nonzero count.
   std::string sparse = mat;
   sparse[128 + 8 + 8] = '\x05';
   test::WriteFile(dir, "huge.mat", sparse);
-  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+  EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadMatLog(path); }),
             path +
                 ": a corrupt MAT file (an array of class 5 (expected cell, struct, char or "
                 "numeric arrays))");
@@ -308,12 +308,12 @@ TEST(MatLog, AnArrayLargerThanItsBytesIsRefused) {
   chars.replace(128 + 8 + 16 + 8 + 4, 4, std::string("\x02\0\0\0", 4));  // 1 x 2 characters
   chars.replace(128 + 8 + 16 + 16 + 24, 8, std::string("\x05\0\0\0\0\0\0\x6c", 8));
   test::WriteFile(dir, "huge.mat", chars);
-  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+  EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadMatLog(path); }),
             path + ": a corrupt MAT file (an element states 1811939328 bytes where 8 are left)");
   // The same file stating the one element it holds is read as far as its layout: not a struct.
   mat.replace(128 + 8 + 16 + 8 + 4, 4, std::string("\x01\0\0\0", 4));
   test::WriteFile(dir, "huge.mat", mat);
-  EXPECT_EQ(test::InputErrorOf([&] { (void)mapping::ReadMatLog(path); }),
+  EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadMatLog(path); }),
             path + ": 'parsedData' is not a struct array");
 }
 
@@ -337,13 +337,13 @@ TEST(MatLog, ACompressedElementPastTheBudgetIsRefusedBeforeItIsInflated) {
   mat += packed;
   const std::string path = test::WriteFile(dir, "bomb.mat", mat);
   EXPECT_TRUE(test::ThrowsInputErrorWith(
-      [&] { (void)mapping::ReadMatLog(path, std::uint64_t{2} << 20); },
+      [&] { (void)io::ReadMatLog(path, std::uint64_t{2} << 20); },
       {"bomb.mat: a corrupt MAT file (its compressed elements inflate to more than the"}));
   EXPECT_FALSE(test::InputErrorOf([&] {
-                 (void)mapping::ReadMatLog(path, std::uint64_t{8} << 20);
+                 (void)io::ReadMatLog(path, std::uint64_t{8} << 20);
                }).find("inflate to more than") != std::string::npos);
   EXPECT_TRUE(test::ThrowsInputErrorWith(
-      [&] { (void)mapping::ReadMatLog(path, 1000); },
+      [&] { (void)io::ReadMatLog(path, 1000); },
       {"bomb.mat: holds", "more than the 1000 bytes sonarbench reads from such a file"}));
 }
 

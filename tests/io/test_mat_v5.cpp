@@ -5,7 +5,7 @@
 
 #include "mat_v5.hpp"
 
-namespace sonarbench::mapping::mat_v5 {
+namespace sonarbench::io::mat_v5 {
 namespace {
 
 // StoredBytes hands out uint8-stored values exactly when NumericAt reads each of them back as
@@ -35,4 +35,4 @@ TEST(MatV5, StoredBytesAreWhatNumericAtReadsOrNothing) {
 }
 
 }  // namespace
-}  // namespace sonarbench::mapping::mat_v5
+}  // namespace sonarbench::io::mat_v5

@@ -20,7 +20,7 @@ constexpr std::uint64_t kNoLimit = std::uint64_t{1} << 40;
 
 // A bag of 30 beams of 399 bins (with their /tf and true poses): one chunk, about 50 kB.
 std::string Written(const test::TempDir& dir) {
-  mapping::RosbagContent bag;
+  io::RosbagContent bag;
   for (int b = 0; b < 30; ++b) {
     mapping::Beam beam;
     beam.time_s = b * 0.1;
@@ -31,7 +31,7 @@ std::string Written(const test::TempDir& dir) {
     bag.true_vehicle.push_back(Eigen::Isometry3d::Identity());
   }
   std::ostringstream out;
-  mapping::WriteRosbag(out, bag, "sonarbench test");
+  io::WriteRosbag(out, bag, "sonarbench test");
   return test::WriteFile(dir, "bag.mcap", out.str());
 }
 
@@ -89,9 +89,8 @@ TEST(Mcap, ReadsZstdChunks) {
     file += plain.substr(next, 9 + n);
     next += 9 + n;
   }
-  file += std::string("\x02\x14\0\0\0\0\0\0\0", 9) + std::string(20, '\0') + mapping::kMcapMagic;
-  const mapping::McapFile read =
-      mapping::ReadMcap(test::WriteFile(dir, "zstd.mcap", file), kNoLimit);
+  file += std::string("\x02\x14\0\0\0\0\0\0\0", 9) + std::string(20, '\0') + io::kMcapMagic;
+  const io::McapFile read = io::ReadMcap(test::WriteFile(dir, "zstd.mcap", file), kNoLimit);
   EXPECT_FALSE(read.has_summary);
   EXPECT_EQ(read.messages.size(), 1U + 3U * 30U);  // /tf_static, then /tf, image, truth a beam
 }
@@ -101,8 +100,7 @@ TEST(Mcap, RefusesDamagedFilesNamingTheByte) {
   const std::string good = ReadFileBytes(Written(dir), kMaxLogBytes);
   const auto bad = [&](const std::string& bytes, const std::vector<std::string>& parts) {
     const std::string path = test::WriteFile(dir, "bad.mcap", bytes);
-    EXPECT_TRUE(
-        test::ThrowsInputErrorWith([&] { (void)mapping::ReadMcap(path, kNoLimit); }, parts));
+    EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)io::ReadMcap(path, kNoLimit); }, parts));
   };
   bad("PK\x03\x04 not a bag", {"bad.mcap", "not an MCAP file"});
   bad(good.substr(0, good.size() - 8), {"closing magic"});
@@ -117,14 +115,14 @@ TEST(Mcap, RefusesDamagedFilesNamingTheByte) {
   // Every cut of the file is refused with a message, none crashes.
   for (std::size_t n = 0; n < good.size(); n += 997) {
     const std::string path = test::WriteFile(dir, "cut.mcap", good.substr(0, n));
-    EXPECT_THROW((void)mapping::ReadMcap(path, kNoLimit), InputError) << n;
+    EXPECT_THROW((void)io::ReadMcap(path, kNoLimit), InputError) << n;
   }
 }
 
 TEST(Mcap, RefusesAFileLargerThanTheLimitBeforeReadingIt) {
   const test::TempDir dir;
   const std::string path = Written(dir);
-  EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)mapping::ReadMcap(path, 1000); },
+  EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)io::ReadMcap(path, 1000); },
                                          {"bag.mcap", "more than the 1000 bytes"}));
 }
 

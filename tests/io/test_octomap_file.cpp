@@ -65,7 +65,7 @@ std::string FullBytes(const octomap::OcTree& tree) {
 // A .bt file of `size` nodes whose data is `data`.
 std::string BinaryFile(const std::string& size, const std::string& data,
                        const std::string& id = "OcTree", const std::string& res = "0.05") {
-  return std::string(mapping::kOcTreeBinaryHeader) + "\n# comment\nid " + id + "\nsize " + size +
+  return std::string(io::kOcTreeBinaryHeader) + "\n# comment\nid " + id + "\nsize " + size +
          "\nres " + res + "\ndata\n" + data;
 }
 
@@ -74,7 +74,7 @@ std::string ErrorReading(const std::string& bytes, double max_cells = kNoBudget)
   test::TempDir dir;
   const std::string path = test::WriteFile(dir, "map.bt", bytes);
   try {
-    (void)mapping::ReadOcTreeFile(path, max_cells);
+    (void)io::ReadOcTreeFile(path, max_cells);
   } catch (const InputError& e) {
     const std::string message = e.what();
     EXPECT_NE(message.find(path), std::string::npos) << message;
@@ -94,8 +94,8 @@ TEST(OcTreeFile, BothFormatsReadBackTheTreeOctomapWrote) {
        {std::pair{"bt", BinaryBytes(tree)}, std::pair{"ot", FullBytes(tree)}}) {
     test::TempDir dir;
     const std::string path = test::WriteFile(dir, std::string("map.") + format, bytes);
-    mapping::OcTreeFileInfo info;
-    const auto read = mapping::ReadOcTreeFile(path, kNoBudget, &info);
+    io::OcTreeFileInfo info;
+    const auto read = io::ReadOcTreeFile(path, kNoBudget, &info);
     EXPECT_EQ(info.format, format);
     EXPECT_EQ(info.tree_type, "OcTree");
     EXPECT_DOUBLE_EQ(info.resolution_m, 0.05);
@@ -110,10 +110,10 @@ TEST(OcTreeFile, BothFormatsReadBackTheTreeOctomapWrote) {
 TEST(OcTreeFile, TheFuzzSeedsHoldTheSameTreeInBothFormats) {
   for (const std::string name : {"wall", "one_cell"}) {
     const std::string seed = test::SourcePath("fuzz/corpus/octomap/" + name);
-    mapping::OcTreeFileInfo bt;
-    mapping::OcTreeFileInfo ot;
-    const auto binary = mapping::ReadOcTreeFile(seed + ".bt", kNoBudget, &bt);
-    const auto full = mapping::ReadOcTreeFile(seed + ".ot", kNoBudget, &ot);
+    io::OcTreeFileInfo bt;
+    io::OcTreeFileInfo ot;
+    const auto binary = io::ReadOcTreeFile(seed + ".bt", kNoBudget, &bt);
+    const auto full = io::ReadOcTreeFile(seed + ".ot", kNoBudget, &ot);
     EXPECT_EQ(Leaves(*binary), Leaves(*full)) << name;
     EXPECT_EQ(bt.nodes, ot.nodes);
     EXPECT_GT(bt.leaf_cells, 0.0);
@@ -137,7 +137,7 @@ TEST(OcTreeFile, BadFilesAreClearErrors) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::memcpy(nan_node.data(), &nan, sizeof nan);
   const std::string full_header =
-      std::string(mapping::kOcTreeFullHeader) + "\nid OcTree\nsize 1\nres 0.05\ndata\n";
+      std::string(io::kOcTreeFullHeader) + "\nid OcTree\nsize 1\nres 0.05\ndata\n";
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"# Octomap something else\n", "first line"},
       {"", "empty"},
@@ -149,9 +149,9 @@ TEST(OcTreeFile, BadFilesAreClearErrors) {
       {BinaryFile(std::to_string(SampleTree().size() + 1), data), "'size'"},
       {BinaryFile(size, data.substr(0, data.size() - 1)), "truncated"},
       {BinaryFile(size, data + "\n"), "bytes follow"},
-      {std::string(mapping::kOcTreeBinaryHeader) + "\nid OcTree\nsize 1\n", "'data'"},
-      {std::string(mapping::kOcTreeBinaryHeader) + "\nid OcTree\ncolour blue\ndata\n", "line 3"},
-      {std::string(mapping::kOcTreeBinaryHeader) + "\nid OcTree\nsize 1\ndata\n", "'res'"},
+      {std::string(io::kOcTreeBinaryHeader) + "\nid OcTree\nsize 1\n", "'data'"},
+      {std::string(io::kOcTreeBinaryHeader) + "\nid OcTree\ncolour blue\ndata\n", "line 3"},
+      {std::string(io::kOcTreeBinaryHeader) + "\nid OcTree\nsize 1\ndata\n", "'res'"},
       {BinaryFile("18", deep), "level 16"},
       {BinaryFile("2", std::string("\x03\x00\x00\x00", 4)), "has none"},
       {BinaryFile("1", std::string("\x00\x00", 2)), "--max-cells"},  // a root leaf: 8^16 cells

@@ -22,8 +22,8 @@ using mapping::Beam;
 
 // A vehicle moving along x and turning, the sonar mounted ahead of it and pitched down, with
 // beams of three lengths (the last one truncated) at head angles all around.
-mapping::RosbagContent MovingBag() {
-  mapping::RosbagContent bag;
+io::RosbagContent MovingBag() {
+  io::RosbagContent bag;
   bag.T_vehicle_sonar = mapping::PoseFromXyzRpy({0.4, 0.0, -0.2}, {0.0, 0.3, 0.0});
   for (int b = 0; b < 30; ++b) {
     Beam beam;
@@ -43,10 +43,10 @@ mapping::RosbagContent MovingBag() {
   return bag;
 }
 
-std::string Written(const mapping::RosbagContent& bag, const test::TempDir& dir,
+std::string Written(const io::RosbagContent& bag, const test::TempDir& dir,
                     const std::string& name = "bag.mcap") {
   std::ostringstream out;
-  mapping::WriteRosbag(out, bag, "sonarbench test");
+  io::WriteRosbag(out, bag, "sonarbench test");
   return test::WriteFile(dir, name, out.str());
 }
 
@@ -54,10 +54,10 @@ std::string Written(const mapping::RosbagContent& bag, const test::TempDir& dir,
 // exactly, the time to the nanosecond a ROS stamp holds, the pose to rounding.
 TEST(Rosbag, ReadsBackWhatItWrote) {
   const test::TempDir dir;
-  const mapping::RosbagContent bag = MovingBag();
-  const mapping::RosbagBeams read = mapping::ReadRosbag(Written(bag, dir), {});
+  const io::RosbagContent bag = MovingBag();
+  const io::RosbagBeams read = io::ReadRosbag(Written(bag, dir), {});
   ASSERT_EQ(read.beams.size(), bag.beams.size());
-  EXPECT_EQ(read.topic, mapping::kSonarTopic);
+  EXPECT_EQ(read.topic, io::kSonarTopic);
   EXPECT_EQ(read.sonar_frame, "sonar");
   EXPECT_EQ(read.world_frame, "map");
   EXPECT_EQ(read.truncated_beams, 1U);
@@ -77,9 +77,9 @@ TEST(Rosbag, ReadsBackWhatItWrote) {
 
 TEST(Rosbag, ABinSizeTheRangesCarryAsFloat32ReadsBackExactly) {
   const test::TempDir dir;
-  mapping::RosbagContent bag = MovingBag();
+  io::RosbagContent bag = MovingBag();
   for (Beam& beam : bag.beams) beam.bin_size_m = static_cast<float>(0.0125313);
-  const mapping::RosbagBeams read = mapping::ReadRosbag(Written(bag, dir), {});
+  const io::RosbagBeams read = io::ReadRosbag(Written(bag, dir), {});
   EXPECT_EQ(read.beams[0].bin_size_m, bag.beams[0].bin_size_m);
 }
 
@@ -88,39 +88,38 @@ TEST(Rosbag, ABinSizeTheRangesCarryAsFloat32ReadsBackExactly) {
 // counted.
 TEST(Rosbag, InterpolatesTransformsAndLeavesOutBeamsTheyDoNotCover) {
   const test::TempDir dir;
-  mapping::RosbagContent bag = MovingBag();
+  io::RosbagContent bag = MovingBag();
   std::ostringstream out;
   {
-    mapping::McapWriter w(out, "ros2", "test");
-    w.Add(mapping::McapSchema{1, mapping::ros2::kProjectedSonarImage, "ros2msg",
-                              mapping::ros2::Definition(mapping::ros2::kProjectedSonarImage)});
-    w.Add(mapping::McapSchema{2, mapping::ros2::kTfMessage, "ros2msg",
-                              mapping::ros2::Definition(mapping::ros2::kTfMessage)});
-    w.Add(mapping::McapChannel{1, 1, "/sonar", "cdr", {}});
-    w.Add(mapping::McapChannel{2, 2, "/tf", "cdr", {}});
+    io::McapWriter w(out, "ros2", "test");
+    w.Add(io::McapSchema{1, io::ros2::kProjectedSonarImage, "ros2msg",
+                         io::ros2::Definition(io::ros2::kProjectedSonarImage)});
+    w.Add(io::McapSchema{2, io::ros2::kTfMessage, "ros2msg",
+                         io::ros2::Definition(io::ros2::kTfMessage)});
+    w.Add(io::McapChannel{1, 1, "/sonar", "cdr", {}});
+    w.Add(io::McapChannel{2, 2, "/tf", "cdr", {}});
     const auto tf = [&](std::int32_t sec, double x, double yaw) {
-      mapping::ros2::TransformStamped t;
+      io::ros2::TransformStamped t;
       t.header.sec = sec;
       t.header.frame_id = "odom";
       t.child_frame_id = "head";
       t.transform = mapping::PoseFromXyzRpy({x, 0, 0}, {0, 0, yaw});
-      w.Write({2, 0, 0, 0, mapping::ros2::EncodeTfMessage({t})});
+      w.Write({2, 0, 0, 0, io::ros2::EncodeTfMessage({t})});
     };
     tf(10, 1.0, 0.0);
     tf(13, 4.0, 0.6);
     for (const std::int32_t sec : {9, 11, 14}) {
-      mapping::ros2::ProjectedSonarImage image;
+      io::ros2::ProjectedSonarImage image;
       image.header = {sec, 0, "head"};
       image.beam_directions = {{1, 0, 0}};
       image.ranges = {static_cast<float>(0.5 * bag.sensor.bin_size_m)};
       image.beam_count = 1;
       image.data = {7};
-      w.Write({1, 0, 0, 0, mapping::ros2::Encode(image)});
+      w.Write({1, 0, 0, 0, io::ros2::Encode(image)});
     }
     w.Finish();
   }
-  const mapping::RosbagBeams read =
-      mapping::ReadRosbag(test::WriteFile(dir, "tf.mcap", out.str()), {});
+  const io::RosbagBeams read = io::ReadRosbag(test::WriteFile(dir, "tf.mcap", out.str()), {});
   ASSERT_EQ(read.beams.size(), 1U);
   EXPECT_EQ(read.beams_outside_tf, 2U);
   EXPECT_EQ(read.world_frame, "odom");
@@ -132,32 +131,32 @@ TEST(Rosbag, InterpolatesTransformsAndLeavesOutBeamsTheyDoNotCover) {
 // One bag a case: an image message that breaks one rule of what a sonar beam is.
 TEST(Rosbag, RefusesImagesThatAreNotOneMechanicalScanningBeam) {
   const test::TempDir dir;
-  const auto bag_of = [&](const mapping::ros2::ProjectedSonarImage& image) {
+  const auto bag_of = [&](const io::ros2::ProjectedSonarImage& image) {
     std::ostringstream out;
-    mapping::McapWriter w(out, "ros2", "test");
-    w.Add(mapping::McapSchema{1, mapping::ros2::kProjectedSonarImage, "ros2msg", "x"});
-    w.Add(mapping::McapChannel{1, 1, "/sonar", "cdr", {}});
-    w.Write({1, 0, 0, 0, mapping::ros2::Encode(image)});
+    io::McapWriter w(out, "ros2", "test");
+    w.Add(io::McapSchema{1, io::ros2::kProjectedSonarImage, "ros2msg", "x"});
+    w.Add(io::McapChannel{1, 1, "/sonar", "cdr", {}});
+    w.Write({1, 0, 0, 0, io::ros2::Encode(image)});
     w.Finish();
     return test::WriteFile(dir, "case.mcap", out.str());
   };
-  mapping::ros2::ProjectedSonarImage good;
+  io::ros2::ProjectedSonarImage good;
   good.header = {1, 0, "sonar"};
   good.beam_directions = {{0, 1, 0}};
   const double bin = mapping::SensorGeometry{}.bin_size_m;
   good.ranges = {static_cast<float>(0.5 * bin), static_cast<float>(1.5 * bin)};
   good.beam_count = 1;
   good.data = {1, 2};
-  mapping::RosbagReadOptions options;
+  io::RosbagReadOptions options;
   options.static_sonar = true;
-  const mapping::RosbagBeams read = mapping::ReadRosbag(bag_of(good), options);
+  const io::RosbagBeams read = io::ReadRosbag(bag_of(good), options);
   ASSERT_EQ(read.beams.size(), 1U);
   EXPECT_EQ(read.beams[0].head_angle_rad, std::numbers::pi / 2);
   EXPECT_TRUE(read.beams[0].T_world_sonar.isApprox(Eigen::Isometry3d::Identity()));
 
-  const auto refused = [&](mapping::ros2::ProjectedSonarImage image, const std::string& part,
-                           const mapping::RosbagReadOptions& with) {
-    EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)mapping::ReadRosbag(bag_of(image), with); },
+  const auto refused = [&](io::ros2::ProjectedSonarImage image, const std::string& part,
+                           const io::RosbagReadOptions& with) {
+    EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)io::ReadRosbag(bag_of(image), with); },
                                            {"case.mcap", "/sonar", part}))
         << part;
   };
@@ -184,29 +183,29 @@ TEST(Rosbag, RefusesImagesThatAreNotOneMechanicalScanningBeam) {
   image.header.frame_id = "son\xC3(ar";  // a manifest could not hold it
   refused(image, "header.frame_id: 'son\\xc3(ar' is not UTF-8", options);
   // A sequence count that says more bytes than the message holds.
-  const std::string cdr = mapping::ros2::Encode(good);
+  const std::string cdr = io::ros2::Encode(good);
   EXPECT_TRUE(test::ThrowsInputErrorWith(
-      [&] { (void)mapping::ros2::DecodeProjectedSonarImage(cdr.substr(0, cdr.size() - 1), "m: "); },
+      [&] { (void)io::ros2::DecodeProjectedSonarImage(cdr.substr(0, cdr.size() - 1), "m: "); },
       {"m: ", "image.data", "do not fit"}));
   EXPECT_TRUE(
-      test::ThrowsInputErrorWith([&] { (void)mapping::ReadRosbag(bag_of(good), {}); },
+      test::ThrowsInputErrorWith([&] { (void)io::ReadRosbag(bag_of(good), {}); },
                                  {"no /tf or /tf_static transform", "'sonar'", "--static"}));
 }
 
 TEST(Rosbag, ASecondSonarTopicMustBeNamed) {
   const test::TempDir dir;
   std::ostringstream out;
-  mapping::McapWriter w(out, "ros2", "test");
-  w.Add(mapping::McapSchema{1, mapping::ros2::kProjectedSonarImage, "ros2msg", "x"});
-  w.Add(mapping::McapChannel{1, 1, "/left", "cdr", {}});
-  w.Add(mapping::McapChannel{2, 1, "/right", "cdr", {}});
+  io::McapWriter w(out, "ros2", "test");
+  w.Add(io::McapSchema{1, io::ros2::kProjectedSonarImage, "ros2msg", "x"});
+  w.Add(io::McapChannel{1, 1, "/left", "cdr", {}});
+  w.Add(io::McapChannel{2, 1, "/right", "cdr", {}});
   w.Finish();
   const std::string path = test::WriteFile(dir, "two.mcap", out.str());
-  EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)mapping::ReadRosbag(path, {}); },
+  EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)io::ReadRosbag(path, {}); },
                                          {"two.mcap", "/left /right", "--topic"}));
-  mapping::RosbagReadOptions options;
+  io::RosbagReadOptions options;
   options.topic = "/right";
-  EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)mapping::ReadRosbag(path, options); },
+  EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)io::ReadRosbag(path, options); },
                                          {"two.mcap", "no message on /right"}));
 }
 

@@ -22,7 +22,7 @@ using test::ThrowsInputErrorWith;
 
 mapping::MapperConfig ReadMapping(const std::string& text) {
   YamlReader reader = YamlReader::FromString(text, "scene.yaml");
-  mapping::MapperConfig config = mapping::ReadMapperConfig(reader);
+  mapping::MapperConfig config = io::ReadMapperConfig(reader);
   reader.ThrowIfErrors();
   return config;
 }
@@ -77,7 +77,7 @@ TEST(YamlReader, KeySetIsBlocksUnlessAnotherIsAskedFor) {
   EXPECT_EQ(ReadMapping("key_set: blocks\n").key_set, KeySetKind::kBlocks);
   EXPECT_EQ(ReadMapping("key_set: open_addressing\n").key_set, KeySetKind::kOpenAddressing);
   EXPECT_EQ(ReadMapping("key_set: std\n").key_set, KeySetKind::kStd);
-  EXPECT_STREQ(mapping::KeySetName(KeySetKind::kBlocks), "blocks");
+  EXPECT_STREQ(io::KeySetName(KeySetKind::kBlocks), "blocks");
   EXPECT_TRUE(ThrowsInputErrorWith(
       [] { (void)ReadMapping("key_set: bonxai\n"); },
       {"scene.yaml:1:10", "'key_set'", "blocks", "open_addressing", "std", "got 'bonxai'"}));

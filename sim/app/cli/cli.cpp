@@ -119,7 +119,7 @@ sonarbench::sim::OutputClaim OneShotClaim(std::string command, std::vector<std::
   for (const std::string& input : inputs) what += "\n" + input;
   sim::OutputClaim claim;
   claim.command = std::move(command);
-  claim.config_sha256 = sonarbench::mapping::Sha256(what);
+  claim.config_sha256 = sonarbench::io::Sha256(what);
   claim.mode = sim::OutputMode::kReplace;
   claim.record = files.front();
   claim.files = std::move(files);

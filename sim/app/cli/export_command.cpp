@@ -15,11 +15,11 @@ struct ExportArgs {
 };
 
 int Export(const ExportArgs& args) {
-  mapping::RosbagContent bag = sim::RosbagFromDataset(args.dataset);
+  io::RosbagContent bag = sim::RosbagFromDataset(args.dataset);
   bag.sound_speed_m_s = args.sound_speed;
   sim::WriteRosbagFile(bag, args.out, args.force);
-  std::cout << bag.beams.size() << " beams on " << mapping::kSonarTopic << ", /tf, /tf_static"
-            << (bag.true_vehicle.empty() ? "" : std::string(", ") + mapping::kGroundTruthTopic)
+  std::cout << bag.beams.size() << " beams on " << io::kSonarTopic << ", /tf, /tf_static"
+            << (bag.true_vehicle.empty() ? "" : std::string(", ") + io::kGroundTruthTopic)
             << "\nwrote " << args.out << "\n";
   return 0;
 }

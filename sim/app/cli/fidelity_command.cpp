@@ -38,7 +38,7 @@ int Fidelity(const FidelityArgs& args) {
             << range << " m range (no echo lies past it)";
     throw sonarbench::InputError(message.str());
   }
-  const sonarbench::mapping::MatLog log = sonarbench::mapping::ReadMatLog(args.log);
+  const sonarbench::io::MatLog log = sonarbench::io::ReadMatLog(args.log);
   const auto meshes = sim::BuildSceneMeshes(scene);
   std::vector<std::string> inputs = sim::SceneInputFiles(scene);
   inputs.push_back(args.log);

@@ -25,12 +25,12 @@ struct ImportArgs {
 
 // A ROS 2 bag's beams, posed by its transforms (or static at the origin with --static).
 sim::ImportedLog ReadBag(const ImportArgs& args, const mapping::SensorGeometry& sensor) {
-  mapping::RosbagReadOptions options;
+  io::RosbagReadOptions options;
   options.sensor = sensor;
   options.topic = args.topic;
   options.static_sonar = args.static_sonar;
   options.max_bytes = args.max_input_mb << 20;
-  mapping::RosbagBeams bag = mapping::ReadRosbag(args.log, options);
+  io::RosbagBeams bag = io::ReadRosbag(args.log, options);
   bool moves = false;
   for (const mapping::Beam& beam : bag.beams) {
     moves = moves || !beam.T_world_sonar.isApprox(bag.beams.front().T_world_sonar, 1e-12);
@@ -56,7 +56,7 @@ int Import(const ImportArgs& args) {
   if (!args.sensor.empty()) sensor = sim::LoadSensorModel(args.sensor).geometry;
   // A bag by its magic bytes, whatever its name; anything else is read as a .mat log.
   const bool bag =
-      mapping::StartsAsMcap(args.log) || std::filesystem::path(args.log).extension() == ".mcap";
+      io::StartsAsMcap(args.log) || std::filesystem::path(args.log).extension() == ".mcap";
   if (!bag && (!args.topic.empty() || args.static_sonar)) {
     throw InputError("--topic and --static apply to ROS 2 bags (.mcap), not to " + args.log);
   }
@@ -64,7 +64,7 @@ int Import(const ImportArgs& args) {
   if (bag) {
     log = ReadBag(args, sensor);
   } else {
-    log = sim::ImportedMatLog(mapping::ReadMatLog(args.log, args.max_input_mb << 20));
+    log = sim::ImportedMatLog(io::ReadMatLog(args.log, args.max_input_mb << 20));
   }
   const sim::DatasetSummary summary =
       sim::ImportLogDataset(args.log, log, sensor, args.out, args.force);

@@ -36,7 +36,7 @@ int Map(const MapArgs& args) {
   if (!args.sensor.empty()) sensor = sonarbench::sim::LoadSensorModel(args.sensor).geometry;
   if (!args.mapping.empty()) {
     sonarbench::YamlReader reader = sonarbench::YamlReader::FromFile(args.mapping);
-    config = sonarbench::mapping::ReadMapperConfig(reader);
+    config = sonarbench::io::ReadMapperConfig(reader);
     reader.ThrowIfErrors();
   }
   config.threads = args.threads;

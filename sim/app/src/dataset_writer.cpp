@@ -68,9 +68,9 @@ OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sw
                        {"poses/sonar_true.tum", "poses/vehicle.tum", "truth/occupancy.bt"});
   }
   for (std::size_t s = 0; s < sweeps; ++s) {
-    claim.files.push_back(mapping::SweepFile("beams", s, "bin"));
-    claim.files.push_back(mapping::SweepFile("images", s, "png"));
-    if (simulated) claim.files.push_back(mapping::SweepFile("truth", s, "csv"));
+    claim.files.push_back(io::SweepFile("beams", s, "bin"));
+    claim.files.push_back(io::SweepFile("images", s, "png"));
+    if (simulated) claim.files.push_back(io::SweepFile("truth", s, "csv"));
   }
   claim.record = "manifest.json";
   claim.force = force;
@@ -86,7 +86,7 @@ bool PrepareDirectory(const OutputDirectory& out, const std::string& config, boo
   if (simulated) fs::create_directories(root / "truth");
   if (!fs::exists(root / kPartialMarker)) {
     WriteText(root / kPartialMarker,
-              json{{"format", mapping::kDatasetFormat}, {"config_sha256", config}}.dump(2) + "\n");
+              json{{"format", io::kDatasetFormat}, {"config_sha256", config}}.dump(2) + "\n");
   }
   return false;
 }
@@ -106,7 +106,7 @@ void Finalize(const OutputDirectory& out, const std::vector<std::string>& claime
   for (const auto& relative : files) {
     list.push_back({{"path", relative},
                     {"bytes", fs::file_size(root / relative)},
-                    {"sha256", mapping::Sha256OfFile((root / relative).string())}});
+                    {"sha256", io::Sha256OfFile((root / relative).string())}});
   }
   manifest["files"] = list;
   WriteText(root / "manifest.json", manifest.dump(2) + "\n");
@@ -116,8 +116,8 @@ void Finalize(const OutputDirectory& out, const std::vector<std::string>& claime
 
 json ManifestBase(const mapping::SensorGeometry& sensor, std::size_t sweeps, std::size_t beams,
                   const std::string& config) {
-  json m = {{"format", mapping::kDatasetFormat},
-            {"schema_version", mapping::kDatasetSchemaVersion},
+  json m = {{"format", io::kDatasetFormat},
+            {"schema_version", io::kDatasetSchemaVersion},
             {"tool", ReportHeader()["tool"]},
             {"config_sha256", config},
             {"units",
@@ -138,7 +138,7 @@ json ManifestBase(const mapping::SensorGeometry& sensor, std::size_t sweeps, std
             {"beam_file",
              "little-endian: 'SBBEAMS1', u32 beam count, per beam f64 time_s, f64 "
              "head_angle_rad, f64 bin_size_m, u32 bin count, u8 intensities"},
-            {"sensor", mapping::SensorGeometryJson(sensor)},
+            {"sensor", io::SensorGeometryJson(sensor)},
             {"sweeps", sweeps},
             {"beams_per_sweep", sensor.BeamsPerSweep()},
             {"beams", beams}};
@@ -146,14 +146,13 @@ json ManifestBase(const mapping::SensorGeometry& sensor, std::size_t sweeps, std
 }
 
 void WriteBeams(const fs::path& path, std::span<const mapping::Beam> beams) {
-  WriteFileAtomically(path.string(),
-                      [&](std::ostream& out) { mapping::WriteBeamFile(out, beams); });
+  WriteFileAtomically(path.string(), [&](std::ostream& out) { io::WriteBeamFile(out, beams); });
 }
 
 bool SweepComplete(const fs::path& root, std::size_t sweep, bool with_truth) {
-  return fs::is_regular_file(root / mapping::SweepFile("beams", sweep, "bin")) &&
-         fs::is_regular_file(root / mapping::SweepFile("images", sweep, "png")) &&
-         (!with_truth || fs::is_regular_file(root / mapping::SweepFile("truth", sweep, "csv")));
+  return fs::is_regular_file(root / io::SweepFile("beams", sweep, "bin")) &&
+         fs::is_regular_file(root / io::SweepFile("images", sweep, "png")) &&
+         (!with_truth || fs::is_regular_file(root / io::SweepFile("truth", sweep, "csv")));
 }
 
 std::string TruthCsv(std::span<const SynthesizedBeam> beams, std::size_t first_index,
@@ -194,30 +193,30 @@ void WriteTruthOccupancy(const fs::path& path, const std::vector<TriangleMesh>& 
 
 std::string SceneConfigHash(const Scene& scene, std::uint64_t seed) {
   json inputs = {{"tool", ReportHeader()["tool"]},
-                 {"schema_version", mapping::kDatasetSchemaVersion},
+                 {"schema_version", io::kDatasetSchemaVersion},
                  {"seed", seed},
-                 {"scene_sha256", mapping::Sha256OfFile(scene.file)},
-                 {"sensor_model_sha256", mapping::Sha256OfFile(scene.sensor_model_file)}};
+                 {"scene_sha256", io::Sha256OfFile(scene.file)},
+                 {"sensor_model_sha256", io::Sha256OfFile(scene.sensor_model_file)}};
   json meshes = json::array();
   for (const MeshSpec& mesh : scene.meshes) {
-    meshes.push_back(mesh.file.empty() ? json(nullptr) : json(mapping::Sha256OfFile(mesh.file)));
+    meshes.push_back(mesh.file.empty() ? json(nullptr) : json(io::Sha256OfFile(mesh.file)));
   }
   inputs["mesh_files_sha256"] = meshes;
   // The vehicle's part files too (a scene without parts hashes as it always did).
   if (!scene.vehicle.empty()) {
     json parts = json::array();
     for (const MeshSpec& part : scene.vehicle) {
-      parts.push_back(part.file.empty() ? json(nullptr) : json(mapping::Sha256OfFile(part.file)));
+      parts.push_back(part.file.empty() ? json(nullptr) : json(io::Sha256OfFile(part.file)));
     }
     inputs["vehicle_files_sha256"] = parts;
   }
   // The scenes it extends are part of it (a scene that extends none hashes as it always did).
   if (!scene.extends.empty()) {
     json bases = json::array();
-    for (const std::string& file : scene.extends) bases.push_back(mapping::Sha256OfFile(file));
+    for (const std::string& file : scene.extends) bases.push_back(io::Sha256OfFile(file));
     inputs["extends_sha256"] = bases;
   }
-  return mapping::Sha256(inputs.dump());
+  return io::Sha256(inputs.dump());
 }
 
 std::vector<std::string> SceneInputFiles(const Scene& scene) {
@@ -289,11 +288,9 @@ void WritePosesAndTruth(const fs::path& root, const Scene& scene, std::uint64_t 
   std::string vehicle;
   for (std::size_t b = 0; b < beam_count; ++b) {
     const ScheduledBeam scheduled = ScheduleBeam(scene, b);
-    sonar +=
-        mapping::TumLine(scheduled.time_s, ReportedSonarPose(scene, b, scheduled.time_s, seed));
-    sonar_true += mapping::TumLine(scheduled.time_s, scheduled.pose.T_world_sonar);
-    vehicle +=
-        mapping::TumLine(scheduled.time_s, scene.trajectory.T_world_vehicle(scheduled.time_s));
+    sonar += io::TumLine(scheduled.time_s, ReportedSonarPose(scene, b, scheduled.time_s, seed));
+    sonar_true += io::TumLine(scheduled.time_s, scheduled.pose.T_world_sonar);
+    vehicle += io::TumLine(scheduled.time_s, scene.trajectory.T_world_vehicle(scheduled.time_s));
   }
   WriteText(root / "poses/sonar.tum", sonar);
   WriteText(root / "poses/sonar_true.tum", sonar_true);
@@ -366,9 +363,9 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
       const auto synthesized = SimulateBeams(scene, synthesizer, seed, options.threads, first,
                                              std::min(beam_count, first + per_sweep));
       const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
-      WriteBeams(root / mapping::SweepFile("beams", s, "bin"), beams);
-      WriteText(root / mapping::SweepFile("truth", s, "csv"), TruthCsv(synthesized, first, scene));
-      WritePolarImage((root / mapping::SweepFile("images", s, "png")).string(), beams,
+      WriteBeams(root / io::SweepFile("beams", s, "bin"), beams);
+      WriteText(root / io::SweepFile("truth", s, "csv"), TruthCsv(synthesized, first, scene));
+      WritePolarImage((root / io::SweepFile("images", s, "png")).string(), beams,
                       scene.name + ", seed " + std::to_string(seed) + ": sweep " +
                           std::to_string(s) + ", polar");
       ++summary.sweeps_written;
@@ -386,7 +383,7 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   return summary;
 }
 
-ImportedLog ImportedMatLog(mapping::MatLog log) {
+ImportedLog ImportedMatLog(io::MatLog log) {
   return {std::move(log.beams), log.truncated_beams, json::object(), json::object()};
 }
 
@@ -397,10 +394,10 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& 
   const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
   summary.sweeps_total = (log.beams.size() + per_sweep - 1) / per_sweep;
   json inputs = {{"tool", ReportHeader()["tool"]},
-                 {"log_sha256", mapping::Sha256OfFile(log_path)},
-                 {"sensor", mapping::SensorGeometryJson(sensor)}};
+                 {"log_sha256", io::Sha256OfFile(log_path)},
+                 {"sensor", io::SensorGeometryJson(sensor)}};
   if (!log.options.empty()) inputs["options"] = log.options;
-  summary.config_sha256 = mapping::Sha256(inputs.dump());
+  summary.config_sha256 = io::Sha256(inputs.dump());
   CheckOutputDirectory(dir);
   OutputClaim claim =
       DatasetClaim("import", summary.config_sha256, summary.sweeps_total, false, force);
@@ -418,15 +415,14 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& 
     if (SweepComplete(root, s, false)) {
       ++summary.sweeps_skipped;
     } else {
-      WriteBeams(root / mapping::SweepFile("beams", s, "bin"), sweep);
+      WriteBeams(root / io::SweepFile("beams", s, "bin"), sweep);
       WritePolarImage(
-          (root / mapping::SweepFile("images", s, "png")).string(), sweep,
+          (root / io::SweepFile("images", s, "png")).string(), sweep,
           fs::path(log_path).filename().string() + ": sweep " + std::to_string(s) + ", polar");
       ++summary.sweeps_written;
     }
   }
-  for (const mapping::Beam& beam : log.beams)
-    poses += mapping::TumLine(beam.time_s, beam.T_world_sonar);
+  for (const mapping::Beam& beam : log.beams) poses += io::TumLine(beam.time_s, beam.T_world_sonar);
   WriteText(root / "poses/sonar.tum", poses);
   json manifest =
       ManifestBase(sensor, summary.sweeps_total, log.beams.size(), summary.config_sha256);

@@ -26,7 +26,7 @@ using Detection = mapping::DetectionConfig;
 // The echo rule of a setting, as the CSV, the plot's legend and the item's name give it.
 std::string EchoRule(const Detection& d) {
   if (d.max_obstacles == 1) return "first echo";
-  return std::to_string(d.max_obstacles) + " echoes, " + mapping::LaterEchoesName(d.later_echoes);
+  return std::to_string(d.max_obstacles) + " echoes, " + io::LaterEchoesName(d.later_echoes);
 }
 
 // A map of `beams` with `detection`, scored against the truth and what a perfect sensor sees.
@@ -71,9 +71,9 @@ void WriteCsv(const std::string& path, const std::vector<DetectorRow>& rows, boo
   csv << "\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const Detection& d = rows[i].item.detection;
-    csv << i << "," << mapping::DetectionMethodName(d.method) << ","
+    csv << i << "," << io::DetectionMethodName(d.method) << ","
         << (d.method == Detection::Method::kThreshold ? std::to_string(d.threshold) : "") << ","
-        << d.max_obstacles << "," << mapping::LaterEchoesName(d.later_echoes);
+        << d.max_obstacles << "," << io::LaterEchoesName(d.later_echoes);
     for (const MapMetrics* m : {&rows[i].scene, rows[i].log ? &*rows[i].log : nullptr}) {
       if (!m) continue;
       const json values = MetricsJson(*m);
@@ -97,7 +97,7 @@ void WritePlot(const std::string& path, const std::vector<DetectorRow>& rows, bo
     const std::string name =
         d.method == Detection::Method::kThreshold
             ? "threshold, " + EchoRule(d)
-            : std::string(mapping::DetectionMethodName(d.method)) + ", each echo rule";
+            : std::string(io::DetectionMethodName(d.method)) + ", each echo rule";
     auto [it, added] = order.emplace(name, series.size());
     if (added) series.push_back({name, colours[series.size() % colours.size()], {}, {}});
     const MapMetrics& m = log ? *row.log : row.scene;
@@ -108,7 +108,7 @@ void WritePlot(const std::string& path, const std::vector<DetectorRow>& rows, bo
     s.labels.push_back(d.method == Detection::Method::kThreshold
                            ? std::to_string(static_cast<int>(d.threshold))
                        : d.max_obstacles == 1 ? "first"
-                                              : mapping::LaterEchoesName(d.later_echoes));
+                                              : io::LaterEchoesName(d.later_echoes));
   }
   WritePng(path,
            RenderLinePlot(std::string("Detectors, ") + (log ? "the log" : "the simulated scene") +
@@ -127,7 +127,7 @@ std::vector<DetectorItem> DetectorStudyItems(const Detection& base) {
       d.later_echoes =
           rule == 2 ? Detection::LaterEchoes::kSupported : Detection::LaterEchoes::kStrongest;
       std::ostringstream name;
-      name << mapping::DetectionMethodName(d.method);
+      name << io::DetectionMethodName(d.method);
       if (d.method == Detection::Method::kThreshold) name << ' ' << d.threshold;
       name << ", " << EchoRule(d);
       items.push_back({name.str(), d});
@@ -192,10 +192,10 @@ void WriteDetectorStudy(const std::string& dir, const Scene& scene,
   for (const DetectorRow& row : rows) {
     const Detection& d = row.item.detection;
     json item = {{"name", row.item.name},
-                 {"method", mapping::DetectionMethodName(d.method)},
+                 {"method", io::DetectionMethodName(d.method)},
                  {"threshold", d.threshold},
                  {"max_obstacles", d.max_obstacles},
-                 {"later_echoes", mapping::LaterEchoesName(d.later_echoes)},
+                 {"later_echoes", io::LaterEchoesName(d.later_echoes)},
                  {"scene", MetricsJson(row.scene)}};
     if (row.log) item["log"] = MetricsJson(*row.log);
     items.push_back(item);

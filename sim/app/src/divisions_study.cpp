@@ -303,9 +303,9 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
   if (options.sweeps) scene.sweeps = *options.sweeps;
   const std::uint64_t seed = options.seed.value_or(scene.seed);
   const std::string config =
-      mapping::Sha256(SceneConfigHash(scene, seed) + "/sweeps " + std::to_string(scene.sweeps) +
-                      "/coverage_beams " + std::to_string(options.coverage_beams) + "/items " +
-                      std::to_string(options.items.size()));
+      io::Sha256(SceneConfigHash(scene, seed) + "/sweeps " + std::to_string(scene.sweeps) +
+                 "/coverage_beams " + std::to_string(options.coverage_beams) + "/items " +
+                 std::to_string(options.items.size()));
   CheckOutputDirectory(dir);
   // The meshes' preflight before the directory is made: bad input leaves none.
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);

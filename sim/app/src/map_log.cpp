@@ -49,7 +49,7 @@ namespace {
 // Where a dataset's beams are mapped to score them against `scene`: an imported log is static at
 // its own origin and goes to the scene's sonar pose, as a .mat log does; a simulated dataset keeps
 // its poses and must be of that scene. Differences that still allow a score go to `warnings`.
-std::optional<Eigen::Isometry3d> DatasetPlacement(const mapping::Dataset& dataset,
+std::optional<Eigen::Isometry3d> DatasetPlacement(const io::Dataset& dataset,
                                                   const std::string& dir, const Scene& scene,
                                                   std::vector<std::string>& warnings) {
   const nlohmann::json& m = dataset.manifest;
@@ -94,7 +94,7 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
   mapping::SensorGeometry geometry = sensor;
   const std::string log_file = MatLogInDirectory(input);
   if (log_file.empty() && std::filesystem::is_directory(input)) {
-    mapping::Dataset dataset = mapping::ReadDataset(input);
+    io::Dataset dataset = io::ReadDataset(input);
     geometry = dataset.sensor;  // a dataset carries its sensor
     const auto pose =
         place_in ? DatasetPlacement(dataset, input, *place_in, result.warnings) : std::nullopt;
@@ -107,7 +107,7 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
     // The scene is checked before the log is read: a moving one is refused at once.
     const std::optional<Eigen::Isometry3d> pose =
         place_in ? std::optional(StaticSonarPose(*place_in)) : std::nullopt;
-    mapping::MatLog log = mapping::ReadMatLog(log_file.empty() ? input : log_file);
+    io::MatLog log = io::ReadMatLog(log_file.empty() ? input : log_file);
     beams = std::move(log.beams);
     result.truncated_beams = log.truncated_beams;
     result.source = "mat";

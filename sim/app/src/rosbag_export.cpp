@@ -21,16 +21,16 @@ std::string LibraryName() { return std::string("sonarbench ") + kVersion; }
 
 }  // namespace
 
-mapping::RosbagContent RosbagFromDataset(const std::string& dir) {
-  mapping::Dataset dataset = mapping::ReadDataset(dir);
-  mapping::RosbagContent bag;
+io::RosbagContent RosbagFromDataset(const std::string& dir) {
+  io::Dataset dataset = io::ReadDataset(dir);
+  io::RosbagContent bag;
   bag.sensor = dataset.sensor;
   bag.beams = std::move(dataset.beams);
   const fs::path vehicle_file = fs::path(dir) / "poses/vehicle.tum";
   const fs::path sonar_file = fs::path(dir) / "poses/sonar_true.tum";
   if (!fs::exists(vehicle_file) || !fs::exists(sonar_file)) return bag;
-  const auto vehicle = mapping::ReadTum(vehicle_file.string());
-  const auto sonar = mapping::ReadTum(sonar_file.string());
+  const auto vehicle = io::ReadTum(vehicle_file.string());
+  const auto sonar = io::ReadTum(sonar_file.string());
   if (vehicle.size() != bag.beams.size() || sonar.size() != bag.beams.size()) {
     throw InputError(vehicle_file.string() + ", " + sonar_file.string() +
                      ": expected a pose for each of the dataset's " +
@@ -50,13 +50,13 @@ mapping::RosbagContent RosbagFromDataset(const std::string& dir) {
   return bag;
 }
 
-void WriteRosbagFile(const mapping::RosbagContent& bag, const std::string& path, bool force) {
+void WriteRosbagFile(const io::RosbagContent& bag, const std::string& path, bool force) {
   std::error_code error;
   if (fs::exists(path, error) || fs::is_symlink(path, error)) {
     if (!fs::is_regular_file(path, error)) {
       throw InputError(path + ": exists and is not a file; choose another --out");
     }
-    if (mapping::McapLibrary(path).value_or("").rfind("sonarbench", 0) != 0) {
+    if (io::McapLibrary(path).value_or("").rfind("sonarbench", 0) != 0) {
       throw InputError(path +
                        ": exists and is not an MCAP file sonarbench wrote; sonarbench never "
                        "replaces it (--force neither): choose another --out");
@@ -67,8 +67,7 @@ void WriteRosbagFile(const mapping::RosbagContent& bag, const std::string& path,
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty()) CheckOutputDirectory(parent.string());
   if (!parent.empty()) CreateOutputDirectory(parent.string());
-  WriteFileAtomically(path,
-                      [&](std::ostream& out) { mapping::WriteRosbag(out, bag, LibraryName()); });
+  WriteFileAtomically(path, [&](std::ostream& out) { io::WriteRosbag(out, bag, LibraryName()); });
 }
 
 }  // namespace sonarbench::sim

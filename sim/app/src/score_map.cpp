@@ -125,7 +125,7 @@ MapFileScore ScoreMapFile(const std::string& map_file, const Scene& scene, const
   auto clock = std::chrono::steady_clock::now();
   MapFileScore s;
   s.map_file = map_file;
-  s.map = mapping::ReadOcTreeFile(map_file, budgets.max_cells, &s.file);
+  s.map = io::ReadOcTreeFile(map_file, budgets.max_cells, &s.file);
   CheckTruthBudget(map_file, s.file.resolution_m, scene, budgets);
   std::vector<BeamPose> poses;
   for (std::size_t b = 0; b < ScenarioBeamCount(scene); ++b) {

@@ -170,9 +170,8 @@ std::optional<Ownership> ReadOwnership(const fs::path& dir) {
   }
   // A dataset written before markers existed: its manifest lists its files.
   if (const auto manifest = ReadJson(dir / "manifest.json");
-      manifest && manifest->is_object() &&
-      manifest->value("format", "") == mapping::kDatasetFormat && manifest->contains("files") &&
-      (*manifest)["files"].is_array()) {
+      manifest && manifest->is_object() && manifest->value("format", "") == io::kDatasetFormat &&
+      manifest->contains("files") && (*manifest)["files"].is_array()) {
     owned[manifest->value("source", "simulate")] = {
         manifest->value("config_sha256", ""),
         SortedUnion(names((*manifest)["files"], "path"), {"manifest.json"})};

@@ -349,7 +349,7 @@ std::optional<YamlReader> ReadSections(YamlReader& root, bool has_base, Scene& s
     acoustics->RejectUnknownKeys();
   }
   if (auto mapping = root.OptionalChild("mapping")) {
-    scene.mapping = mapping::ReadMapperConfig(*mapping, scene.mapping);
+    scene.mapping = io::ReadMapperConfig(*mapping, scene.mapping);
   }
   if (auto criteria = root.OptionalChild("criteria")) {
     std::vector<std::string> mesh_names;

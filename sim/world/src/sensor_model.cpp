@@ -128,7 +128,7 @@ SensorModel ReadSensorModel(YamlReader& root) {
   SensorModel model;
   root.Required("name", model.name, Name());
   YamlReader geometry = root.Child("geometry");
-  model.geometry = mapping::ReadSensorGeometry(geometry);
+  model.geometry = io::ReadSensorGeometry(geometry);
   YamlReader node = root.Child("acoustics");
   ReadAcoustics(node, model.acoustics);
   CheckAcoustics(node, model.acoustics, model.geometry);

@@ -99,8 +99,8 @@ TEST_F(TankDataset, ReadsBackTheSimulatedBeamsAndPoses) {
   EXPECT_TRUE(summary.complete);
   EXPECT_EQ(summary.sweeps_written, 3u);
 
-  const mapping::Dataset dataset = mapping::ReadDataset(out.string());
-  EXPECT_EQ(dataset.manifest["schema_version"], mapping::kDatasetSchemaVersion);
+  const io::Dataset dataset = io::ReadDataset(out.string());
+  EXPECT_EQ(dataset.manifest["schema_version"], io::kDatasetSchemaVersion);
   EXPECT_EQ(dataset.manifest["seed"], scene_->seed);
   EXPECT_EQ(dataset.sweeps, 3u);
   EXPECT_EQ(dataset.sensor.num_bins, scene_->sensor.geometry.num_bins);
@@ -154,10 +154,9 @@ TEST_F(TankDataset, ShardsAndResumedRunsGiveTheSameBytesAsOneRun) {
   const auto partial = sim::SimulateDataset(*scene_, split.string(), first);
   EXPECT_FALSE(partial.complete);
   EXPECT_EQ(partial.sweeps_written, 2u);
-  EXPECT_NE(test::InputErrorOf([&] {
-              (void)mapping::ReadDataset(split.string());
-            }).find("no manifest.json"),
-            std::string::npos);
+  EXPECT_NE(
+      test::InputErrorOf([&] { (void)io::ReadDataset(split.string()); }).find("no manifest.json"),
+      std::string::npos);
   // A run killed while writing leaves at most a temporary file, and its name in the lock file:
   // the rerun removes it.
   std::ofstream(split / "beams/sweep_0001.bin.tmp.999") << "half";
@@ -185,7 +184,7 @@ TEST_F(TankDataset, NeverOverwritesWithoutForceAndNeverDeletesStrangers) {
             std::string::npos);
   other_seed.force = true;
   EXPECT_TRUE(sim::SimulateDataset(*scene_, out.string(), other_seed).complete);
-  EXPECT_EQ(mapping::ReadDataset(out.string()).manifest["seed"], 99);
+  EXPECT_EQ(io::ReadDataset(out.string()).manifest["seed"], 99);
 
   // A directory sonarbench did not write: a file of a name a dataset uses is refused, even with
   // --force; other files stay as they are beside a dataset, whatever --force.
@@ -204,7 +203,7 @@ TEST_F(TankDataset, NeverOverwritesWithoutForceAndNeverDeletesStrangers) {
   EXPECT_TRUE(sim::SimulateDataset(*scene_, stranger.string(), other_seed).complete);
   other_seed.seed = 98;
   EXPECT_TRUE(sim::SimulateDataset(*scene_, stranger.string(), other_seed).complete);
-  EXPECT_EQ(mapping::ReadDataset(stranger.string()).manifest["seed"], 98);
+  EXPECT_EQ(io::ReadDataset(stranger.string()).manifest["seed"], 98);
   EXPECT_EQ(Bytes(stranger / "thesis.tex"), "precious");
   EXPECT_EQ(Bytes(stranger / "src/main.c"), "int main;");
 }
@@ -224,7 +223,7 @@ TEST_F(TankDataset, ADamagedFileIsNamed) {
     f.put(static_cast<char>(~byte));
   }
   EXPECT_NE(test::InputErrorOf([&] {
-              (void)mapping::ReadDataset(out.string());
+              (void)io::ReadDataset(out.string());
             }).find("sweep_0002.bin: its sha256 differs"),
             std::string::npos);
 }

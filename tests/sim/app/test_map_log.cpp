@@ -134,8 +134,7 @@ TEST(RealLogMap, AnImportedLogScoresAsTheMatLogDoes) {
   test::TempDir dir;
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   const std::string imported = (dir.path() / "imported").string();
-  (void)sim::ImportLogDataset(RealLogPath(),
-                              sim::ImportedMatLog(mapping::ReadMatLog(RealLogPath())),
+  (void)sim::ImportLogDataset(RealLogPath(), sim::ImportedMatLog(io::ReadMatLog(RealLogPath())),
                               mapping::SensorGeometry{}, imported, false);
   const sim::LogMapResult from_mat =
       sim::MapLog(RealLogPath(), scene.sensor.geometry, scene.mapping, &scene);

@@ -93,16 +93,17 @@ struct RealTank {
 // 0.616-0.642 / 0.521-0.545 / 0.413-0.445; the sweep-to-sweep spread 2.27-2.30, at 4.5-5 m
 // 2.26-2.45 times its 0.4-1.5 m one (the real log's 2.17); the walls' median strongest echo 151;
 // the bands within 9.4 of the real ones (2.5-3 m, lit by the walls' glint), 3.0-4.0 on average; the
-// near range's mean 14.0-15.2 and spread across head angles 20.4-22.2 (docs/fidelity.md). Every value it reports lies on the real log's grid. Each bound sits outside
-// that spread and inside what a lost piece of the model gives (docs/fidelity.md; the bands' average
-// 7.1 and 11.0 with the gain 2 dB under and over): the self-reflection under the speckle (mean 120,
-// ping spread 1.2), one look of speckle (0.70 and contrast 0.51), no own share (0.90 / 0.75 / 0.59
-// across head steps) or the scattering alike over 3° instead of 7.2° (0.58 / 0.35 / 0.16; 0.82 /
-// 0.51 / 0.25 without the own share either), no receiver jitter (spread 1.6), no skirts (median
-// 167), the gain 2 dB off (every band ≈ 13 units), the background noise all after the time-varied
-// gain (the spread at 4.5-5 m 1.16-1.25 times the near one), no vehicle parts (the near range's
-// mean 6.4 without them and their tail all round; 8.3 across head angles with the model's mean tail
-// instead), the parts without those at the real log's spots (15.1 across head angles).
+// near range's mean 14.0-15.2 and spread across head angles 20.4-22.2 (docs/fidelity.md). Every
+// value it reports lies on the real log's grid. Each bound sits outside that spread and inside what
+// a lost piece of the model gives (docs/fidelity.md; the bands' average 7.1 and 11.0 with the gain
+// 2 dB under and over): the self-reflection under the speckle (mean 120, ping spread 1.2), one look
+// of speckle (0.70 and contrast 0.51), no own share (0.90 / 0.75 / 0.59 across head steps) or the
+// scattering alike over 3° instead of 7.2° (0.58 / 0.35 / 0.16; 0.82 / 0.51 / 0.25 without the own
+// share either), no receiver jitter (spread 1.6), no skirts (median 167), the gain 2 dB off (every
+// band ≈ 13 units), the background noise all after the time-varied gain (the spread at 4.5-5
+// m 1.16-1.25 times the near one), no vehicle parts (the near range's mean 6.4 without them and
+// their tail all round; 8.3 across head angles with the model's mean tail instead), the parts
+// without those at the real log's spots (15.1 across head angles).
 TEST(Fidelity, SimulatedTankStaysNearTheRealLogsRecordedStatistics) {
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   const auto meshes = sim::BuildSceneMeshes(scene);
@@ -173,7 +174,7 @@ TEST(Fidelity, SimulatedTankMapsAsTheRealLogDoes) {
 // The recorded statistics are the real log's, to their last digit.
 TEST(Fidelity, RecordedRealLogStatisticsAreTheLogs) {
   REQUIRE_REAL_LOG();
-  const mapping::MatLog log = mapping::ReadMatLog(RealLogPath());
+  const io::MatLog log = io::ReadMatLog(RealLogPath());
   const mapping::SensorGeometry g;
   const sim::FidelityReport r = sim::CompareWithLog(log.beams, log.beams, g, 1.6);
   EXPECT_EQ(r.real.ringing.first_bin, 5u);

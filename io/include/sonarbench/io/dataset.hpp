@@ -11,7 +11,11 @@
 #include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
+
+// The mapper's types these files hold.
+using mapping::Beam;
+using mapping::SensorGeometry;
 
 /// The sonarbench dataset: a directory that `sonarbench simulate` and `sonarbench import` write
 /// and `sonarbench map` reads (the format is documented in docs/dataset-format.md).
@@ -71,4 +75,4 @@ struct Dataset {
 /// file and what was expected.
 [[nodiscard]] Dataset ReadDataset(const std::string& dir);
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

@@ -4,7 +4,15 @@
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
+
+// The mapper's types these files hold.
+using mapping::DetectionConfig;
+using mapping::Integration;
+using mapping::KeySetKind;
+using mapping::MapperConfig;
+using mapping::Occupancy;
+using mapping::SensorGeometry;
 
 /// Reads a `mapping` mapping of a scene file over `base` (absent keys keep its values; by default
 /// the struct's defaults).
@@ -21,4 +29,4 @@ namespace sonarbench::mapping {
 /// Reads a sensor model's `geometry` mapping (keys carry their units: `..._deg`, `..._m`).
 [[nodiscard]] SensorGeometry ReadSensorGeometry(YamlReader& node);
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

@@ -6,7 +6,10 @@
 
 #include "sonarbench/mapping/beam.hpp"
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
+
+// The mapper's types these files hold.
+using mapping::Beam;
 
 /// Reads a real MSIS log saved by the CRAS lab's tools as a MATLAB v5 (or v7.3) `.mat` file:
 /// one variable `parsedData`, a struct array with one element per ping and the fields `time` [s],
@@ -26,4 +29,4 @@ struct MatLog {
 [[nodiscard]] MatLog ReadMatLog(const std::string& path,
                                 std::uint64_t max_bytes = std::uint64_t{384} << 20);
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

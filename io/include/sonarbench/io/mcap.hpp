@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
 
 /// MCAP (https://mcap.dev/spec), the container rosbag2 stores bags in: the records a ROS 2 bag
 /// needs, written and read without a third-party library.
@@ -96,4 +96,4 @@ inline constexpr char kMcapMagic[] = "\x89MCAP0\r\n";
 /// when `path` does not begin as an MCAP file does. Reads the magic and the header only.
 [[nodiscard]] std::optional<std::string> McapLibrary(const std::string& path);
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

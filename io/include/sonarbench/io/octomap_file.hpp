@@ -6,7 +6,7 @@
 #include <memory>
 #include <string>
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
 
 /// What an OctoMap file holds, from its header and a walk over its nodes.
 struct OcTreeFileInfo {
@@ -36,4 +36,4 @@ struct OcTreeFileInfo {
 inline constexpr const char* kOcTreeBinaryHeader = "# Octomap OcTree binary file";
 inline constexpr const char* kOcTreeFullHeader = "# Octomap OcTree file";
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

@@ -9,7 +9,11 @@
 #include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
-namespace sonarbench::mapping {
+namespace sonarbench::io {
+
+// The mapper's types these files hold.
+using mapping::Beam;
+using mapping::SensorGeometry;
 
 /// A ROS 2 bag (MCAP storage, `ros2` profile, CDR messages) of sonar beams, as `sonarbench
 /// export` writes it and `sonarbench import` reads it (docs/ros2.md):
@@ -67,4 +71,4 @@ struct RosbagBeams {
 /// frame to the tree's root. Throws InputError naming the file, topic, message and field.
 [[nodiscard]] RosbagBeams ReadRosbag(const std::string& path, const RosbagReadOptions& options);
 
-}  // namespace sonarbench::mapping
+}  // namespace sonarbench::io

@@ -56,7 +56,7 @@ struct DatasetSummary {
   std::string config_sha256;
 };
 
-/// Simulates a scene into a dataset directory (mapping::ReadDataset's format). Every file is
+/// Simulates a scene into a dataset directory (io::ReadDataset's format). Every file is
 /// written atomically; a sweep is complete when its beam, truth and image files all exist, and
 /// a rerun skips complete sweeps. manifest.json is written last, once every sweep is present (by
 /// whichever shard finishes last, or by a rerun without --shard). A directory holding another
@@ -75,7 +75,7 @@ struct ImportedLog {
 };
 
 /// A .mat log as an ImportedLog: static at the origin.
-[[nodiscard]] ImportedLog ImportedMatLog(mapping::MatLog log);
+[[nodiscard]] ImportedLog ImportedMatLog(io::MatLog log);
 
 /// Writes a recorded log (a .mat log, static at the origin, or a ROS 2 bag) as a dataset: its
 /// beams by sweep, polar images, the sonar's poses, no truth. Same atomicity and overwrite rules.

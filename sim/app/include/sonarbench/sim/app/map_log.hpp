@@ -54,7 +54,7 @@ struct LogMapResult {
 [[nodiscard]] std::string MatLogInDirectory(const std::string& input);
 
 /// Reads a real `.mat` log (a file, or a folder holding just one, see MatLogInDirectory) or a
-/// dataset directory (mapping::ReadDataset; its own sensor geometry replaces `sensor`) and maps it
+/// dataset directory (io::ReadDataset; its own sensor geometry replaces `sensor`) and maps it
 /// sweep by sweep (BeamsPerSweep() consecutive beams each; the last sweep may be partial). A
 /// `.mat` log's vehicle is static at its own origin: with `place_in` every beam of one is mapped
 /// from that scene's static sonar pose instead (StaticSonarPose, to score it against the scene);

@@ -19,7 +19,7 @@ namespace sonarbench::sim {
 /// A map file, written by any mapper, scored against a scene.
 struct MapFileScore {
   std::string map_file;
-  mapping::OcTreeFileInfo file;
+  io::OcTreeFileInfo file;
   std::unique_ptr<octomap::OcTree> map;
   /// The scene's surface cells at the map's resolution, those a perfect sensor sees, and the
   /// detector's ghosts (ScoreMap).

@@ -21,7 +21,7 @@ inline constexpr const char* kVersion = SONARBENCH_VERSION;
 [[nodiscard]] inline nlohmann::json FilesSha256(const std::string& dir,
                                                 const std::vector<std::string>& files) {
   nlohmann::json hashes = nlohmann::json::object();
-  for (const std::string& file : files) hashes[file] = mapping::Sha256OfFile(dir + "/" + file);
+  for (const std::string& file : files) hashes[file] = io::Sha256OfFile(dir + "/" + file);
   return hashes;
 }
 
