@@ -12,6 +12,7 @@
 #include <memory>
 #include <sstream>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/io/yaml_reader.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"

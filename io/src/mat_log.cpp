@@ -12,6 +12,7 @@
 #include <string>
 
 #include "mat_v5.hpp"
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <type_traits>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 
 namespace sonarbench::io::mat_v5 {

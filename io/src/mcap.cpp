@@ -11,6 +11,7 @@
 #include <set>
 #include <string_view>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 

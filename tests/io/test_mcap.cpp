@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/io/rosbag.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"

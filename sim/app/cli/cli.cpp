@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
 

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "cli.hpp"
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mat_log.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"

@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "cli.hpp"
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mat_log.hpp"
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/io/rosbag.hpp"

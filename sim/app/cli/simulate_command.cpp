@@ -2,6 +2,7 @@
 #include <memory>
 
 #include "cli.hpp"
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper.hpp"

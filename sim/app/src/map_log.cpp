@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/io/mat_log.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/report/report_page.hpp"

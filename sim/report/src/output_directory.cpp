@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/sim/report/images.hpp"

@@ -21,6 +21,7 @@
 #include <string_view>
 #include <vector>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/world/mesh.hpp"

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <future>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "test_util.hpp"
 
