@@ -204,7 +204,9 @@ def special_files(sb, work):
              ("a FIFO as import's --sensor", ("import", LOG, "--sensor", fifo, "--out", work / "f7"),
               "is a FIFO"),
              ("/dev/zero as the scene", ("simulate", "/dev/zero", "--out", work / "f8"),
-              "is a character device")]
+              "is a character device"),
+             ("a FIFO to score", ("score", fifo, "--scene", TANK, "--out", work / "f9"),
+              "is a FIFO")]
     for what, path, expect in (("a FIFO", fifo, "is a FIFO"), ("a directory", folder,
                                                                "is a directory"),
                                ("/dev/zero", "/dev/zero", "is a character device")):
@@ -215,6 +217,17 @@ def special_files(sb, work):
     for what, args, expect in cases:
         text, _ = refused(sb, what, *args, expect=expect)
         check("no such mesh file" not in text, f"{what}: reported as missing: {text}")
+    # A dataset whose poses file is a FIFO (the manifest lists it not): refused, never waited on.
+    dataset = work / "fifo-dataset"
+    code, text, _, _ = sb("simulate", scene, "--out", dataset)
+    check(code == 0, f"simulate: {text}")
+    manifest = json.loads((dataset / "manifest.json").read_text())
+    manifest["files"] = [f for f in manifest["files"] if f["path"] != "poses/sonar.tum"]
+    (dataset / "manifest.json").write_text(json.dumps(manifest))
+    (dataset / "poses/sonar.tum").unlink()
+    os.mkfifo(dataset / "poses/sonar.tum")
+    refused(sb, "a FIFO as a dataset's poses", "map", dataset, "--out", work / "f10",
+            expect="is a FIFO")
     # A chain of extends deeper than any scene needs says so.
     chain = work / "chain"
     chain.mkdir()

@@ -128,7 +128,11 @@ std::string TumLine(double time_s, const Eigen::Isometry3d& pose) {
   return line;
 }
 
+// A poses file or a sweep's beam file: 10^6 lines or beams of a few hundred bytes.
+constexpr std::uint64_t kMaxDatasetFileBytes = std::uint64_t{1} << 30;
+
 std::vector<StampedPose> ReadTum(const std::string& path) {
+  (void)CheckInputFile(path, kMaxDatasetFileBytes);  // a FIFO or device never opened
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot be read");
   std::vector<StampedPose> poses;
@@ -271,6 +275,7 @@ Dataset ReadDataset(const std::string& dir) {
 
   for (std::size_t s = 0; s < dataset.sweeps; ++s) {
     const std::string path = (root / SweepFile("beams", s, "bin")).string();
+    if (std::filesystem::exists(path)) (void)CheckInputFile(path, kMaxDatasetFileBytes);
     std::ifstream in(path, std::ios::binary);
     if (!in)
       throw InputError(path + ": missing (the manifest counts " + std::to_string(dataset.sweeps) +

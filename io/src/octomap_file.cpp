@@ -1,5 +1,6 @@
 #include "sonarbench/io/octomap_file.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -7,6 +8,7 @@
 #include <fstream>
 #include <optional>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::io {
@@ -190,6 +192,9 @@ class NodeWalk {
 
 // Checks the file whole; returns what it holds and where its data starts.
 OcTreeFileInfo CheckFile(const std::string& path, double max_cells, std::streamoff& data_offset) {
+  // A FIFO or device is refused by its type before it is opened; a node takes at least 2 bytes
+  // (.bt) and at most ~60 in memory, so the cell budget bounds the file too.
+  (void)CheckInputFile(path, static_cast<std::uint64_t>(std::min(max_cells * 64.0, 1e12)) + 4096);
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the map file");
   Reader reader(in, path);
