@@ -7,7 +7,7 @@ set -euo pipefail
 sonarbench="$1"
 export NODE_PATH="$2"
 here="$(cd "$(dirname "$0")" && pwd)"
-root="$here/../../.."
+root="$here/../.."
 if ! command -v node > /dev/null || [ ! -d "$NODE_PATH/@mcap/core" ]; then
   echo "Node.js or the npm packages are missing from $NODE_PATH (bash ci/install-npm.sh installs them)"
   if [ "${SONARBENCH_REQUIRE_NODE:-0}" = 1 ]; then exit 1; fi
