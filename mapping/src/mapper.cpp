@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/detail/beam_volume.hpp"
@@ -31,8 +33,35 @@ struct Mapper::State {
   explicit State(double resolution_m) : tree(resolution_m) {}
 };
 
+namespace {
+
+// `c`, once checked: throws std::invalid_argument naming the first field the mapper cannot take.
+const MapperConfig& Checked(const MapperConfig& c) {
+  const auto need = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("MapperConfig: expected ") + what);
+  };
+  need(std::isfinite(c.resolution_m) && c.resolution_m > 0.0, "resolution_m > 0");
+  need(c.rays_horizontal >= 1 && c.rays_vertical >= 1, "rays_horizontal and rays_vertical >= 1");
+  need(c.threads >= 0, "threads >= 0 (0: all cores)");
+  need(std::isfinite(c.free_range_m) && c.free_range_m >= 0.0, "free_range_m >= 0");
+  need(c.prob_hit >= 0.5 && c.prob_hit <= 1.0, "prob_hit in [0.5, 1]");
+  need(c.prob_miss >= 0.0 && c.prob_miss <= 0.5, "prob_miss in [0, 0.5]");
+  need(c.clamp_min >= 0.0 && c.clamp_min <= 0.5 && c.clamp_max >= 0.5 && c.clamp_max <= 1.0,
+       "clamp_min in [0, 0.5] and clamp_max in [0.5, 1]");
+  const DetectionConfig& d = c.detection;
+  need(d.threshold >= 1 && d.threshold <= 255, "detection.threshold in 1..255");
+  need(d.smoothing_bins >= 1 && d.smoothing_bins % 2 == 1, "detection.smoothing_bins odd, >= 1");
+  need(d.min_run_bins >= 1, "detection.min_run_bins >= 1");
+  need(d.max_obstacles >= 1, "detection.max_obstacles >= 1");
+  return c;
+}
+
+}  // namespace
+
 Mapper::Mapper(const MapperConfig& config, const SensorGeometry& sensor)
-    : config_(config), sensor_(sensor), state_(std::make_unique<State>(config.resolution_m)) {
+    : config_(Checked(config)),
+      sensor_(sensor),
+      state_(std::make_unique<State>(config.resolution_m)) {
   state_->free_range_m = !config.clear_without_obstacle ? 0.0
                          : config.free_range_m > 0.0    ? config.free_range_m
                                                         : sensor.MaxRangeM();

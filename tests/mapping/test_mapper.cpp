@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -152,6 +154,38 @@ TEST(Mapper, WritesAndListsTheMapAsItsTreeWithoutBuildingIt) {
   std::sort(tree_leaves.begin(), tree_leaves.end());
   EXPECT_EQ(leaves, tree_leaves);
   EXPECT_TRUE(std::any_of(leaves.begin(), leaves.end(), [](const auto& l) { return l.second; }));
+}
+
+// The mapper checks its own configuration (not only the YAML reader does): each field outside
+// what it takes is refused by name; the defaults and the reader's bounds are taken.
+TEST(Mapper, RefusesAConfigurationItCannotTakeNamingTheField) {
+  const SensorGeometry sensor;
+  EXPECT_NO_THROW(Mapper(MapperConfig{}, sensor));
+  const auto refused = [&](const std::function<void(MapperConfig&)>& change) {
+    MapperConfig c;
+    change(c);
+    try {
+      Mapper mapper(c, sensor);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(refused([](MapperConfig& c) { c.resolution_m = 0.0; }).find("resolution_m"),
+            std::string::npos);
+  EXPECT_NE(refused([](MapperConfig& c) { c.rays_vertical = 0; }).find("rays_vertical"),
+            std::string::npos);
+  EXPECT_NE(refused([](MapperConfig& c) { c.detection.threshold = 256; }).find("threshold"),
+            std::string::npos);
+  EXPECT_NE(refused([](MapperConfig& c) { c.detection.smoothing_bins = 4; }).find("smoothing"),
+            std::string::npos);
+  EXPECT_NE(refused([](MapperConfig& c) { c.prob_hit = 0.4; }).find("prob_hit"), std::string::npos);
+  EXPECT_EQ(refused([](MapperConfig& c) {
+              c.detection.threshold = 255;
+              c.prob_hit = 1.0;
+              c.clamp_min = 0.5;
+            }),
+            "");
 }
 
 }  // namespace

@@ -28,7 +28,10 @@ void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out);
 /// once before several threads call it.
 class Mapper {
  public:
-  Mapper(const MapperConfig& config, const SensorGeometry& sensor);
+  /// Throws std::invalid_argument naming the field when `config` is outside what the mapper
+  /// takes (a resolution that is not positive, rays or echoes under 1, a threshold outside
+  /// 1..255, an even smoothing window, hit/miss probabilities or clamps on the wrong side of 0.5).
+  explicit Mapper(const MapperConfig& config, const SensorGeometry& sensor);
   ~Mapper();
   Mapper(Mapper&&) noexcept;
   Mapper& operator=(Mapper&&) noexcept;
