@@ -112,18 +112,6 @@ std::vector<std::string> SortedUnion(std::vector<std::string> a,
   return a;
 }
 
-// The pids the lock file's lines name ("sonarbench CMD, pid N on HOST, ..."): its writers since
-// the last one out emptied it.
-std::set<std::string> WriterPids(const std::string& text) {
-  std::set<std::string> pids;
-  for (std::size_t at = text.find(", pid "); at != std::string::npos;
-       at = text.find(", pid ", at + 6)) {
-    const std::size_t end = text.find_first_not_of("0123456789", at + 6);
-    if (end != at + 6 && end != std::string::npos) pids.insert(text.substr(at + 6, end - at - 6));
-  }
-  return pids;
-}
-
 bool IsFolder(const fs::path& path) {
   std::error_code error;
   return fs::is_directory(fs::symlink_status(path, error));
@@ -270,38 +258,11 @@ bool OutputDirectory::TakeRunLock() {
   return true;
 }
 
-// Opens the lock file, never through a symlink and never one with another name (a hard link):
-// writing the holder's name would change a file elsewhere.
-void OutputDirectory::OpenLockFile() {
-  const std::string lock = name_ + "/" + kLockFile;
-  lock_fd_ = ::open((root_ / kLockFile).c_str(),
-                    O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK | O_NOCTTY, 0644);
-  if (lock_fd_ < 0 && errno == ELOOP) {
-    throw InputError(lock + " is a symlink: sonarbench writes nothing through one (remove it)");
-  }
-  if (lock_fd_ < 0) {
-    throw EnvironmentError(name_ + ": cannot write in it (" + std::strerror(errno) + ")");
-  }
-  struct stat info {};
-  std::string refused;
-  if (::fstat(lock_fd_, &info) != 0 || !S_ISREG(info.st_mode)) {
-    refused = lock + " is not a regular file: sonarbench did not make it (remove it)";
-  } else if (info.st_nlink != 1) {
-    refused = lock + " has another name (a hard link): writing it would change a file " +
-              "elsewhere; sonarbench did not make it (remove it)";
-  }
-  if (!refused.empty()) {
-    ::close(lock_fd_);  // never truncated on the way out
-    lock_fd_ = -1;
-    throw InputError(refused);
-  }
-}
-
 void OutputDirectory::ClaimFiles() {
   Ownership owned = ReadOwnership(root_).value_or(Ownership{});
   // Every writer the lock file names is gone (this one holds its lock alone): their temporary
   // files are never whole.
-  dead_writers_ = WriterPids(LockText());
+  dead_writers_ = LockedWriters();
   const std::vector<std::string> listed = OwnedFiles(root_).value_or(std::vector<std::string>{});
   CheckInputsAndCollisions(listed);
   ClearStage(listed);
@@ -502,35 +463,6 @@ void OutputDirectory::WriteMarker(const Ownership& owned) const {
                       [&](std::ostream& out) { out << marker.dump(2) << "\n"; });
 }
 
-void OutputDirectory::WriteHolder(bool first) const {
-  char host[256] = "?";
-  ::gethostname(host, sizeof host - 1);
-  const std::string text = "sonarbench " + claim_.command + ", pid " + std::to_string(::getpid()) +
-                           " on " + host + ", config " + claim_.config_sha256.substr(0, 12) + "\n";
-  // The first writer replaces the names of those before it (their temporaries are gone); each
-  // shard that joins adds its own line, under the directory's lock.
-  struct stat info {};
-  const off_t at = first || ::fstat(lock_fd_, &info) != 0 ? 0 : info.st_size;
-  if ((first && ::ftruncate(lock_fd_, 0) != 0) ||
-      ::pwrite(lock_fd_, text.data(), text.size(), at) != static_cast<ssize_t>(text.size())) {
-    throw EnvironmentError(name_ + "/" + kLockFile + ": cannot be written (" +
-                           std::strerror(errno) + ")");
-  }
-}
-
-std::string OutputDirectory::LockText() const {
-  std::string text(4096, '\0');
-  const ssize_t n = ::pread(lock_fd_, text.data(), text.size(), 0);
-  text.resize(n > 0 ? static_cast<std::size_t>(n) : 0);
-  return text;
-}
-
-std::string OutputDirectory::Holder() const {
-  std::string holder = LockText().substr(0, 511);
-  holder = holder.substr(0, holder.find('\n'));
-  return holder.empty() ? "holder unknown" : Quoted(holder, 200);
-}
-
 bool OutputDirectory::HoldsRecord() const {
   const auto owned = ReadOwnership(root_);
   return owned && owned->contains(claim_.command) && Exists(root_ / claim_.record) &&
@@ -542,9 +474,8 @@ void OutputDirectory::DiscardStaged() const {
   for (const std::string& file : claim_.files) {
     std::error_code ignored;
     fs::remove(write_root_ / file, ignored);
-    RemoveEmptyParents(write_root_, file);
+    RemoveEmptyParents(write_root_, file);  // never write_root_ itself
   }
-  fs::create_directories(write_root_);
 }
 
 void OutputDirectory::Commit() {
@@ -604,19 +535,15 @@ void OutputDirectory::Release() noexcept {
   try {
     // A lock file made by an open that was refused goes again (no marker lists it).
     if (lock_created_) ::unlink((root_ / kLockFile).c_str());
-    if (claim_.mode == OutputMode::kReplace && !committed_ && write_root_ != root_) {
-      for (const std::string& file : claim_.files) {
-        std::error_code ignored;
-        fs::remove(write_root_ / file, ignored);
-        RemoveEmptyParents(write_root_, file);
-      }
+    if (!committed_ && write_root_ != root_) {
+      DiscardStaged();
       ::rmdir(write_root_.c_str());
     }
     // The last writer out removes the temporaries of the shards that died before it, and leaves
     // the lock file empty: the same inputs, the same bytes.
     const bool last = ::flock(lock_fd_, LOCK_EX | LOCK_NB) == 0;
     if (last && !lock_created_) {
-      dead_writers_ = WriterPids(LockText());
+      dead_writers_ = LockedWriters();
       RemoveTemporaries({});
       if (::ftruncate(lock_fd_, 0) != 0) {
         // Only the writers' names are left in it.

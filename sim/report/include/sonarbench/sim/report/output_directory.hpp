@@ -103,6 +103,9 @@ class OutputDirectory {
   void WriteMarker(const Ownership& owned) const;
   void WriteHolder(bool first) const;
   [[nodiscard]] std::string LockText() const;
+  // The pids the lock file's lines name ("sonarbench CMD, pid N on HOST, ..."): its writers
+  // since the last one out emptied it.
+  [[nodiscard]] std::set<std::string> LockedWriters() const;
   [[nodiscard]] std::string Holder() const;
 
   std::string name_;
