@@ -14,6 +14,7 @@
 
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/io/yaml_reader.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"

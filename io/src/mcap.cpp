@@ -12,6 +12,7 @@
 #include <string_view>
 
 #include "sonarbench/io/files.hpp"
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 

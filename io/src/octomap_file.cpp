@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "sonarbench/io/files.hpp"
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::io {

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <map>
 
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::io::ros2 {

@@ -8,6 +8,7 @@
 
 #include "ros2_messages.hpp"
 #include "sonarbench/io/mcap.hpp"
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::io {

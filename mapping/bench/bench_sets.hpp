@@ -4,8 +4,8 @@
 #include <absl/container/flat_hash_set.h>
 #include <absl/hash/hash.h>
 
-#include "sonarbench/mapping/detail/beam_volume.hpp"
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "beam_volume.hpp"
+#include "key_set.hpp"
 
 namespace sonarbench::mapping::bench {
 

@@ -23,9 +23,9 @@
 #include <vector>
 
 #include "bench_sets.hpp"
+#include "block_set.hpp"
+#include "integrate.hpp"
 #include "sonarbench/io/mat_log.hpp"
-#include "sonarbench/mapping/detail/block_set.hpp"
-#include "sonarbench/mapping/detail/integrate.hpp"
 #include "sonarbench/mapping/detection.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 

@@ -1,9 +1,9 @@
-#include "sonarbench/mapping/detail/arc_evidence.hpp"
+#include "arc_evidence.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "key_set.hpp"
 
 namespace sonarbench::mapping {
 

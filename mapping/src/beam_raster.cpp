@@ -1,4 +1,4 @@
-#include "sonarbench/mapping/detail/beam_raster.hpp"
+#include "beam_raster.hpp"
 
 #include <algorithm>
 #include <bit>

@@ -1,4 +1,4 @@
-#include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "beam_volume.hpp"
 
 namespace sonarbench::mapping {
 namespace {
@@ -25,6 +25,26 @@ std::vector<Eigen::Vector3d> BeamRayDirections(const SensorGeometry& sensor, int
     }
   }
   return directions;
+}
+
+BeamKeys RayCastBeamKeys(const octomap::OcTree& tree, const Beam& beam,
+                         std::span<const Eigen::Vector3d> directions,
+                         std::span<const double> obstacle_ranges_m, double free_range_m) {
+  BeamCells cells;
+  CastBeam(tree, beam, directions, obstacle_ranges_m, free_range_m, cells);
+  return {std::move(cells.free), std::move(cells.occupied), cells.visits};
+}
+
+BeamKeys ExactBeamKeys(const octomap::OcTree& tree, const SensorGeometry& sensor, const Beam& beam,
+                       std::span<const double> obstacle_ranges_m, double free_range_m) {
+  std::vector<std::uint64_t> free, occupied;
+  const WedgeCellCounts counts = ExactBeamCells(tree, BeamWedge(sensor, beam), obstacle_ranges_m,
+                                                free_range_m, free, occupied);
+  BeamKeys keys;
+  for (const std::uint64_t packed : free) keys.free.insert(UnpackKey(packed));
+  for (const std::uint64_t packed : occupied) keys.occupied.insert(UnpackKey(packed));
+  keys.visits = counts.examined;
+  return keys;
 }
 
 }  // namespace sonarbench::mapping

@@ -1,4 +1,4 @@
-#include "sonarbench/mapping/detail/beam_wedge.hpp"
+#include "beam_wedge.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <limits>
 
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "key_set.hpp"
 #include "wedge_cell_tester.hpp"
 
 namespace sonarbench::mapping {

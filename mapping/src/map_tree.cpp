@@ -1,4 +1,4 @@
-#include "sonarbench/mapping/detail/map_tree.hpp"
+#include "map_tree.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -6,13 +6,14 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <variant>
 
+#include "beam_volume.hpp"
+#include "block_set.hpp"
+#include "integrate.hpp"
+#include "key_set.hpp"
+#include "map_tree.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/detail/beam_volume.hpp"
-#include "sonarbench/mapping/detail/block_set.hpp"
-#include "sonarbench/mapping/detail/integrate.hpp"
-#include "sonarbench/mapping/detail/key_set.hpp"
-#include "sonarbench/mapping/detail/map_tree.hpp"
 #include "sonarbench/mapping/detection.hpp"
 
 namespace sonarbench::mapping {
@@ -23,10 +24,9 @@ struct Mapper::State {
   ArcEvidence evidence;
   std::vector<Eigen::Vector3d> directions;
   MapTree tree;
-  /// The key sets and buffers of the batches, kept between them (the one of config.key_set).
-  BatchWorkspace<KeySet> std_workspace;
-  BatchWorkspace<KeyOpenSet> open_workspace;
-  BatchWorkspace<BlockKeySet> block_workspace;
+  /// The key sets and buffers of the batches, kept between them: those of config.key_set.
+  std::variant<BatchWorkspace<BlockKeySet>, BatchWorkspace<KeyOpenSet>, BatchWorkspace<KeySet>>
+      workspace;
   /// Whether the tree's inner nodes lag its leaves (see FinishUpdates).
   bool stale = false;
 
@@ -70,6 +70,16 @@ Mapper::Mapper(const MapperConfig& config, const SensorGeometry& sensor)
     // The two-way pattern's -3 dB points at the wedge's elevation limits (docs/physics.md).
     const double w = sensor.beam_width_vertical_rad;
     state_->evidence.pattern_k = 4.0 * std::log(2.0) / (w * w);
+  }
+  switch (config.key_set) {
+    case KeySetKind::kBlocks:
+      break;  // the variant's first
+    case KeySetKind::kOpenAddressing:
+      state_->workspace.emplace<BatchWorkspace<KeyOpenSet>>();
+      break;
+    case KeySetKind::kStd:
+      state_->workspace.emplace<BatchWorkspace<KeySet>>();
+      break;
   }
   state_->directions = BeamRayDirections(sensor, config.rays_horizontal, config.rays_vertical);
   MapTree& tree = state_->tree;
@@ -122,15 +132,7 @@ BatchStats Mapper::Integrate(std::span<const Beam> beams,
     return IntegrateBatch(s.tree, beams, obstacles, s.directions, s.free_range_m, s.threads,
                           workspace, s.evidence);
   };
-  switch (config_.key_set) {
-    case KeySetKind::kStd:
-      return integrate(s.std_workspace);
-    case KeySetKind::kOpenAddressing:
-      return integrate(s.open_workspace);
-    case KeySetKind::kBlocks:
-      break;
-  }
-  return integrate(s.block_workspace);
+  return std::visit(integrate, s.workspace);
 }
 
 void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out) {

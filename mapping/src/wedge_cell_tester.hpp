@@ -15,8 +15,8 @@
 #include <span>
 #include <vector>
 
-#include "sonarbench/mapping/detail/beam_wedge.hpp"
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "beam_wedge.hpp"
+#include "key_set.hpp"
 
 namespace sonarbench::mapping::wedge_detail {
 

@@ -1,10 +1,12 @@
 // Maps one sweep of synthetic beams that each see a wall 2 m away, with the installed library,
-// and checks the map: exits 0 when the wall's cells are occupied and the water before it free.
+// and checks the map: exits 0 when the wall's cells are occupied and the water before it free,
+// and the first beam's own cells (beam_cells.hpp) agree.
 #include <cmath>
 #include <cstdio>
 #include <numbers>
 #include <vector>
 
+#include "sonarbench/mapping/beam_cells.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 
 int main() {
@@ -33,9 +35,14 @@ int main() {
   }
   const octomap::OcTreeNode* water = tree.search(1.0, 0.01, 0.01);
   const bool free = water != nullptr && !tree.isNodeOccupied(water);
-  const bool ok = wall && free && stats.beams_with_obstacle == sweep.size();
-  std::printf("%zu beams, %zu with an obstacle; wall %s, water %s: %s\n", stats.beams,
-              stats.beams_with_obstacle, wall ? "occupied" : "not occupied",
-              free ? "free" : "not free", ok ? "ok" : "FAILED");
+  // The first beam alone, as the mapper's exact integration sees it: its wall cell on the shell.
+  const double obstacle[] = {wall_m};
+  const auto keys = sonarbench::mapping::ExactBeamKeys(tree, sensor, sweep.front(), obstacle, 0.0);
+  const bool beam_cells = keys.occupied.contains(tree.coordToKey(wall_m + 0.01, 0.01, 0.01)) &&
+                          keys.free.contains(tree.coordToKey(1.0, 0.01, 0.01));
+  const bool ok = wall && free && beam_cells && stats.beams_with_obstacle == sweep.size();
+  std::printf("%zu beams, %zu with an obstacle; wall %s, water %s, beam cells %s: %s\n",
+              stats.beams, stats.beams_with_obstacle, wall ? "occupied" : "not occupied",
+              free ? "free" : "not free", beam_cells ? "agree" : "disagree", ok ? "ok" : "FAILED");
   return ok ? 0 : 1;
 }

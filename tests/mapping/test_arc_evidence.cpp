@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "sonarbench/mapping/detail/arc_evidence.hpp"
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "arc_evidence.hpp"
+#include "key_set.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 
 namespace sonarbench::mapping {

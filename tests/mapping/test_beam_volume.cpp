@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "sonarbench/mapping/detail/beam_volume.hpp"
-#include "sonarbench/mapping/detail/integrate.hpp"
+#include "beam_volume.hpp"
+#include "integrate.hpp"
 
 namespace sonarbench::mapping {
 namespace {

@@ -5,8 +5,8 @@
 #include <random>
 #include <set>
 
-#include "sonarbench/mapping/detail/beam_volume.hpp"
-#include "sonarbench/mapping/detail/beam_wedge.hpp"
+#include "beam_volume.hpp"
+#include "beam_wedge.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 
 namespace sonarbench::mapping {

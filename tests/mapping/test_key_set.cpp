@@ -7,10 +7,10 @@
 #include <unordered_set>
 #include <vector>
 
-#include "sonarbench/mapping/detail/beam_volume.hpp"
-#include "sonarbench/mapping/detail/block_set.hpp"
-#include "sonarbench/mapping/detail/integrate.hpp"
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "beam_volume.hpp"
+#include "block_set.hpp"
+#include "integrate.hpp"
+#include "key_set.hpp"
 
 namespace sonarbench::mapping {
 namespace {

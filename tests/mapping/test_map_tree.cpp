@@ -8,11 +8,11 @@
 #include <unordered_set>
 #include <vector>
 
-#include "sonarbench/mapping/detail/beam_raster.hpp"
-#include "sonarbench/mapping/detail/beam_volume.hpp"
-#include "sonarbench/mapping/detail/integrate.hpp"
-#include "sonarbench/mapping/detail/map_tree.hpp"
-#include "sonarbench/mapping/detail/ray_keys.hpp"
+#include "beam_raster.hpp"
+#include "beam_volume.hpp"
+#include "integrate.hpp"
+#include "map_tree.hpp"
+#include "ray_keys.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 
 namespace sonarbench::mapping {

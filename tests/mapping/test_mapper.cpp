@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "key_set.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "test_util.hpp"
 

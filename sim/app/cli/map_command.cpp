@@ -57,14 +57,9 @@ int Map(const MapArgs& args) {
       [&](std::size_t done, std::size_t total) { progress.Update("map", done, total); });
   progress.Clear();
   if (scene) {
-    sonarbench::sim::LogScoreParts parts;
-    result.metrics = sonarbench::sim::ScoreLogMap(result, *scene, &parts);
-    result.truth = std::move(parts.truth);
-    result.observable = std::move(parts.observable);
-    result.detector_ghosts = std::move(parts.detector_ghosts);
-    result.verdict = sonarbench::sim::Evaluate(scene->criteria, *result.metrics);
+    result.score = sonarbench::sim::ScoreLogMap(result, *scene);
     result.certainty = sonarbench::sim::SweepCertainty(result.mapped, result.sensor, config,
-                                                       result.mapper->tree(), result.truth);
+                                                       result.mapper->tree(), result.score->truth);
   }
   sonarbench::sim::WriteLogMapOutputs(out.write_root().string(), result, scene ? &*scene : nullptr);
   out.Commit();
@@ -77,16 +72,16 @@ int Map(const MapArgs& args) {
                     ? " (the mapper's defaults; --scene or --mapping sets them)\n"
                     : "\n");
   for (const std::string& warning : result.warnings) std::cout << "warning: " << warning << "\n";
-  if (result.metrics)
-    std::cout << "against " << args.scene << ": " << MetricsLine(*result.metrics) << "\n";
+  if (result.score)
+    std::cout << "against " << args.scene << ": " << MetricsLine(result.score->metrics) << "\n";
   std::cout << "timing [s]: import " << Seconds3(result.import_s) << ", map "
             << Seconds3(result.map_s) << "\n"
             << "wrote " << args.out << "/report.json, report.html"
-            << (result.verdict ? ", junit.xml, map_side.png, certainty.png, certainty.csv" : "")
+            << (result.score ? ", junit.xml, map_side.png, certainty.png, certainty.csv" : "")
             << ", map.bt, map.ot, map_top.png, polar.png, fan.png\n";
-  if (!result.verdict) return 0;
-  PrintVerdict(scene->name, *result.verdict);
-  return result.verdict->passed ? 0 : kExitCriteriaFailed;
+  if (!result.score) return 0;
+  PrintVerdict(scene->name, result.score->verdict);
+  return result.score->verdict.passed ? 0 : kExitCriteriaFailed;
 }
 
 // `sonarbench map`: its options, filled into `args` when parsed.

@@ -25,7 +25,7 @@ void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::Sc
                   const std::string& out) {
   const auto& t = r.timings;
   std::cout << "beams " << r.beams << ", seed " << r.seed << ", threads " << r.threads << "\n"
-            << MetricsLine(r.metrics) << "\n"
+            << MetricsLine(r.score.metrics) << "\n"
             << "timing [s]: scene " << Seconds3(t.build_scene_s) << ", simulate "
             << Seconds3(t.simulate_s) << ", map " << Seconds3(t.map_s) << ", ground truth "
             << Seconds3(t.ground_truth_s) << ", score " << Seconds3(t.score_s) << "\n"
@@ -40,7 +40,7 @@ void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::Sc
                 << " non-manifold edges (three or more triangles share them)\n";
     }
   }
-  PrintVerdict(scene.name, r.verdict);
+  PrintVerdict(scene.name, r.score.verdict);
 }
 
 // A run that broke leaves a junit.xml saying so (and no other output) for the CI system that
@@ -85,7 +85,7 @@ int Run(const RunArgs& args) {
     sim::WriteScenarioOutputs(out.write_root().string(), scene, result);
     out.Commit();
     PrintSummary(scene, result, args.out);
-    return result.verdict.passed ? 0 : kExitCriteriaFailed;
+    return result.score.verdict.passed ? 0 : kExitCriteriaFailed;
   } catch (const sonarbench::InputError& e) {
     CommitErrorJunit(out, args, "input_error", e.what());
     throw;

@@ -25,18 +25,18 @@ int Score(const ScoreArgs& args) {
   sim::OutputDirectory out(
       args.out, OneShotClaim("score", sim::kMapFileScoreOutputFiles, {args.map, args.scene}));
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
-  const sim::MapFileScore score = sim::ScoreMapFile(
+  const sim::MapFileScore file_score = sim::ScoreMapFile(
       args.map, scene, args.budgets,
       [&](std::size_t done, std::size_t total) { progress.Update("observable", done, total); });
   progress.Clear();
-  sim::WriteMapFileScoreOutputs(out.write_root().string(), scene, score);
+  sim::WriteMapFileScoreOutputs(out.write_root().string(), scene, file_score);
   out.Commit();
-  std::cout << args.map << " (" << score.file.resolution_m << " m) against " << args.scene << ": "
-            << MetricsLine(score.metrics) << "\n"
+  std::cout << args.map << " (" << file_score.file.resolution_m << " m) against " << args.scene
+            << ": " << MetricsLine(file_score.score.metrics) << "\n"
             << "wrote " << args.out << "/report.json, junit.xml, report.html, map_top.png, "
             << "map_side.png\n";
-  PrintVerdict(scene.name, score.verdict);
-  return score.verdict.passed ? 0 : kExitCriteriaFailed;
+  PrintVerdict(scene.name, file_score.score.verdict);
+  return file_score.score.verdict.passed ? 0 : kExitCriteriaFailed;
 }
 
 // `sonarbench score`: its options, filled into `args` when parsed.

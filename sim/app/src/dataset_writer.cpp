@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "sonarbench/io/files.hpp"
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper.hpp"
@@ -244,7 +245,7 @@ Shard ParseShard(const std::string& text) {
                       slash && after_k + 1 != end &&
                       std::isdigit(static_cast<unsigned char>(after_k[1]));
   if (!digits || n_error != std::errc() || after_n != end || n < 1 || k < 1 || k > n) {
-    throw InputError("--shard " + Quoted(text) + ": expected K/N with 1 <= K <= N, e.g. 3/8");
+    throw InputError("--shard " + io::Quoted(text) + ": expected K/N with 1 <= K <= N, e.g. 3/8");
   }
   return {k - 1, n};
 }
@@ -259,7 +260,7 @@ std::optional<Shard> ShardFromSlurm() {
     int v = -1;
     const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
     if (text.empty() || error != std::errc() || end != text.data() + text.size() || v < 0) {
-      throw InputError(std::string("environment variable ") + name + "=" + Quoted(text) +
+      throw InputError(std::string("environment variable ") + name + "=" + io::Quoted(text) +
                        ": expected a non-negative integer");
     }
     return v;

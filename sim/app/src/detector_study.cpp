@@ -155,10 +155,10 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
   // The log first (bad input fails before the simulation): read and placed once as `map --score`
   // does, its truth, observable cells and direct echoes kept.
   std::optional<LogMapResult> log;
-  LogScoreParts log_parts;
+  std::optional<SceneScore> log_score;
   if (!options.log.empty()) {
     log = MapLog(options.log, scene.sensor.geometry, base, &scene, scene.budgets);
-    (void)ScoreLogMap(*log, scene, &log_parts);
+    log_score = ScoreLogMap(*log, scene);
   }
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
@@ -172,8 +172,8 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
                                 simulated.truth, simulated.observable, simulated.direct),
                     std::nullopt};
     if (log) {
-      row.log = MapAndScore(base, item.detection, log->sensor, log->mapped, log_parts.truth,
-                            log_parts.observable, log_parts.direct);
+      row.log = MapAndScore(base, item.detection, log->sensor, log->mapped, log_score->truth,
+                            log_score->observable, log_score->direct);
     }
     rows.push_back(std::move(row));
     if (options.progress) options.progress(rows.size(), items.size());

@@ -11,6 +11,7 @@
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/io/mat_log.hpp"
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
@@ -63,15 +64,15 @@ std::optional<Eigen::Isometry3d> DatasetPlacement(const io::Dataset& dataset,
   }
   if (source == "import") return StaticSonarPose(scene);
   if (source != "simulate") {
-    throw InputError(dir + "/manifest.json: 'source' is " + Quoted(source) +
+    throw InputError(dir + "/manifest.json: 'source' is " + io::Quoted(source) +
                      "; expected 'simulate' or 'import' to score it against a scene");
   }
   const nlohmann::json named = m.value("scene", nlohmann::json::object());
   const std::string name = named.is_object() ? named.value("name", "") : "";
   if (name != scene.name) {
-    throw InputError(dir + ": a dataset of scene " + Quoted(name) + " (manifest.json); it " +
-                     "cannot be scored against scene " + Quoted(scene.name) + " (" + scene.file +
-                     "): score it against the scene it was simulated from");
+    throw InputError(dir + ": a dataset of scene " + io::Quoted(name) + " (manifest.json); it " +
+                     "cannot be scored against scene " + io::Quoted(scene.name) + " (" +
+                     scene.file + "): score it against the scene it was simulated from");
   }
   const nlohmann::json seed = m.value("seed", nlohmann::json());
   if (seed.is_number_unsigned() &&
@@ -161,16 +162,11 @@ Eigen::Isometry3d StaticSonarPose(const Scene& scene) {
   return first;
 }
 
-MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene, LogScoreParts* parts) {
+SceneScore ScoreLogMap(const LogMapResult& result, const Scene& scene) {
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
-  const octomap::OcTree& map = result.mapper->tree();
-  LogScoreParts own;
-  LogScoreParts& p = parts ? *parts : own;
-  p.truth = VoxelizeMeshes(meshes, map);
-  p.observable = PerfectSensorCells(tracer, result.poses, result.sensor, scene.sensor.acoustics,
-                                    map, {}, &p.direct);
-  return ScoreMap(map, p.truth, p.observable, meshes, {}, &p.direct, &p.detector_ghosts);
+  return ScoreAgainstScene(result.mapper->tree(), scene, meshes, tracer, result.poses,
+                           result.sensor);
 }
 
 namespace {
@@ -178,7 +174,7 @@ namespace {
 // report.html of a mapped log: what was mapped, the scores and criteria when scored, the images.
 std::string LogMapHtml(const LogMapResult& result, const Scene* scene,
                        const std::vector<ReportImage>& images, const MapCells& cells) {
-  const Verdict* verdict = result.verdict ? &*result.verdict : nullptr;
+  const Verdict* verdict = result.score ? &result.score->verdict : nullptr;
   const std::string name = std::filesystem::path(result.input).filename().string();
   std::ostringstream html;
   html << HtmlPageStart(
@@ -204,7 +200,7 @@ std::string LogMapHtml(const LogMapResult& result, const Scene* scene,
     html << "<p class=\"acceptable\">" << XmlEscape(warning) << "</p>\n";
   }
   if (verdict) html << CriteriaHtml(*verdict);
-  if (result.metrics) html << MetricsHtml(*result.metrics);
+  if (result.score) html << MetricsHtml(result.score->metrics);
   html << ImagesHtmlAndEnd(images);
   return html.str();
 }
@@ -271,8 +267,8 @@ std::vector<ReportImage> MapImages(const LogMapResult& result, const Scene* scen
   if (scene) {
     Eigen::Vector3d sonar = Eigen::Vector3d::Zero();
     if (!result.poses.empty()) sonar = result.poses.front().T_world_sonar.translation();
-    return MapTruthImages(result.mapper->tree(), result.truth, result.observable,
-                          result.detector_ghosts, sonar, scene->name + ", " + name);
+    return MapTruthImages(result.mapper->tree(), result.score->truth, result.score->observable,
+                          result.score->detector_ghosts, sonar, scene->name + ", " + name);
   }
   MapView top;
   top.resolution_m = result.mapper->config().resolution_m;
@@ -315,7 +311,7 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
   CreateOutputDirectory(out_dir);
   const fs::path dir(out_dir);
   const std::string name = fs::path(result.input).filename().string();
-  const bool scored = scene && result.verdict;
+  const bool scored = scene && result.score;
   MapCells cells;
   std::vector<ReportImage> images =
       WriteMapAndImages(dir, result, scored ? scene : nullptr, name, cells);
@@ -329,8 +325,8 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
   if (scored) {
     WriteFileAtomically((dir / "junit.xml").string(), [&](std::ostream& out) {
       out << ScoredJunitXml(*scene, "map", result.input,
-                            {{"scene_file", scene->file}, {"input", result.input}}, *result.verdict,
-                            result.import_s + result.map_s);
+                            {{"scene_file", scene->file}, {"input", result.input}},
+                            result.score->verdict, result.import_s + result.map_s);
     });
   }
   WriteFileAtomically((dir / "report.html").string(), [&](std::ostream& out) {
@@ -341,10 +337,10 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
     report["outputs"]["junit"] = "junit.xml";
     report["outputs"]["map_side"] = "map_side.png";
   }
-  if (result.metrics) report["metrics"] = MetricsJson(*result.metrics);
-  if (result.verdict) {
-    report["verdict"] = VerdictJson(*result.verdict);
-    report["criteria"] = CriteriaJson(*result.verdict);
+  if (result.score) {
+    report["metrics"] = MetricsJson(result.score->metrics);
+    report["verdict"] = VerdictJson(result.score->verdict);
+    report["criteria"] = CriteriaJson(result.score->verdict);
   }
   if (!result.warnings.empty()) report["warnings"] = result.warnings;
   std::vector<std::string> covered = kLogMapOutputFiles;

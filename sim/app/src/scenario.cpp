@@ -61,21 +61,13 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
                             beams.begin() + static_cast<long>(std::min(per_sweep, beams.size())));
   result.timings.map_s = clock.Lap();
 
-  const octomap::OcTree& map = result.mapper->tree();
-  result.truth = VoxelizeMeshes(meshes, map, report("truth"));
   std::vector<BeamPose> poses;
   for (std::size_t b = 0; b < synthesized.size(); ++b) poses.push_back(ScheduleBeam(scene, b).pose);
   if (!poses.empty()) result.sonar_start_m = poses.front().T_world_sonar.translation();
-  DirectEchoes direct;
-  result.observable =
-      PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics, map,
-                         report("observable"), &direct);
-  result.timings.ground_truth_s = clock.Lap();
-
-  result.metrics = ScoreMap(map, result.truth, result.observable, meshes, report("score"), &direct,
-                            &result.detector_ghosts);
-  result.verdict = Evaluate(scene.criteria, result.metrics);
-  result.timings.score_s = clock.Lap();
+  result.score = ScoreAgainstScene(result.mapper->tree(), scene, meshes, tracer, poses,
+                                   scene.sensor.geometry, options.progress);
+  result.timings.ground_truth_s = result.score.ground_truth_s;
+  result.timings.score_s = result.score.score_s;
   return result;
 }
 

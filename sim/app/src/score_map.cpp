@@ -96,11 +96,13 @@ void CheckFrame(MapFileScore& s, const Scene& scene, const std::vector<BeamPose>
                    "frame, in metres. Is this map in another frame?");
 }
 
-double TotalSeconds(const MapFileScore& s) { return s.read_s + s.ground_truth_s + s.score_s; }
+double TotalSeconds(const MapFileScore& s) {
+  return s.read_s + s.score.ground_truth_s + s.score.score_s;
+}
 
 std::string ScoreHtml(const Scene& scene, const MapFileScore& s,
                       const std::vector<ReportImage>& images) {
-  const Verdict& v = s.verdict;
+  const Verdict& v = s.score.verdict;
   std::ostringstream html;
   html << HtmlPageStart("sonarbench: " + scene.name + " " + (v.passed ? "PASS" : "FAIL"),
                         "sonarbench score: " + scene.name, &v);
@@ -113,7 +115,7 @@ std::string ScoreHtml(const Scene& scene, const MapFileScore& s,
        << " of the map's occupied cells lie within the sonar's reach, the box "
        << Metres(s.reach_lo_m) << " to " << Metres(s.reach_hi_m) << " m (at least "
        << Percent(kMinOccupiedInReach) << " must).</p>\n";
-  html << CriteriaHtml(v) << MetricsHtml(s.metrics) << ImagesHtmlAndEnd(images);
+  html << CriteriaHtml(v) << MetricsHtml(s.score.metrics) << ImagesHtmlAndEnd(images);
   return html.str();
 }
 
@@ -139,34 +141,31 @@ MapFileScore ScoreMapFile(const std::string& map_file, const Scene& scene, const
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   CheckKeyRange(map_file, s.file.resolution_m, scene, meshes);
   const RayTracer tracer(meshes);
-  s.truth = VoxelizeMeshes(meshes, *s.map);
-  DirectEchoes direct;
-  s.observable = PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics,
-                                    *s.map, progress, &direct);
-  s.ground_truth_s = SecondsSince(clock);
-  s.metrics = ScoreMap(*s.map, s.truth, s.observable, meshes, {}, &direct, &s.detector_ghosts);
-  s.verdict = Evaluate(scene.criteria, s.metrics);
-  if (s.metrics.ghost_share > kGhostShareWarning) {
-    s.verdict.warnings.push_back(
-        FormatMetricValue(s.metrics.ghost_share) +
+  s.score =
+      ScoreAgainstScene(*s.map, scene, meshes, tracer, poses, scene.sensor.geometry,
+                        [&progress](std::string_view stage, std::size_t done, std::size_t total) {
+                          if (progress && stage == "observable") progress(done, total);
+                        });
+  if (s.score.metrics.ghost_share > kGhostShareWarning) {
+    s.score.verdict.warnings.push_back(
+        FormatMetricValue(s.score.metrics.ghost_share) +
         " of the map's occupied cells lie more than 2 "
         "cells from every surface of the scene: is the map in the scene's frame (origin, axes, "
         "metres)?");
   }
-  s.score_s = SecondsSince(clock);
   return s;
 }
 
 void WriteMapFileScoreOutputs(const std::string& out_dir, const Scene& scene,
                               const MapFileScore& s) {
   CreateOutputDirectory(out_dir);
-  const std::vector<ReportImage> images =
-      MapTruthImages(*s.map, s.truth, s.observable, s.detector_ghosts, s.sonar_start_m,
-                     scene.name + ", " + std::filesystem::path(s.map_file).filename().string());
+  const std::vector<ReportImage> images = MapTruthImages(
+      *s.map, s.score.truth, s.score.observable, s.score.detector_ghosts, s.sonar_start_m,
+      scene.name + ", " + std::filesystem::path(s.map_file).filename().string());
   WriteReportImages(out_dir, images);
   WriteFileAtomically(out_dir + "/junit.xml", [&](std::ostream& out) {
     out << ScoredJunitXml(scene, "score", s.map_file,
-                          {{"scene_file", scene.file}, {"map_file", s.map_file}}, s.verdict,
+                          {{"scene_file", scene.file}, {"map_file", s.map_file}}, s.score.verdict,
                           TotalSeconds(s));
   });
   WriteFileAtomically(out_dir + "/report.html",
@@ -179,21 +178,21 @@ void WriteMapFileScoreOutputs(const std::string& out_dir, const Scene& scene,
                    {"format", s.file.format},
                    {"resolution_m", s.file.resolution_m},
                    {"nodes", s.file.nodes},
-                   {"occupied_cells", s.metrics.occupied_cells},
-                   {"free_cells", s.metrics.free_cells}}},
+                   {"occupied_cells", s.score.metrics.occupied_cells},
+                   {"free_cells", s.score.metrics.free_cells}}},
                  {"frame_check",
                   {{"reach_lo_m", Vector(s.reach_lo_m)},
                    {"reach_hi_m", Vector(s.reach_hi_m)},
                    {"occupied_in_reach", s.occupied_in_reach},
                    {"min_occupied_in_reach", kMinOccupiedInReach}}},
                  {"beams", ScenarioBeamCount(scene)},
-                 {"verdict", VerdictJson(s.verdict)},
-                 {"criteria", CriteriaJson(s.verdict)},
-                 {"metrics", MetricsJson(s.metrics)},
+                 {"verdict", VerdictJson(s.score.verdict)},
+                 {"criteria", CriteriaJson(s.score.verdict)},
+                 {"metrics", MetricsJson(s.score.metrics)},
                  {"timing",
                   {{"read_s", s.read_s},
-                   {"ground_truth_s", s.ground_truth_s},
-                   {"score_s", s.score_s},
+                   {"ground_truth_s", s.score.ground_truth_s},
+                   {"score_s", s.score.score_s},
                    {"total_s", TotalSeconds(s)}}},
                  {"outputs",
                   {{"map_top", "map_top.png"},

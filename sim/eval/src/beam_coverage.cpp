@@ -6,7 +6,7 @@
 #include <optional>
 #include <utility>
 
-#include "sonarbench/mapping/detail/beam_wedge.hpp"
+#include "sonarbench/mapping/beam_cells.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -212,26 +212,19 @@ BeamCoverage MeasureBeamCoverage(const mapping::Beam& beam, const mapping::Senso
                                  double range_m, int rays_horizontal, int rays_vertical,
                                  const octomap::OcTree& key_space, const WedgeCells& wedge) {
   const auto directions = mapping::BeamRayDirections(sensor, rays_horizontal, rays_vertical);
-  mapping::BeamCells cells;
   const double obstacle[] = {range_m};
-  mapping::CastBeam(key_space, beam, directions, obstacle, 0.0, cells);
-  mapping::KeySet visited = cells.free;
-  visited.insert(cells.occupied.begin(), cells.occupied.end());
-  return CoverageOf(visited, cells.visits, wedge);
+  mapping::BeamKeys keys = mapping::RayCastBeamKeys(key_space, beam, directions, obstacle, 0.0);
+  keys.free.insert(keys.occupied.begin(), keys.occupied.end());
+  return CoverageOf(keys.free, keys.visits, wedge);
 }
 
 BeamCoverage MeasureExactBeamCoverage(const mapping::Beam& beam,
                                       const mapping::SensorGeometry& sensor, double range_m,
                                       const octomap::OcTree& key_space, const WedgeCells& wedge) {
-  std::vector<std::uint64_t> free, occupied;
   const double obstacle[] = {range_m};
-  const auto counts = mapping::ExactBeamCells(key_space, mapping::BeamWedge(sensor, beam), obstacle,
-                                              0.0, free, occupied);
-  mapping::KeySet visited;
-  for (const auto* keys : {&free, &occupied}) {
-    for (const std::uint64_t packed : *keys) visited.insert(mapping::UnpackKey(packed));
-  }
-  return CoverageOf(visited, counts.examined, wedge);
+  mapping::BeamKeys keys = mapping::ExactBeamKeys(key_space, sensor, beam, obstacle, 0.0);
+  keys.free.insert(keys.occupied.begin(), keys.occupied.end());
+  return CoverageOf(keys.free, keys.visits, wedge);
 }
 
 }  // namespace sonarbench::sim

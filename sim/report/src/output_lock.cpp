@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/report/output_directory.hpp"
 
@@ -78,7 +79,7 @@ std::set<std::string> OutputDirectory::LockedWriters() const {
 std::string OutputDirectory::Holder() const {
   std::string holder = LockText().substr(0, 511);
   holder = holder.substr(0, holder.find('\n'));
-  return holder.empty() ? "holder unknown" : Quoted(holder, 200);
+  return holder.empty() ? "holder unknown" : io::Quoted(holder, 200);
 }
 
 }  // namespace sonarbench::sim

@@ -162,9 +162,9 @@ std::vector<ReportImage> RenderImages(const Scene& scene, const ScenarioResult& 
   const std::function<void()> tasks[] = {
       [&] { images[1] = FanImage(result.first_sweep, name); },
       [&] {
-        map_images = MapTruthImages(result.mapper->tree(), result.truth, result.observable,
-                                    result.detector_ghosts, result.sonar_start_m, name,
-                                    SonarPath(scene, result.beams));
+        map_images = MapTruthImages(result.mapper->tree(), result.score.truth,
+                                    result.score.observable, result.score.detector_ghosts,
+                                    result.sonar_start_m, name, SonarPath(scene, result.beams));
       },
       [&] { images[0] = PolarImage(result.first_sweep, name); }};
   RunTasks(result.threads, tasks);
@@ -174,7 +174,7 @@ std::vector<ReportImage> RenderImages(const Scene& scene, const ScenarioResult& 
 
 std::string ScenarioHtml(const Scene& scene, const ScenarioResult& result,
                          const std::vector<ReportImage>& images) {
-  const Verdict& v = result.verdict;
+  const Verdict& v = result.score.verdict;
   std::ostringstream html;
   html << HtmlPageStart("sonarbench: " + scene.name + " " + (v.passed ? "PASS" : "FAIL"),
                         "sonarbench scenario: " + scene.name, &v);
@@ -183,7 +183,7 @@ std::string ScenarioHtml(const Scene& scene, const ScenarioResult& result,
        << result.beams << " beams in " << scene.sweeps << " sweeps, " << result.threads
        << (result.threads == 1 ? " thread, " : " threads, ")
        << Seconds(TotalSeconds(result.timings)) << " s.</p>\n";
-  html << CriteriaHtml(v) << MetricsHtml(result.metrics);
+  html << CriteriaHtml(v) << MetricsHtml(result.score.metrics);
   const StageTimings& t = result.timings;
   html << "<h2>Timing</h2>\n<table><tr><th>stage</th><th>seconds</th></tr>\n";
   for (const auto& [stage, seconds] :
@@ -265,13 +265,13 @@ nlohmann::json MetricsJson(const MapMetrics& m) {
 }
 
 nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& result) {
-  const MapMetrics& m = result.metrics;
+  const MapMetrics& m = result.score.metrics;
   const StageTimings& t = result.timings;
   nlohmann::json report = ReportHeader();
   report["schema_version"] = kScenarioReportSchema;
   report.update({{"scene", SceneJson(scene)},
-                 {"verdict", VerdictJson(result.verdict)},
-                 {"criteria", CriteriaJson(result.verdict)},
+                 {"verdict", VerdictJson(result.score.verdict)},
+                 {"criteria", CriteriaJson(result.score.verdict)},
                  {"seed", result.seed},
                  {"threads", result.threads},
                  {"meshes", MeshesJson(result.meshes)},
@@ -311,7 +311,7 @@ std::string ScenarioJunitXml(const Scene& scene, const ScenarioResult& result) {
   return ScoredJunitXml(
       scene, "scenario",
       "seed " + std::to_string(result.seed) + ", " + std::to_string(result.beams) + " beams",
-      {{"scene_file", scene.file}, {"seed", std::to_string(result.seed)}}, result.verdict,
+      {{"scene_file", scene.file}, {"seed", std::to_string(result.seed)}}, result.score.verdict,
       TotalSeconds(result.timings));
 }
 

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "sonarbench/io/files.hpp"
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 
@@ -112,7 +113,7 @@ PlyHeader ReadPlyHeader(const std::string& bytes,
     for (const char c : line) {
       if ((static_cast<unsigned char>(c) < 0x20 && c != '\t') || c == 0x7f) {
         throw fail("header line " + std::to_string(line_number) + " holds the control character " +
-                   Quoted(std::string_view(&c, 1)));
+                   io::Quoted(std::string_view(&c, 1)));
       }
     }
     std::istringstream words(line);
@@ -120,7 +121,7 @@ PlyHeader ReadPlyHeader(const std::string& bytes,
     words >> keyword;
     const auto bad_line = [&](const std::string& expected) {
       return fail("header line " + std::to_string(line_number) + ": expected " + expected +
-                  ", got " + Quoted(line));
+                  ", got " + io::Quoted(line));
     };
     if (line_number == 1) {
       if (keyword != "ply" || words >> keyword) throw bad_line("'ply'");
@@ -180,7 +181,7 @@ class PlyValues {
         const auto c = static_cast<unsigned char>(bytes_[i]);
         if ((c < 0x20 && c != '\t' && !(c == '\r' && i + 1 == line_end_)) || c == 0x7f) {
           throw fail_("line " + std::to_string(line_number_) + " holds the control character " +
-                      Quoted(std::string_view(bytes_.data() + i, 1)));
+                      io::Quoted(std::string_view(bytes_.data() + i, 1)));
         }
       }
       SkipBlanks();
@@ -200,7 +201,7 @@ class PlyValues {
       const auto [stop, error] = std::from_chars(bytes_.data() + at_, bytes_.data() + end, value);
       if (error != std::errc() || stop != bytes_.data() + end) {
         throw fail_("line " + std::to_string(line_number_) + " holds " +
-                    Quoted(bytes_.substr(at_, end - at_)) + " where a number belongs");
+                    io::Quoted(bytes_.substr(at_, end - at_)) + " where a number belongs");
       }
       at_ = end;
       return value;
@@ -410,7 +411,7 @@ void CheckColladaInstances(const std::string& bytes,
     const std::optional<std::string> ref =
         XmlAttribute(bytes.substr(name_end, end - name_end), key);
     if (!ref || !ref->starts_with('#') || !ids.contains(ref->substr(1))) {
-      throw fail(at, "<" + tag + "> " + (ref ? "refers to " + Quoted(*ref) : "has no " + key) +
+      throw fail(at, "<" + tag + "> " + (ref ? "refers to " + io::Quoted(*ref) : "has no " + key) +
                          ", expected " + key + "=\"#ID\" naming an element of this file");
     }
   }
@@ -456,7 +457,7 @@ void CheckCollada(const std::string& path, const std::string& bytes) {
       std::istringstream items(element.content);
       for (std::string item; items >> item;) {
         if (const auto index = WholeNumber(item); !index || *index > 0x7fffffff) {
-          throw fail(element.at, "<" + tag + "> holds " + Quoted(item) +
+          throw fail(element.at, "<" + tag + "> holds " + io::Quoted(item) +
                                      " where an index (a whole number from 0 to 2^31 - 1) "
                                      "belongs");
         }
@@ -574,7 +575,7 @@ MeshFileData LoadMeshFile(const std::string& path, double max_triangles) {
                                   aiProcess_SortByPType | aiProcess_JoinIdenticalVertices);
   if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0) {
     throw InputError(path + ": not a readable mesh file (OBJ, STL, PLY or DAE expected): " +
-                     Quoted(importer.GetErrorString(), 300));
+                     io::Quoted(importer.GetErrorString(), 300));
   }
   MeshFileData data;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {

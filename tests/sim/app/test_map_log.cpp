@@ -140,8 +140,8 @@ TEST(RealLogMap, AnImportedLogScoresAsTheMatLogDoes) {
       sim::MapLog(RealLogPath(), scene.sensor.geometry, scene.mapping, &scene);
   const sim::LogMapResult from_dataset =
       sim::MapLog(imported, scene.sensor.geometry, scene.mapping, &scene);
-  const nlohmann::json a = sim::MetricsJson(sim::ScoreLogMap(from_mat, scene));
-  const nlohmann::json b = sim::MetricsJson(sim::ScoreLogMap(from_dataset, scene));
+  const nlohmann::json a = sim::MetricsJson(sim::ScoreLogMap(from_mat, scene).metrics);
+  const nlohmann::json b = sim::MetricsJson(sim::ScoreLogMap(from_dataset, scene).metrics);
   EXPECT_GT(a["counts"]["true_positive_cells"].get<std::size_t>(), 100u);
   EXPECT_EQ(a, b);
   // The ghosts' split is reported, its parts summing to the whole.

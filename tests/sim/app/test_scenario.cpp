@@ -132,7 +132,7 @@ TEST_F(TankScenario, EveryWallIsMappedAtTheSonarsHeight) {
       const int along = 1 - axis;
       std::set<int> truth_columns;
       std::set<int> mapped_columns;
-      for (const auto& key : result_->truth) {
+      for (const auto& key : result_->score.truth) {
         const auto c = Centre(key);
         if (std::abs(c(axis) - at) < res && std::abs(c(along)) < HalfSide(along)) {
           truth_columns.insert(key[static_cast<unsigned>(along)]);
@@ -181,7 +181,7 @@ TEST_F(TankScenario, FloorRingAppearsWhereTheFanMeetsTheFloor) {
 }
 
 TEST_F(TankScenario, MetricsAreConsistentWithTheirCounts) {
-  const MapMetrics& m = result_->metrics;
+  const MapMetrics& m = result_->score.metrics;
   EXPECT_EQ(m.occupied_cells, cells_->occupied.size());
   EXPECT_LE(m.observable_cells, m.truth_cells);
   EXPECT_DOUBLE_EQ(m.occupied_precision,
@@ -203,7 +203,7 @@ TEST_F(TankScenario, OutputsAreWrittenWithTheReportLast) {
   const auto report = nlohmann::json::parse(in);
   EXPECT_EQ(report["seed"], scene_->seed);
   EXPECT_DOUBLE_EQ(report["metrics"]["occupied_precision"].get<double>(),
-                   result_->metrics.occupied_precision);
+                   result_->score.metrics.occupied_precision);
   EXPECT_TRUE(report["timing"].contains("map_s"));
   EXPECT_EQ(report["parameters"]["mapping"]["rays_vertical"], 64);
   // The sensor's settings in force, the ones switched off too.
@@ -248,7 +248,7 @@ TEST(SeabedScenario, NothingOccupiedAboveTheSeabed) {
   const ScenarioResult result = RunScenario(scene, RunOptions{});
   const auto& tree = result.mapper->tree();
   double truth_top = -1e9;
-  for (const auto& key : result.truth)
+  for (const auto& key : result.score.truth)
     truth_top = std::max<double>(truth_top, tree.keyToCoord(key).z());
   const double sonar_z = (scene.trajectory.waypoints.front().position_m +
                           scene.sensor.geometry.T_vehicle_sonar.translation())
@@ -262,7 +262,7 @@ TEST(SeabedScenario, NothingOccupiedAboveTheSeabed) {
   std::size_t above = 0;
   for (const auto& key : cells.occupied) above += tree.keyToCoord(key).z() > bound ? 1 : 0;
   EXPECT_EQ(above, 0u) << "occupied cells above z = " << bound << " m";
-  EXPECT_GT(result.metrics.occupied_recall, 0.0);
+  EXPECT_GT(result.score.metrics.occupied_recall, 0.0);
 }
 
 // The map and the report's images too: on two threads the images are drawn side by side.

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "sonarbench/mapping/detail/beam_wedge.hpp"
+#include "sonarbench/mapping/beam_cells.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/divisions_study.hpp"
 #include "sonarbench/sim/eval/beam_coverage.hpp"
@@ -115,14 +115,10 @@ TEST(ExactWedgeCells, AreTheCellsOfTheMappersExactMode) {
     const double range = 0.3 + 2.2 * unit(rng);
     SCOPED_TRACE("trial " + std::to_string(trial));
     const WedgeCells wedge = ExactWedgeCells(beam, micron, range, key_space);
-    std::vector<std::uint64_t> free, occupied;
     const double obstacle[] = {range};
-    (void)mapping::ExactBeamCells(key_space, mapping::BeamWedge(micron, beam), obstacle, 0.0, free,
-                                  occupied);
-    mapping::KeySet exact;
-    for (const auto* keys : {&free, &occupied}) {
-      for (const auto packed : *keys) exact.insert(mapping::UnpackKey(packed));
-    }
+    mapping::BeamKeys keys = mapping::ExactBeamKeys(key_space, micron, beam, obstacle, 0.0);
+    mapping::KeySet& exact = keys.free;
+    exact.insert(keys.occupied.begin(), keys.occupied.end());
     for (const auto& key : wedge.inside) EXPECT_TRUE(exact.contains(key));
     for (const auto& key : wedge.undecided) EXPECT_TRUE(exact.contains(key));
     std::size_t outside = 0;

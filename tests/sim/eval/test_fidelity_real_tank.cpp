@@ -162,7 +162,7 @@ TEST(Fidelity, SimulatedTankStaysNearTheRealLogsRecordedStatistics) {
 TEST(Fidelity, SimulatedTankMapsAsTheRealLogDoes) {
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   const sim::ScenarioResult run = sim::RunScenario(scene, sim::RunOptions{});
-  const sim::MapMetrics& m = run.metrics;
+  const sim::MapMetrics& m = run.score.metrics;
   EXPECT_NEAR(m.occupied_precision,
               RealTank::Ratio(RealTank::kMapTruePositives, RealTank::kMapOccupied), 0.05);
   EXPECT_NEAR(m.occupied_recall,
@@ -216,7 +216,7 @@ TEST(Fidelity, RecordedRealLogStatisticsAreTheLogs) {
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   const sim::LogMapResult mapped =
       sim::MapLog(RealLogPath(), scene.sensor.geometry, scene.mapping, &scene);
-  const sim::MapMetrics m = sim::ScoreLogMap(mapped, scene);
+  const sim::MapMetrics m = sim::ScoreLogMap(mapped, scene).metrics;
   EXPECT_EQ(m.true_positive_cells, RealTank::kMapTruePositives);
   EXPECT_EQ(m.occupied_cells, RealTank::kMapOccupied);
   EXPECT_EQ(m.observed_occupied_cells, RealTank::kMapObservedOccupied);

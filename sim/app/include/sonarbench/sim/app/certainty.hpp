@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "sonarbench/mapping/beam.hpp"
-#include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/beam_cells.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 

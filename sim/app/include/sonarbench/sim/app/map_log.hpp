@@ -8,9 +8,7 @@
 
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/app/certainty.hpp"
-#include "sonarbench/sim/eval/ground_truth.hpp"
-#include "sonarbench/sim/eval/score.hpp"
-#include "sonarbench/sim/eval/verdict.hpp"
+#include "sonarbench/sim/eval/scene_score.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 
 namespace sonarbench::sim {
@@ -34,14 +32,8 @@ struct LogMapResult {
   mapping::SensorGeometry sensor;
   /// Every beam's pose as mapped.
   std::vector<BeamPose> poses;
-  /// The map scored against a scene's surfaces (ScoreLogMap), if it was; the scene's surface
-  /// cells, those a perfect sensor sees and the detector's ghosts, for the map's images.
-  std::optional<MapMetrics> metrics;
-  mapping::KeySet truth;
-  mapping::KeySet observable;
-  mapping::KeySet detector_ghosts;
-  /// The metrics against the scene's criteria, when scored.
-  std::optional<Verdict> verdict;
+  /// The map scored against a scene (ScoreLogMap), when it was.
+  std::optional<SceneScore> score;
   /// The occupied cells' probability sweep by sweep, when scored (SweepCertainty).
   std::optional<CertaintyCurve> certainty;
   /// What the user should know about the score (a dataset simulated from other scene files).
@@ -73,19 +65,10 @@ struct LogMapResult {
 /// cannot be placed along a trajectory.
 [[nodiscard]] Eigen::Isometry3d StaticSonarPose(const Scene& scene);
 
-/// Scores `result`'s map against `scene`'s surfaces as `sonarbench run` scores a simulated one
-/// (ScoreMap): the truth voxelised from the scene's meshes, the cells a perfect sensor could see
-/// from the poses the log's beams were mapped from, rays twice as dense as the scene's sensor
-/// samples each beam, over the log's own beam geometry. What it builds on the way goes to `parts`
-/// when given.
-struct LogScoreParts {
-  mapping::KeySet truth;            ///< the scene's surface cells
-  mapping::KeySet observable;       ///< those a perfect sensor sees
-  DirectEchoes direct;              ///< the beams' direct echoes
-  mapping::KeySet detector_ghosts;  ///< the ghosts no direct echo explains
-};
-[[nodiscard]] MapMetrics ScoreLogMap(const LogMapResult& result, const Scene& scene,
-                                     LogScoreParts* parts = nullptr);
+/// Scores `result`'s map against `scene` as `sonarbench run` scores a simulated one
+/// (ScoreAgainstScene), from the poses the log's beams were mapped from and over the log's own
+/// beam geometry.
+[[nodiscard]] SceneScore ScoreLogMap(const LogMapResult& result, const Scene& scene);
 
 /// The files WriteLogMapOutputs writes, relative to its `out_dir`.
 inline const std::vector<std::string> kLogMapOutputFiles = {

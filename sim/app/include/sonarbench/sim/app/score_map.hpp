@@ -8,9 +8,7 @@
 #include <vector>
 
 #include "sonarbench/io/octomap_file.hpp"
-#include "sonarbench/sim/eval/ground_truth.hpp"
-#include "sonarbench/sim/eval/score.hpp"
-#include "sonarbench/sim/eval/verdict.hpp"
+#include "sonarbench/sim/eval/scene_score.hpp"
 #include "sonarbench/sim/world/budget.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 
@@ -21,13 +19,7 @@ struct MapFileScore {
   std::string map_file;
   io::OcTreeFileInfo file;
   std::unique_ptr<octomap::OcTree> map;
-  /// The scene's surface cells at the map's resolution, those a perfect sensor sees, and the
-  /// detector's ghosts (ScoreMap).
-  mapping::KeySet truth;
-  mapping::KeySet observable;
-  mapping::KeySet detector_ghosts;
-  MapMetrics metrics;
-  Verdict verdict;
+  SceneScore score;
   /// The frame check: the box the scene's sonar reaches (its positions' box grown by its range)
   /// [m], and the share of the map's occupied cells whose centres lie in it.
   Eigen::Vector3d reach_lo_m = Eigen::Vector3d::Zero();
@@ -36,8 +28,6 @@ struct MapFileScore {
   /// The sonar's position at the scene's first beam [m], where the side view is cut.
   Eigen::Vector3d sonar_start_m = Eigen::Vector3d::Zero();
   double read_s = 0.0;
-  double ground_truth_s = 0.0;
-  double score_s = 0.0;
 };
 
 /// The least share of a map's occupied cells that must lie within the scene sonar's reach.

@@ -5,7 +5,7 @@
 #include <cstddef>
 
 #include "sonarbench/mapping/beam.hpp"
-#include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/beam_cells.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
 namespace sonarbench::sim {

@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/beam_cells.hpp"
 #include "sonarbench/sim/world/geometry.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
 #include "sonarbench/sim/world/ray_tracer.hpp"

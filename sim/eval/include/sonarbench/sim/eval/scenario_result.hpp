@@ -8,8 +8,7 @@
 
 #include "sonarbench/mapping/batch_stats.hpp"
 #include "sonarbench/mapping/mapper.hpp"
-#include "sonarbench/sim/eval/score.hpp"
-#include "sonarbench/sim/eval/verdict.hpp"
+#include "sonarbench/sim/eval/scene_score.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
 
 namespace sonarbench::sim {
@@ -30,14 +29,9 @@ struct ScenarioResult {
   std::size_t beams = 0;
   StageTimings timings;
   mapping::BatchStats mapping_totals;
-  MapMetrics metrics;
   std::unique_ptr<mapping::Mapper> mapper;
   /// The first sweep's beams, for images.
   std::vector<mapping::Beam> first_sweep;
-  /// The scene's surface cells, those a perfect sensor sees, and the detector's ghosts (ScoreMap).
-  mapping::KeySet truth;
-  mapping::KeySet observable;
-  mapping::KeySet detector_ghosts;
   /// The sonar's position at the first beam [m], where the side slice of the map is cut.
   Eigen::Vector3d sonar_start_m = Eigen::Vector3d::Zero();
   /// Each mesh's name, triangle count and preflight findings, in scene order, then the
@@ -49,8 +43,8 @@ struct ScenarioResult {
     bool vehicle_part = false;
   };
   std::vector<MeshSummary> meshes;
-  /// The metrics against the scene's criteria.
-  Verdict verdict;
+  /// The map scored against the scene.
+  SceneScore score;
 };
 
 }  // namespace sonarbench::sim

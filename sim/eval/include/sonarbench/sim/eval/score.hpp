@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "sonarbench/mapping/detail/beam_volume.hpp"
+#include "sonarbench/mapping/beam_cells.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
 #include "sonarbench/sim/world/mesh.hpp"

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "sonarbench/mapping/beam.hpp"
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "sonarbench/mapping/beam_cells.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/eval/verdict.hpp"

@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "sonarbench/mapping/detail/block_set.hpp"
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "block_set.hpp"
+#include "key_set.hpp"
 
 namespace sonarbench::mapping::detail {
 struct ChildLinker;

@@ -12,10 +12,10 @@
 #include <utility>
 #include <vector>
 
+#include "beam_volume.hpp"
+#include "block_set.hpp"
+#include "map_tree.hpp"
 #include "sonarbench/mapping/batch_stats.hpp"
-#include "sonarbench/mapping/detail/beam_volume.hpp"
-#include "sonarbench/mapping/detail/block_set.hpp"
-#include "sonarbench/mapping/detail/map_tree.hpp"
 
 namespace sonarbench::mapping {
 

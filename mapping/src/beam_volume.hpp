@@ -8,27 +8,17 @@
 #include <cstdint>
 #include <span>
 #include <tuple>
-#include <unordered_set>
 #include <vector>
 
+#include "arc_evidence.hpp"
+#include "beam_raster.hpp"
+#include "beam_wedge.hpp"
+#include "key_set.hpp"
 #include "sonarbench/mapping/beam.hpp"
-#include "sonarbench/mapping/detail/arc_evidence.hpp"
-#include "sonarbench/mapping/detail/beam_raster.hpp"
-#include "sonarbench/mapping/detail/beam_wedge.hpp"
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "sonarbench/mapping/beam_cells.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
 namespace sonarbench::mapping {
-
-/// The standard library's set with OctoMap's key hash: OctoMap's own `KeySet`.
-using KeySet = std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHash>;
-
-/// The H×V ray directions that sample a beam's volume, in the sonar frame, for head angle 0:
-/// horizontal offsets evenly spaced over [-w_h/2, +w_h/2] and elevations over [-w_v/2, +w_v/2],
-/// both edges included (a single ray sits on the axis). Rotate about z by the head angle.
-[[nodiscard]] std::vector<Eigen::Vector3d> BeamRayDirections(const SensorGeometry& sensor,
-                                                             int rays_horizontal,
-                                                             int rays_vertical);
 
 /// The cells a batch of beams marks, in a set type `Set` with `insert(key)`, `erase(key)` and
 /// iteration (std::unordered_set, OpenKeySet, absl::flat_hash_set, ...), and the scratch space

@@ -1,6 +1,6 @@
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/io/text.hpp"
 
-namespace sonarbench {
+namespace sonarbench::io {
 
 std::string Quoted(std::string_view text, std::size_t max) {
   std::string out = "'";
@@ -55,4 +55,4 @@ bool IsUtf8(std::string_view text) {
   return true;
 }
 
-}  // namespace sonarbench
+}  // namespace sonarbench::io

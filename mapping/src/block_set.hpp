@@ -10,7 +10,7 @@
 #include <span>
 #include <vector>
 
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "key_set.hpp"
 
 namespace sonarbench::mapping {
 

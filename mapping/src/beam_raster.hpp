@@ -7,8 +7,8 @@
 #include <span>
 #include <vector>
 
-#include "sonarbench/mapping/detail/key_set.hpp"
-#include "sonarbench/mapping/detail/ray_keys.hpp"
+#include "key_set.hpp"
+#include "ray_keys.hpp"
 
 namespace sonarbench::mapping {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "sonarbench/mapping/detail/key_set.hpp"
+#include "key_set.hpp"
 
 namespace sonarbench::mapping {
 
