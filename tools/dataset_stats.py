@@ -5,7 +5,7 @@ simulated run with a real log bin by bin where `sonarbench fidelity` gives only 
     python3 tools/dataset_stats.py DIR [DIR ...] [--crossing T --from R] [--bins FIRST LAST]
                                    [--lit FIRST LAST] [--arc HEAD_DEG BIN]
                                    [--behind-walls FIRST LAST] [--profile HEAD_DEG FIRST LAST]
-                                   [--sectors FIRST LAST]
+                                   [--sectors FIRST LAST] [--heads FROM TO]
 
 DIR is what `sonarbench simulate SCENE --out DIR` or `sonarbench import LOG.mat --out DIR`
 wrote. For each, per range band: the mean intensity, the share of bins at 0 and at 150 or
@@ -49,8 +49,9 @@ FIRST LAST, what the beams pointing one way hear against range: the mean intensi
 within 6° of head angle HEAD_DEG, per group of 4 bins from FIRST to LAST (the last group may be
 shorter; bins past a beam's end left out). With --sectors FIRST LAST, where a vehicle's parts
 echo: per 9° of head angle from 0° (five head steps), the mean intensity per group of 6 bins from
-FIRST to LAST (bins past a beam's end left out; sectors without beams left out). Standard library
-only.
+FIRST to LAST (bins past a beam's end left out; sectors without beams left out). With --heads
+FROM TO, only the beams whose head angle lies in [FROM, TO) degrees: fit on one half of a sweep,
+check on the other. Standard library only.
 """
 import argparse
 import glob
@@ -67,9 +68,12 @@ FIRST_SPREAD_BIN = 32  # past the self-reflection's bright bins
 CORRELATED_MEAN = 60
 
 
+HEADS = None  # --heads FROM TO: only the beams whose head angle [deg, 0-360) lies in [FROM, TO)
+
+
 def load_beams(directory, with_angles=False):
-    """(bin_size_m, intensities) of every beam, sweep by sweep; with_angles: (head_angle_rad,
-    bin_size_m, intensities)."""
+    """(bin_size_m, intensities) of every beam, sweep by sweep (those HEADS keeps); with_angles:
+    (head_angle_rad, bin_size_m, intensities)."""
     files = sorted(glob.glob(os.path.join(directory, "beams", "sweep_*.bin")))
     if not files:
         sys.exit(f"{directory}: no beams/sweep_*.bin (not a sonarbench dataset?)")
@@ -89,8 +93,10 @@ def load_beams(directory, with_angles=False):
             if offset + bins > len(data):
                 sys.exit(f"{path}: beam {beam} truncated")
             intensities = data[offset:offset + bins]
-            beams.append((angle, bin_size, intensities) if with_angles else (bin_size, intensities))
             offset += bins
+            if HEADS and not HEADS[0] <= math.degrees(angle) % 360.0 < HEADS[1]:
+                continue
+            beams.append((angle, bin_size, intensities) if with_angles else (bin_size, intensities))
     return beams
 
 
@@ -509,7 +515,13 @@ if __name__ == "__main__":
     parser.add_argument("--sectors", type=int, nargs=2, metavar=("FIRST", "LAST"),
                         help="also report, per 9 degrees of head angle, the mean per 6 bins from "
                              "FIRST to LAST (where a vehicle's parts echo, bins 28-63)")
+    parser.add_argument("--heads", type=float, nargs=2, metavar=("FROM", "TO"),
+                        help="only the beams whose head angle [deg] lies in [FROM, TO): one half "
+                             "of the sweep to fit on, the other to check")
     args = parser.parse_args()
+    if args.heads is not None and not 0 <= args.heads[0] < args.heads[1] <= 360:
+        parser.error(f"--heads {args.heads[0]:g} {args.heads[1]:g}: expected 0 <= FROM < TO <= 360")
+    HEADS = args.heads
     if (args.crossing is None) != (args.from_m is None):
         parser.error("--crossing and --from go together")
     if args.bins is not None and not 0 <= args.bins[0] <= args.bins[1]:

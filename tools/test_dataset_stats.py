@@ -75,6 +75,18 @@ def main():
             "1.00 / 1.00 / 1.00" in result.stdout, result.stdout
         assert "30-69 none, 70-99 none, 100-255 0.00; the deviations of bins 1 / 2 / 3 apart " \
             "(cells of mean 60 or more) correlate by none / none / none" in out, out
+        # --heads keeps the beams of one half of the sweep: the beam of 255 at 1 rad (57.3°) alone,
+        # or the twelve of 0 and 1.8° without it.
+        result = run(os.path.join(tmp, "spread"), "--heads", "50", "60")
+        assert result.returncode == 0, result.stderr
+        assert ": 1 beams" in result.stdout and "3.0-4.0 m: mean 255.0" in result.stdout, \
+            result.stdout
+        result = run(os.path.join(tmp, "spread"), "--heads", "0", "50")
+        assert ": 12 beams" in result.stdout and "3.0-4.0 m: mean 105.0" in result.stdout, \
+            result.stdout
+        result = run(os.path.join(tmp, "spread"), "--heads", "180", "90")
+        assert result.returncode == 2 and "expected 0 <= FROM < TO <= 360" in result.stderr, \
+            result.stderr
         # A chequerboard at one angle (100 and 110 alternating along the beam and from beam to
         # beam): deviations of opposite sign in neighbouring bins, correlation -1, of the same
         # sign two bins apart, 1, and opposite again three apart, -1; at another

@@ -146,7 +146,7 @@ TEST(SensorModelFile, ReverberationIsTheScenes) {
   EXPECT_EQ(micron.acoustics.pulse_skirt_length_m, 0.0);
   const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
   EXPECT_EQ(tank.sensor.acoustics.reverberation_length_m, 0.9);
-  EXPECT_EQ(tank.sensor.acoustics.reverberation_db, -3.0);
+  EXPECT_EQ(tank.sensor.acoustics.reverberation_db, -4.0);
   EXPECT_EQ(micron.acoustics.back_lobe_width_deg, 0.0);
   EXPECT_EQ(tank.sensor.acoustics.back_lobe_width_deg, 30.0);
   EXPECT_EQ(tank.sensor.acoustics.back_lobe_db, -15.0);
