@@ -1,10 +1,14 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <sstream>
+#include <utility>
+#include <vector>
 
 #include "cli.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/detector_study.hpp"
 
 namespace sonarbench::app {
@@ -17,6 +21,7 @@ struct DetectorsArgs {
   std::string out = "out/detectors";
   std::optional<std::uint64_t> seed;
   int threads = 0;
+  std::vector<double> heads;
   bool no_progress = false;
 };
 
@@ -29,6 +34,15 @@ int Detectors(const DetectorsArgs& args) {
   options.seed = args.seed;
   options.log = args.log;
   options.threads = args.threads;
+  if (!args.heads.empty()) {
+    if (!(args.heads[0] >= 0.0 && args.heads[0] < args.heads[1] && args.heads[1] <= 360.0)) {
+      std::ostringstream message;
+      message << "--heads " << args.heads[0] << " " << args.heads[1]
+              << ": expected FROM TO degrees with 0 <= FROM < TO <= 360";
+      throw sonarbench::InputError(message.str());
+    }
+    options.heads_deg = std::pair{args.heads[0], args.heads[1]};
+  }
   sim::OutputDirectory out(
       args.out, OneShotClaim("detectors", sim::kDetectorStudyFiles, {args.scene, args.log}));
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
@@ -53,6 +67,17 @@ int Detectors(const DetectorsArgs& args) {
     }
     std::cout << "\n";
   }
+  if (const auto agreement = sim::StudyAgreement(rows); !agreement.empty()) {
+    std::cout << "the scene against the log over the settings: Spearman, mean / max |difference|\n";
+    for (const sim::Agreement& a : agreement) {
+      char line[160];
+      std::snprintf(line, sizeof line, "  %-17s %5.2f, %.3f / %.3f\n", a.figure.c_str(), a.spearman,
+                    a.mean_abs_difference, a.max_abs_difference);
+      std::cout << line;
+    }
+    std::cout << "best F1 at 1 cell: " << rows[sim::BestF1Row(rows, false)].item.name
+              << " (scene); " << rows[sim::BestF1Row(rows, true)].item.name << " (log)\n";
+  }
   std::cout << "wrote " << args.out << "/detectors.csv, precision_vs_recall_scene.png"
             << (args.log.empty() ? "" : ", precision_vs_recall_log.png") << ", study.json\n";
   return 0;
@@ -74,6 +99,12 @@ CLI::App* AddOptions(CLI::App& app, DetectorsArgs& args) {
                    "A recorded log of the scene's place: a .mat log, its folder, or a dataset")
       ->check(CLI::ExistingPath);
   command->add_option("-o,--out", args.out, "Output directory")->capture_default_str();
+  command
+      ->add_option("--heads", args.heads,
+                   "Only the beams whose head angle lies in [FROM, TO) degrees, of the scene and "
+                   "the log alike: one half of the sweep to fit on, the other to check")
+      ->expected(2)
+      ->type_name("FROM TO");
   AddSeedOption(command, args.seed, "Overrides the scene's seed");
   AddThreadsOption(command, args.threads);
   AddBudgetOptions(command, args.budgets);

@@ -1,15 +1,21 @@
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
+#include <vector>
 
 #include "cli.hpp"
+#include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mat_log.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/app/detector_study.hpp"
+#include "sonarbench/sim/app/map_log.hpp"
 #include "sonarbench/sim/report/fidelity_report.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
@@ -27,7 +33,41 @@ struct FidelityArgs {
   std::optional<std::uint64_t> seed;
   int threads = 0;
   double wall_min_range_m = 1.6;
+  std::string maps = "all";
 };
+
+// The log's beams: a .mat log, a folder holding one, or a dataset directory (as `map` takes).
+std::vector<sonarbench::mapping::Beam> ReadLogBeams(const std::string& input) {
+  if (const std::string mat = sonarbench::sim::MatLogInDirectory(input); !mat.empty()) {
+    return sonarbench::io::ReadMatLog(mat).beams;
+  }
+  if (std::filesystem::is_directory(input)) return sonarbench::io::ReadDataset(input).beams;
+  return sonarbench::io::ReadMatLog(input).beams;
+}
+
+// The detector study's settings --maps names: all of them, none, or their indices (detectors.csv's
+// `item` column) separated by commas. Throws InputError naming the option and what it expects.
+std::optional<std::vector<sonarbench::sim::DetectorItem>> MapSettings(
+    const std::string& text, const sonarbench::mapping::DetectionConfig& detection) {
+  const auto all = sonarbench::sim::DetectorStudyItems(detection);
+  if (text == "none") return std::nullopt;
+  if (text == "all") return all;
+  std::vector<sonarbench::sim::DetectorItem> chosen;
+  std::stringstream list(text);
+  for (std::string item; std::getline(list, item, ',');) {
+    const std::optional<std::size_t> index = ParsedWhole<std::size_t>(item);
+    if (!index || *index >= all.size()) {
+      throw sonarbench::InputError("--maps '" + text + "': expected all, none, or indices 0-" +
+                                   std::to_string(all.size() - 1) +
+                                   " of the detector study's settings separated by commas");
+    }
+    chosen.push_back(all[*index]);
+  }
+  if (chosen.size() < 2) {
+    throw sonarbench::InputError("--maps '" + text + "': expected at least two settings to rank");
+  }
+  return chosen;
+}
 
 int Fidelity(const FidelityArgs& args) {
   namespace sim = sonarbench::sim;
@@ -39,7 +79,8 @@ int Fidelity(const FidelityArgs& args) {
             << range << " m range (no echo lies past it)";
     throw sonarbench::InputError(message.str());
   }
-  const sonarbench::io::MatLog log = sonarbench::io::ReadMatLog(args.log);
+  const auto map_settings = MapSettings(args.maps, scene.mapping.detection);
+  const std::vector<sonarbench::mapping::Beam> log_beams = ReadLogBeams(args.log);
   const auto meshes = sim::BuildSceneMeshes(scene);
   std::vector<std::string> inputs = sim::SceneInputFiles(scene);
   inputs.push_back(args.log);
@@ -52,16 +93,32 @@ int Fidelity(const FidelityArgs& args) {
   progress.Clear();
   const std::vector<sonarbench::mapping::Beam> beams = sim::BeamsOf(synthesized);
   const auto& g = scene.sensor.geometry;
-  const auto report = sim::CompareWithLog(beams, log.beams, g, args.wall_min_range_m);
+  const auto report = sim::CompareWithLog(beams, log_beams, g, args.wall_min_range_m);
+  nlohmann::json maps;
+  if (map_settings) {
+    sim::DetectorStudyOptions options;
+    options.items = *map_settings;
+    options.seed = args.seed;
+    options.log = args.log;
+    options.threads = args.threads;
+    options.progress = [&](std::size_t done, std::size_t total) {
+      progress.Update("maps", done, total);
+    };
+    maps = sim::MapFidelity(scene, options);
+    progress.Clear();
+  }
   const auto per_sweep = static_cast<std::size_t>(g.BeamsPerSweep());
   const std::span<const sonarbench::mapping::Beam> sim_all(beams);
-  const std::span<const sonarbench::mapping::Beam> real_all(log.beams);
+  const std::span<const sonarbench::mapping::Beam> real_all(log_beams);
   sim::WriteFidelityOutputs(
       out.write_root().string(), report, sim_all.first(std::min(per_sweep, sim_all.size())),
-      real_all.first(std::min(per_sweep, real_all.size())), g, args.scene, args.log);
+      real_all.first(std::min(per_sweep, real_all.size())), g, args.scene, args.log, maps);
   out.Commit();
-  std::cout << sim::FidelitySummary(sim::FidelityJson(report, args.scene, args.log)) << "wrote "
-            << args.out << "/fidelity.json\n";
+  nlohmann::json brief = sim::FidelityJson(report, args.scene, args.log);
+  if (!maps.is_null()) brief["maps"] = maps;
+  std::cout << sim::FidelityBrief(brief) << "wrote " << args.out
+            << "/report.html, fidelity.json (every statistic)"
+            << (maps.is_null() ? "" : ", maps.csv") << ", profile.png, polar.png, fan.png\n";
   return 0;
 }
 
@@ -78,9 +135,18 @@ CLI::App* AddOptions(CLI::App& app, FidelityArgs& args) {
       "right). Writes fidelity.json, profile.csv/.png, wall_range.csv, wall_profile.csv, "
       "direct_wall_profile.csv, second_trip_profile.csv, histogram.csv, by_head_angle.csv (the "
       "self-reflection's and the near range's mean per head angle), polar.png and fan.png into "
-      "--out.");
+      "--out; and, with --maps, the maps of both against the scene, setting by setting, in "
+      "maps.csv, with report.html to read first.");
   command->add_option("scene", args.scene, "Scene YAML file")->required()->check(CLI::ExistingFile);
-  command->add_option("log", args.log, "Real log (.mat)")->required()->check(CLI::ExistingFile);
+  command->add_option("log", args.log, "Real log: a .mat log, its folder, or a dataset directory")
+      ->required()
+      ->check(CLI::ExistingPath);
+  command
+      ->add_option("--maps", args.maps,
+                   "Also map the scene and the log with the detector study's settings (all, none, "
+                   "or indices as in detectors.csv, e.g. 6,7,8) over the whole sweep and each half "
+                   "of it, and compare the maps (fidelity.json's maps, maps.csv, report.html)")
+      ->capture_default_str();
   command->add_option("-o,--out", args.out, "Output directory")->capture_default_str();
   AddSeedOption(command, args.seed, "Overrides the scene's seed");
   AddThreadsOption(command, args.threads);

@@ -1,8 +1,11 @@
 #include "sonarbench/sim/app/detector_study.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <sstream>
 
 #include "sonarbench/io/mapping_yaml.hpp"
@@ -29,15 +32,45 @@ std::string EchoRule(const Detection& d) {
   return std::to_string(d.max_obstacles) + " echoes, " + io::LaterEchoesName(d.later_echoes);
 }
 
-// A map of `beams` with `detection`, scored against the truth and what a perfect sensor sees.
+// Beams to map, each sweep's (of those kept) integrated as one batch.
+struct Batches {
+  std::vector<mapping::Beam> beams;
+  std::vector<std::size_t> sizes;
+};
+
+// The beams of `beams` that `heads` keeps (all without it), batched by the sweeps of
+// `per_sweep` consecutive beams they come from; `keep` is called with each kept beam's index.
+Batches SelectBeams(std::span<const mapping::Beam> beams, std::size_t per_sweep,
+                    const std::optional<std::pair<double, double>>& heads,
+                    const std::function<void(std::size_t)>& keep = {}) {
+  Batches out;
+  for (std::size_t first = 0; first < beams.size(); first += per_sweep) {
+    std::size_t kept = 0;
+    for (std::size_t b = first; b < std::min(first + per_sweep, beams.size()); ++b) {
+      if (heads && !InHeads(beams[b].head_angle_rad, *heads)) continue;
+      out.beams.push_back(beams[b]);
+      if (keep) keep(b);
+      ++kept;
+    }
+    if (kept > 0) out.sizes.push_back(kept);
+  }
+  return out;
+}
+
+// A map of `batches` with `detection`, scored against the truth and what a perfect sensor sees.
 MapMetrics MapAndScore(const mapping::MapperConfig& base, const Detection& detection,
-                       const mapping::SensorGeometry& sensor, std::span<const mapping::Beam> beams,
+                       const mapping::SensorGeometry& sensor, const Batches& batches,
                        const mapping::KeySet& truth, const mapping::KeySet& observable,
                        const DirectEchoes& direct) {
   mapping::MapperConfig config = base;
   config.detection = detection;
   mapping::Mapper mapper(config, sensor);
-  (void)mapper.IntegrateSweeps(beams);
+  const std::span<const mapping::Beam> all(batches.beams);
+  std::size_t first = 0;
+  for (const std::size_t size : batches.sizes) {
+    (void)mapper.Integrate(all.subspan(first, size));
+    first += size;
+  }
   return ScoreMap(mapper.tree(), truth, observable, {}, {}, &direct);
 }
 
@@ -119,6 +152,139 @@ void WritePlot(const std::string& path, const std::vector<DetectorRow>& rows, bo
 
 }  // namespace
 
+double Spearman(const std::vector<double>& a, const std::vector<double>& b) {
+  const auto ranks = [](const std::vector<double>& x) {
+    std::vector<std::size_t> order(x.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](auto i, auto j) { return x[i] < x[j]; });
+    std::vector<double> rank(x.size());
+    for (std::size_t i = 0; i < order.size();) {
+      std::size_t j = i;
+      while (j + 1 < order.size() && x[order[j + 1]] == x[order[i]]) ++j;
+      for (std::size_t k = i; k <= j; ++k) rank[order[k]] = 0.5 * static_cast<double>(i + j);
+      i = j + 1;
+    }
+    return rank;
+  };
+  const std::vector<double> ra = ranks(a), rb = ranks(b);
+  const double n = static_cast<double>(a.size());
+  double ma = 0.0, mb = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) ma += ra[i] / n, mb += rb[i] / n;
+  double cov = 0.0, va = 0.0, vb = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    cov += (ra[i] - ma) * (rb[i] - mb);
+    va += (ra[i] - ma) * (ra[i] - ma);
+    vb += (rb[i] - mb) * (rb[i] - mb);
+  }
+  return va > 0.0 && vb > 0.0 ? cov / std::sqrt(va * vb) : NAN;
+}
+
+std::vector<Agreement> StudyAgreement(const std::vector<DetectorRow>& rows) {
+  std::vector<Agreement> out;
+  if (rows.empty() || !rows.front().log) return out;
+  for (const char* figure :
+       {"precision_1", "recall_1", "f1_1", "ghost_arc_share", "ghost_echo_share"}) {
+    std::vector<double> sim, log;
+    for (const DetectorRow& row : rows) {
+      sim.push_back(MetricsJson(row.scene).at(figure).get<double>());
+      log.push_back(MetricsJson(*row.log).at(figure).get<double>());
+    }
+    Agreement a{figure, Spearman(sim, log), 0.0, 0.0};
+    for (std::size_t i = 0; i < sim.size(); ++i) {
+      const double d = std::abs(sim[i] - log[i]);
+      a.mean_abs_difference += d / static_cast<double>(sim.size());
+      a.max_abs_difference = std::max(a.max_abs_difference, d);
+    }
+    out.push_back(a);
+  }
+  return out;
+}
+
+std::size_t BestF1Row(const std::vector<DetectorRow>& rows, bool log) {
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const double f = log ? rows[i].log->f1_within[1] : rows[i].scene.f1_within[1];
+    const double b = log ? rows[best].log->f1_within[1] : rows[best].scene.f1_within[1];
+    if (f > b) best = i;
+  }
+  return best;
+}
+
+json AgreementJson(const std::vector<DetectorRow>& rows, const MapGoals& goals) {
+  const std::vector<Agreement> agreement = StudyAgreement(rows);
+  if (agreement.empty()) return json();
+  json figures = json::object();
+  bool meets = true;
+  for (const Agreement& a : agreement) {
+    const bool ok = !std::isnan(a.spearman) && a.spearman >= goals.min_spearman &&
+                    a.mean_abs_difference <= goals.max_mean_abs_difference &&
+                    a.max_abs_difference <= goals.max_abs_difference;
+    meets = meets && ok;
+    figures[a.figure] = {{"spearman", std::isnan(a.spearman) ? json() : json(a.spearman)},
+                         {"mean_abs_difference", a.mean_abs_difference},
+                         {"max_abs_difference", a.max_abs_difference},
+                         {"meets", ok}};
+  }
+  const std::size_t best_scene = BestF1Row(rows, false);
+  const std::size_t best_log = BestF1Row(rows, true);
+  return {{"figures", figures},
+          {"best_f1_1",
+           {{"scene", rows[best_scene].item.name},
+            {"log", rows[best_log].item.name},
+            {"same", best_scene == best_log}}},
+          {"goals",
+           {{"max_mean_abs_difference", goals.max_mean_abs_difference},
+            {"max_abs_difference", goals.max_abs_difference},
+            {"min_spearman", goals.min_spearman}}},
+          {"meets", meets && best_scene == best_log}};
+}
+
+json MapFidelity(const Scene& scene, DetectorStudyOptions options, const MapGoals& goals) {
+  const std::vector<DetectorItem> items =
+      options.items.empty() ? DetectorStudyItems(scene.mapping.detection) : options.items;
+  options.items = items;
+  const auto progress = options.progress;
+  json parts = json::array();
+  bool meets = true;
+  const std::vector<std::pair<std::string, std::optional<std::pair<double, double>>>> halves = {
+      {"all head angles", std::nullopt},
+      {"head angles 0-180 deg", std::pair{0.0, 180.0}},
+      {"head angles 180-360 deg", std::pair{180.0, 360.0}}};
+  for (std::size_t p = 0; p < halves.size(); ++p) {
+    options.heads_deg = halves[p].second;
+    options.progress = [&](std::size_t done, std::size_t) {
+      if (progress) progress(p * items.size() + done, halves.size() * items.size());
+    };
+    const std::vector<DetectorRow> rows = RunDetectorStudy(scene, options);
+    json table = json::array();
+    for (const DetectorRow& row : rows) {
+      json scene_values, log_values;
+      for (const char* key :
+           {"precision_1", "recall_1", "f1_1", "ghost_arc_share", "ghost_echo_share"}) {
+        scene_values[key] = MetricsJson(row.scene).at(key);
+        log_values[key] = MetricsJson(*row.log).at(key);
+      }
+      table.push_back({{"name", row.item.name}, {"scene", scene_values}, {"log", log_values}});
+    }
+    json agreement = AgreementJson(rows, goals);
+    meets = meets && agreement.value("meets", false);
+    const auto& heads = halves[p].second;
+    parts.push_back({{"name", halves[p].first},
+                     {"heads_deg", heads ? json::array({heads->first, heads->second}) : json()},
+                     {"agreement", std::move(agreement)},
+                     {"rows", std::move(table)}});
+  }
+  json names = json::array();
+  for (const DetectorItem& item : items) names.push_back(item.name);
+  return {{"settings", names}, {"parts", parts}, {"meets", meets}};
+}
+
+bool InHeads(double head_angle_rad, const std::pair<double, double>& heads_deg) {
+  double deg = std::fmod(head_angle_rad * 180.0 / std::numbers::pi, 360.0);
+  if (deg < 0.0) deg += 360.0;
+  return deg >= heads_deg.first && deg < heads_deg.second;
+}
+
 std::vector<DetectorItem> DetectorStudyItems(const Detection& base) {
   std::vector<DetectorItem> items;
   auto add = [&](Detection d) {
@@ -156,23 +322,32 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
   // does, its truth, observable cells and direct echoes kept.
   std::optional<LogMapResult> log;
   std::optional<SceneScore> log_score;
+  Batches log_beams;
   if (!options.log.empty()) {
     log = MapLog(options.log, scene.sensor.geometry, base, &scene, scene.budgets);
+    std::vector<BeamPose> poses;
+    log_beams =
+        SelectBeams(log->mapped, static_cast<std::size_t>(log->sensor.BeamsPerSweep()),
+                    options.heads_deg, [&](std::size_t b) { poses.push_back(log->poses[b]); });
+    log->poses = std::move(poses);
     log_score = ScoreLogMap(*log, scene);
   }
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
-  const SimulatedScene simulated =
-      SimulateForScoring(scene, meshes, tracer, options.seed.value_or(scene.seed), options.threads);
+  const SimulatedScene simulated = SimulateForScoring(
+      scene, meshes, tracer, options.seed.value_or(scene.seed), options.threads, options.heads_deg);
+  const Batches sim_beams =
+      SelectBeams(simulated.beams, static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep()),
+                  options.heads_deg);
 
   std::vector<DetectorRow> rows;
   for (const DetectorItem& item : items) {
     DetectorRow row{item,
-                    MapAndScore(base, item.detection, scene.sensor.geometry, simulated.beams,
+                    MapAndScore(base, item.detection, scene.sensor.geometry, sim_beams,
                                 simulated.truth, simulated.observable, simulated.direct),
                     std::nullopt};
     if (log) {
-      row.log = MapAndScore(base, item.detection, log->sensor, log->mapped, log_score->truth,
+      row.log = MapAndScore(base, item.detection, log->sensor, log_beams, log_score->truth,
                             log_score->observable, log_score->direct);
     }
     rows.push_back(std::move(row));
@@ -205,7 +380,11 @@ void WriteDetectorStudy(const std::string& dir, const Scene& scene,
                 {"seed", options.seed.value_or(scene.seed)},
                 {"log", options.log.empty() ? json() : json(options.log)},
                 {"resolution_m", scene.mapping.resolution_m},
+                {"heads_deg", options.heads_deg ? json::array({options.heads_deg->first,
+                                                               options.heads_deg->second})
+                                                : json()},
                 {"items", items}});
+  if (with_log) study["agreement"] = AgreementJson(rows);
   WriteJson((root / "study.json").string(), study);
 }
 

@@ -1,17 +1,22 @@
 #include "sonarbench/sim/app/simulated_scene.hpp"
 
+#include "sonarbench/sim/app/detector_study.hpp"
+
 namespace sonarbench::sim {
 
 SimulatedScene SimulateForScoring(const Scene& scene, const std::vector<TriangleMesh>& meshes,
-                                  const RayTracer& tracer, std::uint64_t seed, int threads) {
+                                  const RayTracer& tracer, std::uint64_t seed, int threads,
+                                  const std::optional<std::pair<double, double>>& heads_deg) {
   SimulatedScene s;
   s.synthesized = SimulateScene(scene, tracer, seed, threads);
   s.beams = BeamsOf(s.synthesized);
   const octomap::OcTree key_space(scene.mapping.resolution_m);
   s.truth = VoxelizeMeshes(meshes, key_space);
   std::vector<BeamPose> poses;
-  for (std::size_t b = 0; b < s.synthesized.size(); ++b)
-    poses.push_back(ScheduleBeam(scene, b).pose);
+  for (std::size_t b = 0; b < s.synthesized.size(); ++b) {
+    const BeamPose pose = ScheduleBeam(scene, b).pose;
+    if (!heads_deg || InHeads(pose.head_angle_rad, *heads_deg)) poses.push_back(pose);
+  }
   s.observable = PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics,
                                     key_space, {}, &s.direct);
   return s;

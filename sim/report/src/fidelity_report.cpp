@@ -226,7 +226,7 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                           std::span<const mapping::Beam> sim_sweep,
                           std::span<const mapping::Beam> real_sweep,
                           const mapping::SensorGeometry& sensor, const std::string& scene_file,
-                          const std::string& log_file) {
+                          const std::string& log_file, const nlohmann::json& maps) {
   namespace fs = std::filesystem;
   CreateOutputDirectory(out_dir);
   const fs::path dir(out_dir);
@@ -250,7 +250,15 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
            SideBySide(RenderFanImage(sim_sweep, 0.01, "simulated: " + scene_file + ", first sweep"),
                       RenderFanImage(real_sweep, 0.01, "real: " + log_file + ", first sweep")));
 
-  WriteJson((dir / "fidelity.json").string(), FidelityJson(r, scene_file, log_file));
+  nlohmann::json report = FidelityJson(r, scene_file, log_file);
+  if (!maps.is_null()) {
+    report["maps"] = maps;
+    report["outputs"].push_back("maps.csv");
+    WriteText((dir / "maps.csv").string(), MapsCsv(maps));
+  }
+  report["outputs"].push_back("report.html");
+  WriteText((dir / "report.html").string(), FidelityHtml(report));
+  WriteJson((dir / "fidelity.json").string(), report);
 }
 
 }  // namespace sonarbench::sim

@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <set>
 
 #include "sonarbench/sim/app/dataset_writer.hpp"
@@ -85,5 +87,84 @@ TEST(DetectorStudy, ADatasetOfTheSceneScoresAsTheScene) {
                    rows[1].scene.ghost_share);
 }
 
+// Spearman's rank correlation against cases worked by hand: the same order 1, the reverse -1,
+// a tie taking the average of its ranks (ranks 0, 1.5, 1.5, 3 against 0, 1, 2, 3: 0.9487), a
+// constant column none.
+TEST(DetectorStudy, SpearmanRanksAsWorkedByHand) {
+  EXPECT_DOUBLE_EQ(Spearman({0.1, 0.5, 0.3}, {1.0, 9.0, 4.0}), 1.0);
+  EXPECT_DOUBLE_EQ(Spearman({0.1, 0.5, 0.3}, {9.0, 1.0, 4.0}), -1.0);
+  EXPECT_NEAR(Spearman({1.0, 2.0, 2.0, 3.0}, {1.0, 2.0, 3.0, 4.0}), 3.0 / std::sqrt(10.0), 1e-12);
+  EXPECT_TRUE(std::isnan(Spearman({1.0, 1.0, 1.0}, {1.0, 2.0, 3.0})));
+}
+
+// The agreement of three settings whose log differs from the scene by 0.02 in every figure but
+// one, off by 0.1: that figure misses the goal on its largest difference; its ranks still agree.
+TEST(DetectorStudy, AgreementMeetsTheGoalsOnlyWithinThem) {
+  std::vector<DetectorRow> rows;
+  for (int i = 0; i < 3; ++i) {
+    MapMetrics scene;
+    scene.precision_within = {0.0, 0.2 + 0.2 * i, 0.0};
+    scene.recall_within = {0.0, 0.3 + 0.1 * i, 0.0};
+    scene.f1_within = {0.0, 0.25 + 0.1 * i, 0.0};
+    scene.ghost_arc_share = 0.1 * i;
+    scene.ghost_echo_share = 0.5 - 0.1 * i;
+    MapMetrics log = scene;
+    log.precision_within[1] += 0.02;
+    log.recall_within[1] += i == 2 ? 0.1 : 0.02;
+    log.f1_within[1] += 0.02;
+    *log.ghost_arc_share += 0.02;
+    *log.ghost_echo_share -= 0.02;
+    DetectorRow row;
+    row.item.name = "setting " + std::to_string(i);
+    row.scene = scene;
+    row.log = log;
+    rows.push_back(std::move(row));
+  }
+  const nlohmann::json a = AgreementJson(rows);
+  EXPECT_TRUE(a["figures"]["precision_1"]["meets"].get<bool>());
+  EXPECT_NEAR(a["figures"]["precision_1"]["mean_abs_difference"].get<double>(), 0.02, 1e-12);
+  EXPECT_FALSE(a["figures"]["recall_1"]["meets"].get<bool>());
+  EXPECT_NEAR(a["figures"]["recall_1"]["max_abs_difference"].get<double>(), 0.1, 1e-12);
+  EXPECT_DOUBLE_EQ(a["figures"]["recall_1"]["spearman"].get<double>(), 1.0);
+  EXPECT_EQ(a["best_f1_1"]["scene"], "setting 2");
+  EXPECT_TRUE(a["best_f1_1"]["same"].get<bool>());
+  EXPECT_FALSE(a["meets"].get<bool>());
+  rows[2].log->recall_within[1] -= 0.08;  // back within the goals
+  EXPECT_TRUE(AgreementJson(rows)["meets"].get<bool>());
+}
+
+// A head angle belongs to [from, to) degrees taken modulo 360: -10° is 350°, 360° is 0°.
+TEST(DetectorStudy, HeadsAreHalfOpenAndWrapAround) {
+  const auto rad = [](double deg) { return deg * std::numbers::pi / 180.0; };
+  const std::pair<double, double> first{0.0, 180.0}, second{180.0, 360.0};
+  EXPECT_TRUE(InHeads(rad(0.0), first));
+  EXPECT_TRUE(InHeads(rad(179.9), first));
+  EXPECT_FALSE(InHeads(rad(180.0), first));
+  EXPECT_TRUE(InHeads(rad(180.0), second));
+  EXPECT_TRUE(InHeads(rad(-10.0), second));
+  EXPECT_TRUE(InHeads(rad(360.0), first));
+  EXPECT_TRUE(InHeads(rad(725.0), first));
+}
+
+// One half of the sweep maps only its beams: the scene's first echoes at 110 then lie on that
+// half's walls, none on the other's, and its dataset as the log still scores as the scene.
+TEST(DetectorStudy, AHalfOfTheSweepMapsOnlyItsBeams) {
+  test::TempDir dir;
+  Scene scene = LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  scene.sweeps = 1;
+  const auto dataset = dir.path() / "dataset";
+  (void)SimulateDataset(scene, dataset.string(), DatasetOptions{});
+  DetectorStudyOptions options;
+  options.log = dataset.string();
+  options.items = {DetectorStudyItems(scene.mapping.detection)[6]};  // threshold 110, first echo
+  const MapMetrics whole = RunDetectorStudy(scene, options).front().scene;
+  options.heads_deg = std::pair{0.0, 180.0};
+  const DetectorRow half = RunDetectorStudy(scene, options).front();
+  ASSERT_TRUE(half.log.has_value());
+  EXPECT_EQ(half.log->occupied_cells, half.scene.occupied_cells);
+  EXPECT_LT(half.scene.occupied_cells, whole.occupied_cells);
+  EXPECT_GT(half.scene.occupied_cells, whole.occupied_cells / 4);
+  EXPECT_LT(half.scene.observable_cells, whole.observable_cells);
+}
 }  // namespace
 }  // namespace sonarbench::sim

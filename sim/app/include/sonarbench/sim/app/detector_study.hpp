@@ -2,8 +2,10 @@
 
 #include <cstdint>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sonarbench/mapping/mapper_config.hpp"
@@ -31,8 +33,15 @@ struct DetectorStudyOptions {
   /// `sonarbench map LOG --scene SCENE --score` maps it, beside the simulated scene; "" for none.
   std::string log;
   int threads = 0;
+  /// Only the beams whose head angle lies in [first, second) degrees (0-360), of the simulated
+  /// scene and of the log alike, mapped sweep by sweep and scored against what those beams see:
+  /// one half of a sweep to fit a model on, the other to check it.
+  std::optional<std::pair<double, double>> heads_deg;
   std::function<void(std::size_t done, std::size_t total)> progress;
 };
+
+/// Whether `head_angle_rad` lies in [heads.first, heads.second) degrees, taken modulo 360.
+[[nodiscard]] bool InHeads(double head_angle_rad, const std::pair<double, double>& heads_deg);
 
 /// One row of the study: a setting's map of the simulated scene and, if given, of the log, each
 /// scored against the scene's surfaces (ScoreMap) as `report.json`'s metrics.
@@ -47,6 +56,45 @@ struct DetectorRow {
 /// cannot be read or placed in the scene (as `map --score` does).
 [[nodiscard]] std::vector<DetectorRow> RunDetectorStudy(const Scene& scene,
                                                         const DetectorStudyOptions& options);
+
+/// How closely the simulated scene's maps follow the log's over the study's settings, for one
+/// figure (a MapMetrics value in [0, 1]): the Spearman rank correlation of the two columns
+/// (average ranks for ties; NaN when either column is constant) and their mean and largest
+/// absolute difference.
+struct Agreement {
+  std::string figure;  ///< "precision_1", "recall_1", "f1_1", "ghost_arc_share", "ghost_echo_share"
+  double spearman = 0.0;
+  double mean_abs_difference = 0.0;
+  double max_abs_difference = 0.0;
+};
+/// The five figures above, over the rows that have a log (none: empty).
+[[nodiscard]] std::vector<Agreement> StudyAgreement(const std::vector<DetectorRow>& rows);
+/// The Spearman rank correlation of two equally long columns (average ranks for ties).
+[[nodiscard]] double Spearman(const std::vector<double>& a, const std::vector<double>& b);
+/// The index of the row with the best F1 at one cell: of the scene's maps or, with `log`, of the
+/// log's (the first among equals).
+[[nodiscard]] std::size_t BestF1Row(const std::vector<DetectorRow>& rows, bool log);
+
+/// What "the simulated scene predicts the log's maps" asks of each figure of StudyAgreement.
+struct MapGoals {
+  double max_mean_abs_difference = 0.03;
+  double max_abs_difference = 0.08;
+  double min_spearman = 0.95;
+};
+
+/// StudyAgreement and BestF1Row as JSON, each figure with whether it meets `goals`, and "meets":
+/// every figure does and the best setting by F1 at 1 cell is the same on both. Rows without a
+/// log: null.
+[[nodiscard]] nlohmann::json AgreementJson(const std::vector<DetectorRow>& rows,
+                                           const MapGoals& goals = {});
+
+/// The study with the log over the whole sweep and over each half of it ([0, 180) and [180, 360)
+/// degrees of head angle; `options.heads_deg` is ignored), as fidelity.json's "maps": "settings"
+/// (their names), "parts" (per part its name, "heads_deg", AgreementJson as "agreement", and
+/// "rows": each setting's P@1, R@1, F1@1 and ghost split, scene and log) and "meets" (every part
+/// does). `options.progress` counts the settings over the three parts.
+[[nodiscard]] nlohmann::json MapFidelity(const Scene& scene, DetectorStudyOptions options,
+                                         const MapGoals& goals = {});
 
 /// detectors.csv (a row per setting), precision_vs_recall_scene.png and, with a log,
 /// precision_vs_recall_log.png (precision against recall at one cell of tolerance) and study.json,

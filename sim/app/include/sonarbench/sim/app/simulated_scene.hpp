@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "sonarbench/sim/eval/ground_truth.hpp"
@@ -22,10 +24,11 @@ struct SimulatedScene {
 };
 
 /// Simulates `scene` with `seed` on `tracer` (built from `meshes`, the scene's) and voxelises its
-/// truth and observable cells.
-[[nodiscard]] SimulatedScene SimulateForScoring(const Scene& scene,
-                                                const std::vector<TriangleMesh>& meshes,
-                                                const RayTracer& tracer, std::uint64_t seed,
-                                                int threads);
+/// truth and observable cells; with `heads_deg`, the cells and echoes that the beams whose head
+/// angle lies in [first, second) degrees see (every beam is simulated and kept).
+[[nodiscard]] SimulatedScene SimulateForScoring(
+    const Scene& scene, const std::vector<TriangleMesh>& meshes, const RayTracer& tracer,
+    std::uint64_t seed, int threads,
+    const std::optional<std::pair<double, double>>& heads_deg = std::nullopt);
 
 }  // namespace sonarbench::sim

@@ -27,7 +27,9 @@ inline const std::vector<std::string> kFidelityOutputFiles = {"fidelity.json",
                                                               "histogram.csv",
                                                               "by_head_angle.csv",
                                                               "polar.png",
-                                                              "fan.png"};
+                                                              "fan.png",
+                                                              "maps.csv",
+                                                              "report.html"};
 
 /// fidelity.json's content: the report's header, the scene and log, and every statistic.
 [[nodiscard]] nlohmann::json FidelityJson(const FidelityReport& report,
@@ -37,10 +39,21 @@ inline const std::vector<std::string> kFidelityOutputFiles = {"fidelity.json",
 /// That content as text, a line per statistic ("key: value"), for the terminal.
 [[nodiscard]] std::string FidelitySummary(const nlohmann::json& report);
 
+/// report.html from fidelity.json's content: the maps' verdict first (when it holds "maps"),
+/// then the beams' key statistics, the maps' agreement per part, the images.
+[[nodiscard]] std::string FidelityHtml(const nlohmann::json& report);
+/// The terminal's summary of fidelity.json's content: the beams' key statistics, the maps'
+/// agreement per part and the verdict, a dozen lines.
+[[nodiscard]] std::string FidelityBrief(const nlohmann::json& report);
+/// maps.csv from fidelity.json's "maps": a row per part and setting, scene and log columns.
+[[nodiscard]] std::string MapsCsv(const nlohmann::json& maps);
+
+/// With `maps` (fidelity.json's "maps", null for none), also "maps" in fidelity.json and
+/// maps.csv; report.html always.
 void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& report,
                           std::span<const mapping::Beam> sim_sweep,
                           std::span<const mapping::Beam> real_sweep,
                           const mapping::SensorGeometry& sensor, const std::string& scene_file,
-                          const std::string& log_file);
+                          const std::string& log_file, const nlohmann::json& maps = nullptr);
 
 }  // namespace sonarbench::sim
