@@ -35,12 +35,12 @@ using mapping::kDegToRad;
 // equals the time-varied gain, no absorption), so echoes can be predicted exactly.
 inline SensorModel QuietSensor() {
   SensorModel model;
-  model.acoustics.speckle = false;
-  model.acoustics.noise_level_db = -300.0;
-  model.acoustics.absorption_db_per_m = 0.0;
-  model.acoustics.spreading_db_per_decade = 20.0;
-  model.acoustics.tvg_db_per_decade = 20.0;
-  model.acoustics.gain_db = 0.0;
+  model.acoustics.speckle.on = false;
+  model.acoustics.noise.level_db = -300.0;
+  model.acoustics.gain.absorption_db_per_m = 0.0;
+  model.acoustics.gain.spreading_db_per_decade = 20.0;
+  model.acoustics.gain.tvg_db_per_decade = 20.0;
+  model.acoustics.gain.gain_db = 0.0;
   return model;
 }
 

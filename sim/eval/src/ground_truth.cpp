@@ -269,8 +269,8 @@ mapping::KeySet PerfectSensorCells(const RayTracer& tracer, std::span<const Beam
                                    const mapping::SensorGeometry& sensor,
                                    const Acoustics& acoustics, const octomap::OcTree& key_space,
                                    const StageProgress& progress, DirectEchoes* direct) {
-  return ObservableSurfaceCells(tracer, beams, sensor, 2 * acoustics.rays_horizontal,
-                                2 * acoustics.rays_vertical, key_space, progress, direct);
+  return ObservableSurfaceCells(tracer, beams, sensor, 2 * acoustics.pattern.rays_horizontal,
+                                2 * acoustics.pattern.rays_vertical, key_space, progress, direct);
 }
 
 }  // namespace sonarbench::sim

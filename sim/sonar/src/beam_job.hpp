@@ -216,18 +216,18 @@ class BeamSynthesizer::BeamJob {
   void DrawPowers();
 
   EchoDeposit Deposit() {
-    return {s_.receiver_,          g_, a_.pulse_length_m, HasSecondTrip(a_), scratch_.spreader,
+    return {s_.receiver_,          g_, a_.pulse.length_m, HasSecondTrip(a_), scratch_.spreader,
             scratch_.impulse_power};
   }
   // The vehicle's echoes: the pulse alone, no second trip (FormLevels adds them after the
   // scene's skirts, second trip and reverberation).
   EchoDeposit VehicleDeposit() {
-    return {s_.receiver_,          g_, a_.pulse_length_m, false, scratch_.vehicle_spreader,
+    return {s_.receiver_,          g_, a_.pulse.length_m, false, scratch_.vehicle_spreader,
             scratch_.impulse_power};
   }
   // The scene's glints: the pulse and its skirts, no second trip or reverberation (FormLevels).
   EchoDeposit GlintDeposit() {
-    return {s_.receiver_,          g_, a_.pulse_length_m, false, scratch_.glint_spreader,
+    return {s_.receiver_,          g_, a_.pulse.length_m, false, scratch_.glint_spreader,
             scratch_.impulse_power};
   }
 

@@ -48,10 +48,10 @@ BeamPattern::BeamPattern(const SensorModel& sensor) : acoustics_(sensor.acoustic
   // directions' factors multiply to the two-way pattern.
   pattern_k_h_ = 4.0 * std::log(2.0) / (g.beam_width_horizontal_rad * g.beam_width_horizontal_rad);
   pattern_k_v_ = 4.0 * std::log(2.0) / (g.beam_width_vertical_rad * g.beam_width_vertical_rad);
-  if (a.sidelobe_extent_deg > 0.0) {
-    sidelobe_level_ = std::pow(10.0, a.sidelobe_db / 10.0);
-    sidelobe_width2_ = std::pow(a.sidelobe_width_deg * mapping::kDegToRad, 2);
-    sidelobe_extent_rad_ = a.sidelobe_extent_deg * mapping::kDegToRad;
+  if (a.pattern.sidelobe_extent_deg > 0.0) {
+    sidelobe_level_ = std::pow(10.0, a.pattern.sidelobe_db / 10.0);
+    sidelobe_width2_ = std::pow(a.pattern.sidelobe_width_deg * mapping::kDegToRad, 2);
+    sidelobe_extent_rad_ = a.pattern.sidelobe_extent_deg * mapping::kDegToRad;
     // 1e-9 over: past it atan2 can round no azimuth back inside the extent.
     sidelobe_extent_sin2_ = std::pow(std::sin(sidelobe_extent_rad_), 2) * (1.0 + 1e-9);
   }
@@ -59,44 +59,49 @@ BeamPattern::BeamPattern(const SensorModel& sensor) : acoustics_(sensor.acoustic
     return std::exp(-pattern_k_h_ * angle * angle) + SidelobePattern(angle);
   };
   const auto vertical = [&](double angle) { return std::exp(-pattern_k_v_ * angle * angle); };
-  const double aperture_h = a.aperture_scale_horizontal * g.beam_width_horizontal_rad;
-  const double aperture_v = a.aperture_scale_vertical * g.beam_width_vertical_rad;
-  horizontal_slots_ = Tabulate<JitterSlot>(a.rays_horizontal, Centred(aperture_h), horizontal);
-  vertical_slots_ = Tabulate<JitterSlot>(a.rays_vertical, Centred(aperture_v), vertical);
-  if (a.sidelobe_extent_deg > 0.0) {
+  const double aperture_h = a.pattern.aperture_scale_horizontal * g.beam_width_horizontal_rad;
+  const double aperture_v = a.pattern.aperture_scale_vertical * g.beam_width_vertical_rad;
+  horizontal_slots_ =
+      Tabulate<JitterSlot>(a.pattern.rays_horizontal, Centred(aperture_h), horizontal);
+  vertical_slots_ = Tabulate<JitterSlot>(a.pattern.rays_vertical, Centred(aperture_v), vertical);
+  if (a.pattern.sidelobe_extent_deg > 0.0) {
     // A sidelobe ray stands for a stratum wider than a main-lobe ray's in both directions: its
     // pattern factor carries the ratio of their solid angles, so the weights stay the pattern's
     // integral over the rays' strata.
     const double span = sidelobe_extent_rad_ - 0.5 * aperture_h;
-    const double area = (span / a.sidelobe_rays_horizontal) / (aperture_h / a.rays_horizontal) *
-                        (static_cast<double>(a.rays_vertical) / a.sidelobe_rays_vertical);
+    const double area =
+        (span / a.pattern.sidelobe_rays_horizontal) / (aperture_h / a.pattern.rays_horizontal) *
+        (static_cast<double>(a.pattern.rays_vertical) / a.pattern.sidelobe_rays_vertical);
     sidelobe_horizontal_slots_ = Tabulate<JitterSlot>(
-        a.sidelobe_rays_horizontal,
+        a.pattern.sidelobe_rays_horizontal,
         [&](double fraction) { return 0.5 * aperture_h + fraction * span; },
         [&](double angle) { return area * horizontal(angle); });
     sidelobe_vertical_slots_ =
-        Tabulate<JitterSlot>(a.sidelobe_rays_vertical, Centred(aperture_v), vertical);
+        Tabulate<JitterSlot>(a.pattern.sidelobe_rays_vertical, Centred(aperture_v), vertical);
   }
-  if (a.back_lobe_width_deg > 0.0) TabulateBackLobe(aperture_h, aperture_v);
+  if (a.pattern.back_lobe_width_deg > 0.0) TabulateBackLobe(aperture_h, aperture_v);
 }
 
 void BeamPattern::TabulateBackLobe(double aperture_h, double aperture_v) {
   const Acoustics& a = acoustics_;
-  back_level_ = std::pow(10.0, a.back_lobe_db / 10.0);
-  const double sigma = a.back_lobe_width_deg * mapping::kDegToRad;
+  back_level_ = std::pow(10.0, a.pattern.back_lobe_db / 10.0);
+  const double sigma = a.pattern.back_lobe_width_deg * mapping::kDegToRad;
   back_k_ = 1.0 / (sigma * sigma);
   // Strata over ±min(3σ, 90°) about the axis behind in both directions. A stratum at
   // elevation ε spans Δφ cos ε · Δε of solid angle; a main-lobe ray stands for Δθ · Δε_main.
   const double span = 2.0 * std::min(3.0 * sigma, 0.5 * std::numbers::pi);
-  const double stratum = span / a.back_lobe_rays;
+  const double stratum = span / a.pattern.back_lobe_rays;
   const double level = back_level_ * back_level_;
-  back_horizontal_slots_ = Tabulate<JitterSlot>(a.back_lobe_rays, Centred(span), [&](double angle) {
-    return level * std::exp(-back_k_ * angle * angle) * stratum / (aperture_h / a.rays_horizontal);
-  });
-  back_vertical_slots_ = Tabulate<JitterSlot>(a.back_lobe_rays, Centred(span), [&](double angle) {
-    return std::exp(-back_k_ * angle * angle) * std::cos(angle) * stratum /
-           (aperture_v / a.rays_vertical);
-  });
+  back_horizontal_slots_ =
+      Tabulate<JitterSlot>(a.pattern.back_lobe_rays, Centred(span), [&](double angle) {
+        return level * std::exp(-back_k_ * angle * angle) * stratum /
+               (aperture_h / a.pattern.rays_horizontal);
+      });
+  back_vertical_slots_ =
+      Tabulate<JitterSlot>(a.pattern.back_lobe_rays, Centred(span), [&](double angle) {
+        return std::exp(-back_k_ * angle * angle) * std::cos(angle) * stratum /
+               (aperture_v / a.pattern.rays_vertical);
+      });
 }
 
 double BeamPattern::BackLobePattern(const Eigen::Vector3d& u, double blur) const {
@@ -163,9 +168,9 @@ double BeamPattern::DrawRays(const Eigen::Matrix3d& R_world_beam, Rng& rng,
   const Eigen::Vector3d up = R_world_beam.col(2);
   constexpr unsigned kSlotMask = kJitterSlots - 1;
   static_assert((kJitterSlots & kSlotMask) == 0, "slots are picked by masking a draw's bits");
-  for (int i = 0, r = 0; i < a.rays_horizontal; ++i) {
+  for (int i = 0, r = 0; i < a.pattern.rays_horizontal; ++i) {
     const JitterSlot* stratum_h = &horizontal_slots_[static_cast<std::size_t>(i) * kJitterSlots];
-    for (int j = 0; j < a.rays_vertical; ++j, ++r) {
+    for (int j = 0; j < a.pattern.rays_vertical; ++j, ++r) {
       const std::uint64_t draw = rng.Next();
       const JitterSlot& h = stratum_h[(draw >> 32) & kSlotMask];
       const JitterSlot& v =
@@ -199,17 +204,17 @@ double BeamPattern::DrawRays(const Eigen::Matrix3d& R_world_beam, Rng& rng,
     }
   };
   // The sidelobes', if PrimaryRays counted any: left of the main lobe's rays, then right.
-  if (a.sidelobe_extent_deg > 0.0) {
+  if (a.pattern.sidelobe_extent_deg > 0.0) {
     for (const double side : {1.0, -1.0}) {
-      draw_strata(sidelobe_horizontal_slots_, a.sidelobe_rays_horizontal, sidelobe_vertical_slots_,
-                  a.sidelobe_rays_vertical, ahead, side, true);
+      draw_strata(sidelobe_horizontal_slots_, a.pattern.sidelobe_rays_horizontal,
+                  sidelobe_vertical_slots_, a.pattern.sidelobe_rays_vertical, ahead, side, true);
     }
   }
   // The back lobe's, if PrimaryRays counted any, about the axis behind; their weights stay out
   // of the sum (Acoustics::back_lobe_width_deg).
-  if (a.back_lobe_width_deg > 0.0) {
-    draw_strata(back_horizontal_slots_, a.back_lobe_rays, back_vertical_slots_, a.back_lobe_rays,
-                -ahead, 1.0, false);
+  if (a.pattern.back_lobe_width_deg > 0.0) {
+    draw_strata(back_horizontal_slots_, a.pattern.back_lobe_rays, back_vertical_slots_,
+                a.pattern.back_lobe_rays, -ahead, 1.0, false);
   }
   return weight_sum;
 }

@@ -46,10 +46,10 @@ BeamSynthesizer::BeamSynthesizer(const SensorModel& sensor, const RayTracer& tra
 
 void BeamSynthesizer::BeamJob::SeedPlace() {
   std::vector<std::uint64_t>& sector_seeds = scratch_.sector_seeds;
-  const bool own = a_.speckle_own_share > 0.0;
+  const bool own = a_.speckle.own_share > 0.0;
   const int sector_reach = static_cast<int>((s_.speckle_.weights.size() - (own ? 1 : 0)) / 2);
   sector_seeds.resize(s_.speckle_.weights.size());
-  if (a_.speckle_correlation_m <= 0.0) return;
+  if (a_.speckle.correlation_m <= 0.0) return;
   const double step = g_.step_angle_rad;
   const long long turn = std::llround(2.0 * std::numbers::pi / step);
   const Eigen::Vector3d axis = R_world_beam_.col(0);
@@ -57,7 +57,7 @@ void BeamSynthesizer::BeamJob::SeedPlace() {
   const long long tilt = std::llround(std::asin(std::clamp(axis.z(), -1.0, 1.0)) / step);
   std::array<std::uint64_t, 3> cells{};
   for (int i = 0; i < 3; ++i) {
-    const double cell = std::floor(T_world_sonar_.translation()[i] / a_.speckle_correlation_m);
+    const double cell = std::floor(T_world_sonar_.translation()[i] / a_.speckle.correlation_m);
     cells[static_cast<std::size_t>(i)] =
         static_cast<std::uint64_t>(static_cast<std::int64_t>(cell));
   }
@@ -162,7 +162,7 @@ void BeamSynthesizer::BeamJob::FormLevels(EchoPower echo_power) {
   s_.receiver_.Convert(scratch_.powers, levels);
   // The receiver off while the head transmits: after the draws, so the other bins' are the same.
   for (std::size_t k = 0; k < bins_; ++k) {
-    if (static_cast<double>(k) * g_.bin_size_m >= a_.blanking_range_m) break;
+    if (static_cast<double>(k) * g_.bin_size_m >= a_.noise.blanking_range_m) break;
     levels[k] = 0;
   }
   if (echo_power == EchoPower::kKeep) out_.echo_power = scratch_.echo_power;
@@ -211,21 +211,21 @@ void BeamSynthesizer::BeamJob::AddApart(PulseSpreader& spreader, bool skirts) {
 }
 
 void BeamSynthesizer::BeamJob::DrawSpeckle() {
-  if (!a_.speckle) return;
+  if (!a_.speckle.on) return;
   std::vector<double>& speckle = scratch_.speckle;
   speckle.resize(bins_);
   if (place_rng_) {
     SectorSpeckle(speckle, s_.speckle_.window, s_.speckle_.weights, scratch_.sector_seeds,
-                  a_.speckle_looks);
+                  a_.speckle.looks);
   } else {
-    CorrelatedSpeckle(speckle, s_.speckle_.window, *echo_rng_, a_.speckle_looks);
+    CorrelatedSpeckle(speckle, s_.speckle_.window, *echo_rng_, a_.speckle.looks);
   }
 }
 
 // The powers first, then their levels: no 8-bit store inside the loop that draws the noise. The
 // self-reflection is the sonar's own, not the place's: added after the speckle.
 void BeamSynthesizer::BeamJob::DrawPowers() {
-  const double gain = std::pow(10.0, a_.gain_db / 10.0);
+  const double gain = std::pow(10.0, a_.gain.gain_db / 10.0);
   const std::vector<double>& echo = scratch_.echo_power;
   const std::vector<double>& speckle = scratch_.speckle;
   std::vector<double>& self_reflection = scratch_.self_reflection;
@@ -235,7 +235,7 @@ void BeamSynthesizer::BeamJob::DrawPowers() {
   powers.resize(bins_);
   for (std::size_t k = 0; k < bins_; ++k) {
     double signal = gain * echo[k];
-    if (a_.speckle) signal *= speckle[k];
+    if (a_.speckle.on) signal *= speckle[k];
     if (k < self_reflection.size()) signal += self_reflection[k];
     powers[k] = signal + noise_at_bin[k] * rng_.Exponential();
   }

@@ -185,7 +185,7 @@ void BeamSynthesizer::BeamJob::QueueStraightReturn(const MirrorPath& was, const 
     glint = Glint(m, static_cast<double>(mirror.dot(to_sonar)));
   }
   scratch_.rays.push_back({at + 1e-4f * to_sonar, to_sonar, static_cast<float>(d) - 2e-4f});
-  const double last_leg = std::pow(range / d, a_.spreading_db_per_decade / 10.0);
+  const double last_leg = std::pow(range / d, a_.gain.spreading_db_per_decade / 10.0);
   scratch_.returns.push_back(
       {range,
        weight * m.reflectivity * CosPower(cos_in * cos_out, 0.5 * m.backscatter_exponent) *

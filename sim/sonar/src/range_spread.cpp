@@ -9,11 +9,11 @@ namespace sonarbench::sim {
 
 void AddPulseSkirts(const SensorModel& sensor, std::vector<double>& echo_power) {
   const Acoustics& a = sensor.acoustics;
-  if (a.pulse_skirt_length_m <= 0.0) return;
-  const double q = std::exp(-sensor.geometry.bin_size_m / a.pulse_skirt_length_m);
+  if (a.pulse.skirt_length_m <= 0.0) return;
+  const double q = std::exp(-sensor.geometry.bin_size_m / a.pulse.skirt_length_m);
   // The skirts hold S = 10^(db/10) of the pulse's power, shared out of the echo's: the pulse
   // keeps 1 / (1 + S), each side S / (2 (1 + S)), a geometric series of ratio q from q.
-  const double skirts_share = std::pow(10.0, a.pulse_skirt_db / 10.0);
+  const double skirts_share = std::pow(10.0, a.pulse.skirt_db / 10.0);
   const double keep = 1.0 / (1.0 + skirts_share);
   const double feed = keep * skirts_share * (1.0 - q) / (2.0 * q);
   // Two passes, each an exponential sum of the bins on one side: `before` holds
@@ -36,9 +36,9 @@ void AddPulseSkirts(const SensorModel& sensor, std::vector<double>& echo_power) 
 
 void AddReverberation(const SensorModel& sensor, std::vector<double>& echo_power) {
   const Acoustics& a = sensor.acoustics;
-  if (a.reverberation_length_m <= 0.0) return;
-  const double keep = std::exp(-sensor.geometry.bin_size_m / a.reverberation_length_m);
-  const double feed = std::pow(10.0, a.reverberation_db / 10.0) * (1.0 - keep);
+  if (a.tail.reverberation_length_m <= 0.0) return;
+  const double keep = std::exp(-sensor.geometry.bin_size_m / a.tail.reverberation_length_m);
+  const double feed = std::pow(10.0, a.tail.reverberation_db / 10.0) * (1.0 - keep);
   double tail = 0.0;
   for (double& power : echo_power) {
     const double echo = power;
@@ -50,7 +50,7 @@ void AddReverberation(const SensorModel& sensor, std::vector<double>& echo_power
 void AddSecondTrip(const SensorModel& sensor, const Receiver& receiver,
                    std::vector<double>& echo_power, std::span<const double> impulse_power) {
   if (!HasSecondTrip(sensor.acoustics)) return;
-  const double second_trip = std::pow(10.0, sensor.acoustics.second_trip_db / 10.0);
+  const double second_trip = std::pow(10.0, sensor.acoustics.tail.second_trip_db / 10.0);
   const std::span<const double> tvg_at_bin = receiver.TvgAtBin();
   const std::span<const double> untvg_at_bin = receiver.UntvgAtBin();
   const std::size_t bins = std::min({echo_power.size(), impulse_power.size(), tvg_at_bin.size()});

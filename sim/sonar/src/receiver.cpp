@@ -12,18 +12,18 @@ namespace {
 // window maps it: x to the knee, then knee + w·tanh((x - knee) / w), w = ceiling - knee (a hard
 // clip at the ceiling for w = 0).
 double ReceiverCeiling(const Acoustics& a, double x) {
-  const double width = a.ad_ceiling - a.ad_knee;
-  if (x <= a.ad_knee) return x;
-  if (width <= 0.0) return a.ad_ceiling;
-  return a.ad_knee + width * std::tanh((x - a.ad_knee) / width);
+  const double width = a.converter.ceiling - a.converter.knee;
+  if (x <= a.converter.knee) return x;
+  if (width <= 0.0) return a.converter.ceiling;
+  return a.converter.knee + width * std::tanh((x - a.converter.knee) / width);
 }
 
 // Its inverse: the least x whose output reaches y; infinite where the ceiling keeps it from y.
 double UnderCeiling(const Acoustics& a, double y) {
-  const double width = a.ad_ceiling - a.ad_knee;
-  if (y <= a.ad_knee) return y;
-  if (y >= a.ad_ceiling) return std::numeric_limits<double>::infinity();
-  return a.ad_knee + width * std::atanh((y - a.ad_knee) / width);
+  const double width = a.converter.ceiling - a.converter.knee;
+  if (y <= a.converter.knee) return y;
+  if (y >= a.converter.ceiling) return std::numeric_limits<double>::infinity();
+  return a.converter.knee + width * std::atanh((y - a.converter.knee) / width);
 }
 
 // QuantisePower's tables, held in locals by a loop over bins: an 8-bit store may alias anything,
@@ -65,12 +65,12 @@ Receiver::Receiver(const SensorModel& sensor)
 
 void Receiver::TabulateGain(const mapping::SensorGeometry& g) {
   const Acoustics& a = acoustics_;
-  const double noise = std::pow(10.0, a.noise_level_db / 10.0);
+  const double noise = std::pow(10.0, a.noise.level_db / 10.0);
   const double before_tvg =
-      a.noise_before_tvg_db > -100.0 ? std::pow(10.0, a.noise_before_tvg_db / 10.0) : 0.0;
+      a.noise.before_tvg_db > -100.0 ? std::pow(10.0, a.noise.before_tvg_db / 10.0) : 0.0;
   for (int i = 0; i < g.num_bins; ++i) {
     const double r = (i + 0.5) * g.bin_size_m;
-    tvg_at_bin_.push_back(std::pow(r, a.tvg_db_per_decade / 10.0));
+    tvg_at_bin_.push_back(std::pow(r, a.gain.tvg_db_per_decade / 10.0));
     untvg_at_bin_.push_back(1.0 / tvg_at_bin_.back());
     noise_at_bin_.push_back(noise + before_tvg * tvg_at_bin_.back());
   }
@@ -81,24 +81,24 @@ void Receiver::TabulateConverter() {
   // Quantise rounds half up: the converter's reading q begins where the output reaches q - 0.5
   // of its steps (255 / ad_levels intensity units each), at the level the ceiling's inverse
   // gives; the readings past the ceiling, or past ad_levels, are never reached.
-  const double reading_steps = 255.0 / a.ad_levels;  // 1 exactly for 255 levels
+  const double reading_steps = 255.0 / a.converter.levels;  // 1 exactly for 255 levels
   ad_thresholds_.fill(std::numeric_limits<double>::infinity());
   ad_thresholds_[0] = 0.0;
   ad_top_reading_ = 0;
-  for (int q = 1; q <= a.ad_levels; ++q) {
+  for (int q = 1; q <= a.converter.levels; ++q) {
     const double steps = UnderCeiling(a, (q - 0.5) * reading_steps);
-    const double level_db = a.ad_low_db + steps / 255.0 * a.ad_span_db;
+    const double level_db = a.converter.low_db + steps / 255.0 * a.converter.span_db;
     ad_thresholds_[static_cast<std::size_t>(q)] =
         std::isinf(steps) ? steps : std::pow(10.0, level_db / 10.0);
     if (!std::isinf(steps)) ad_top_reading_ = static_cast<std::uint8_t>(q);
   }
   for (int q = 0; q < 256; ++q) {
     ad_reported_[static_cast<std::size_t>(q)] =
-        static_cast<std::uint8_t>(std::min(q, a.ad_levels) * 255 / a.ad_levels);
+        static_cast<std::uint8_t>(std::min(q, a.converter.levels) * 255 / a.converter.levels);
   }
   // Buckets of positive doubles by their exponent and top mantissa bits: with 2^m per octave,
   // a bucket spans 3.01/2^m dB; m is chosen so that spans half a reading's step, or less.
-  const double step_db = a.ad_span_db / a.ad_levels;
+  const double step_db = a.converter.span_db / a.converter.levels;
   int mantissa_bits = 0;
   while (mantissa_bits < 20 &&
          10.0 * std::log10(2.0) / std::ldexp(1.0, mantissa_bits) > 0.5 * step_db) {
@@ -129,26 +129,28 @@ void Receiver::TabulateRangeLoss(double max_range_m) {
 
 void Receiver::TabulateJitter() {
   const Acoustics& a = acoustics_;
-  if (a.level_jitter_db <= 0.0) return;
+  if (a.noise.level_jitter_db <= 0.0) return;
   // a² + b² = 1 and a b = ρ: a² and b² are the roots of x² - x + ρ².
-  const double rho = a.level_jitter_bin_correlation;
+  const double rho = a.noise.level_jitter_bin_correlation;
   const double root = std::sqrt(1.0 - 4.0 * rho * rho);
   const double own = rho > 0.0 ? std::sqrt(0.5 * (1.0 + root)) : 1.0;
   const double shared = std::sqrt(0.5 * (1.0 - root));
   level_jitter_factors_.reserve(kLevelJitters);
   for (int i = 0; i < kLevelJitters; ++i) {
     const double z = NormalQuantile((i + 0.5) / kLevelJitters);
-    level_jitter_factors_.push_back(std::pow(10.0, a.level_jitter_db * own * z / 10.0));
+    level_jitter_factors_.push_back(std::pow(10.0, a.noise.level_jitter_db * own * z / 10.0));
     if (rho > 0.0) {
-      level_jitter_next_factors_.push_back(std::pow(10.0, a.level_jitter_db * shared * z / 10.0));
+      level_jitter_next_factors_.push_back(
+          std::pow(10.0, a.noise.level_jitter_db * shared * z / 10.0));
     }
   }
 }
 
 double Receiver::RangeLoss(double range_m) const {
   const Acoustics& a = acoustics_;
-  const double spreading_exponent = (a.spreading_db_per_decade - a.tvg_db_per_decade) / 10.0;
-  const double absorption_per_m = a.absorption_db_per_m * std::log(10.0) / 10.0;
+  const double spreading_exponent =
+      (a.gain.spreading_db_per_decade - a.gain.tvg_db_per_decade) / 10.0;
+  const double absorption_per_m = a.gain.absorption_db_per_m * std::log(10.0) / 10.0;
   const double exponent =
       (spreading_exponent != 0.0 ? spreading_exponent * std::log(range_m) : 0.0) +
       absorption_per_m * range_m;
@@ -166,8 +168,9 @@ std::uint8_t Receiver::QuantisePower(double power) const {
 
 std::uint8_t Receiver::Quantise(double level_db) const {
   const Acoustics& a = acoustics_;
-  const double output = ReceiverCeiling(a, (level_db - a.ad_low_db) / a.ad_span_db * 255.0);
-  const double reading = std::round(output / (255.0 / a.ad_levels));  // / 1 for 255 levels
+  const double output =
+      ReceiverCeiling(a, (level_db - a.converter.low_db) / a.converter.span_db * 255.0);
+  const double reading = std::round(output / (255.0 / a.converter.levels));  // / 1 for 255 levels
   return ad_reported_[static_cast<std::size_t>(std::clamp(reading, 0.0, 255.0))];
 }
 

@@ -11,16 +11,16 @@ namespace sonarbench::sim {
 SelfReflection::SelfReflection(const SensorModel& sensor, std::uint64_t run_seed)
     : acoustics_(sensor.acoustics), step_angle_rad_(sensor.geometry.step_angle_rad) {
   const Acoustics& a = acoustics_;
-  const std::size_t n = a.self_reflection_db.size();
-  const double sigma_a = a.self_reflection_angle_spread_db;
-  const double sigma_p = a.self_reflection_ping_spread_db;
+  const std::size_t n = a.self_reflection.profile_db.size();
+  const double sigma_a = a.self_reflection.angle_spread_db;
+  const double sigma_p = a.self_reflection.ping_spread_db;
   // The ping's spread covers the ringing's bins: those whose centre lies within its range.
   ringing_bins_ = n;
-  if (a.self_reflection_ringing_range_m > 0.0) {
+  if (a.self_reflection.ringing_range_m > 0.0) {
     ringing_bins_ = std::min(
         n,
         static_cast<std::size_t>(std::max(
-            0.0, std::ceil(a.self_reflection_ringing_range_m / sensor.geometry.bin_size_m - 0.5))));
+            0.0, std::ceil(a.self_reflection.ringing_range_m / sensor.geometry.bin_size_m - 0.5))));
   }
   // E[10^(σ z / 10)] = exp(½ (σ ln 10 / 10)²) for z standard normal: divided out, so the
   // profile stays the mean power.
@@ -35,7 +35,7 @@ SelfReflection::SelfReflection(const SensorModel& sensor, std::uint64_t run_seed
   by_head_.assign(turn * n, 0.0);
   for (std::size_t j = 0; j < turn; ++j) {
     for (std::size_t k = 0; k < n; ++k) {
-      by_head_[j * n + k] = std::pow(10.0, a.self_reflection_db[k] / 10.0) / mean_factor(k);
+      by_head_[j * n + k] = std::pow(10.0, a.self_reflection.profile_db[k] / 10.0) / mean_factor(k);
     }
   }
   if (sigma_a > 0.0 && n > 0) SpreadOverHeadSteps(run_seed);
@@ -43,9 +43,9 @@ SelfReflection::SelfReflection(const SensorModel& sensor, std::uint64_t run_seed
 
 void SelfReflection::SpreadOverHeadSteps(std::uint64_t run_seed) {
   const Acoustics& a = acoustics_;
-  const std::size_t n = a.self_reflection_db.size();
+  const std::size_t n = a.self_reflection.profile_db.size();
   const auto turn = static_cast<std::size_t>(turn_);
-  const double sigma_a = a.self_reflection_angle_spread_db;
+  const double sigma_a = a.self_reflection.angle_spread_db;
   // Head step j's draw in bin k: u_jk = (z_jk + z_j,k+1) / √2, the z independent standard normals
   // of Rng(DeriveSeed(seed, j)); then A_jk = Σ_e c_e u_(j+e mod turn),k, c_e ∝ exp(-|e| Δ / θ)
   // with Σ c² = 1, cut at half a turn or where what is left holds under 1e-12 of its power.
@@ -61,9 +61,9 @@ void SelfReflection::SpreadOverHeadSteps(std::uint64_t run_seed) {
     }
   }
   std::vector<double> kernel{1.0};
-  if (a.self_reflection_angle_correlation_deg > 0.0) {
+  if (a.self_reflection.angle_correlation_deg > 0.0) {
     const double steps =
-        a.self_reflection_angle_correlation_deg * std::numbers::pi / 180.0 / step_angle_rad_;
+        a.self_reflection.angle_correlation_deg * std::numbers::pi / 180.0 / step_angle_rad_;
     kernel = ExponentialKernel(steps, (turn_ - 1) / 2);
     double squares = 0.0;
     for (const double c : kernel) squares += c * c;
@@ -83,13 +83,13 @@ void SelfReflection::SpreadOverHeadSteps(std::uint64_t run_seed) {
 }
 
 void SelfReflection::Draw(double head_angle_rad, Rng& ping_rng, std::vector<double>& power) const {
-  const std::size_t n = acoustics_.self_reflection_db.size();
+  const std::size_t n = acoustics_.self_reflection.profile_db.size();
   const long long turn = turn_;
   const long long step = std::llround(head_angle_rad / step_angle_rad_);
   const auto j = static_cast<std::size_t>(((step % turn) + turn) % turn);
   power.assign(by_head_.begin() + static_cast<std::ptrdiff_t>(j * n),
                by_head_.begin() + static_cast<std::ptrdiff_t>((j + 1) * n));
-  const double sigma_p = acoustics_.self_reflection_ping_spread_db;
+  const double sigma_p = acoustics_.self_reflection.ping_spread_db;
   if (sigma_p <= 0.0 || n == 0) return;
   double z = ping_rng.Normal();
   for (std::size_t k = 0; k < ringing_bins_; ++k) {

@@ -126,7 +126,7 @@ void CorrelateSectors(const SensorModel& sensor, std::vector<double>& weights) {
   // (cut where what is left holds under 1e-12 of its power; normalised with the weights below),
   // so a beam hears Σ_d w_d Σ_e c_e u_{a+d+e}: its weights on the independent sectors are w
   // convolved with c.
-  const double steps = sensor.acoustics.speckle_angular_correlation_deg * std::numbers::pi / 180.0 /
+  const double steps = sensor.acoustics.speckle.angular_correlation_deg * std::numbers::pi / 180.0 /
                        g.step_angle_rad;
   const std::vector<double> kernel = ExponentialKernel(steps, std::numeric_limits<int>::max());
   const int kernel_reach = static_cast<int>(kernel.size() / 2);
@@ -190,9 +190,9 @@ SpeckleSectors SpeckleSectorsFor(const SensorModel& sensor) {
   // A bin's speckle is the coherent sum of the scatterers its range response covers: the pulse
   // and, with skirts, one e-folding of each; or the range a scene sets.
   const double speckle_range_m =
-      acoustics.speckle_window_m > 0.0
-          ? acoustics.speckle_window_m
-          : acoustics.pulse_length_m + 2.0 * acoustics.pulse_skirt_length_m;
+      acoustics.speckle.window_m > 0.0
+          ? acoustics.speckle.window_m
+          : acoustics.pulse.length_m + 2.0 * acoustics.pulse.skirt_length_m;
   sectors.window =
       static_cast<int>(std::max(1L, std::lround(speckle_range_m / sensor.geometry.bin_size_m)));
   // Sector d's share of the two-way horizontal pattern exp(-θ²/2σ²), σ = w_h / √(8 ln 2): the
@@ -210,9 +210,9 @@ SpeckleSectors SpeckleSectorsFor(const SensorModel& sensor) {
       total += share;
     }
     for (double& w : sectors.weights) w = std::sqrt(w / total);
-    if (acoustics.speckle_angular_correlation_deg > 0.0) CorrelateSectors(sensor, sectors.weights);
+    if (acoustics.speckle.angular_correlation_deg > 0.0) CorrelateSectors(sensor, sectors.weights);
     // The beam's own scatterers' share, after the sectors' (the synthesis seeds it last).
-    if (const double own = acoustics.speckle_own_share; own > 0.0) {
+    if (const double own = acoustics.speckle.own_share; own > 0.0) {
       for (double& w : sectors.weights) w *= std::sqrt(1.0 - own);
       sectors.weights.push_back(std::sqrt(own));
     }

@@ -44,16 +44,16 @@ class TankScenario : public ::testing::Test {
     scene_ = new Scene(LoadScene(test::SourcePath("scenes/cras-tank.yaml")));
     MaterialNamed("tank_wall").reflectivity = 0.5;
     MaterialNamed("tank_wall").glint = 0.0;
-    scene_->sensor.acoustics.sidelobe_extent_deg = 0.0;
+    scene_->sensor.acoustics.pattern.sidelobe_extent_deg = 0.0;
     Material& floor = MaterialNamed("tank_floor");
     floor.reflectivity = 0.2;
     floor.backscatter_exponent = 0.5;
     for (Material& m : scene_->materials) m.specular = 0.0;
-    scene_->sensor.acoustics.reverberation_length_m = 0.0;
-    scene_->sensor.acoustics.second_trip_db = -100.0;
-    scene_->sensor.acoustics.pulse_skirt_length_m = 0.0;
-    scene_->sensor.acoustics.back_lobe_width_deg = 0.0;
-    scene_->sensor.acoustics.speckle_angular_correlation_deg = 0.0;
+    scene_->sensor.acoustics.tail.reverberation_length_m = 0.0;
+    scene_->sensor.acoustics.tail.second_trip_db = -100.0;
+    scene_->sensor.acoustics.pulse.skirt_length_m = 0.0;
+    scene_->sensor.acoustics.pattern.back_lobe_width_deg = 0.0;
+    scene_->sensor.acoustics.speckle.angular_correlation_deg = 0.0;
     scene_->mapping.detection.threshold = 90;
     result_ = new ScenarioResult(RunScenario(*scene_, RunOptions{}));
     cells_ = new MapCells(CollectMapCells(result_->mapper->tree()));
@@ -103,7 +103,7 @@ TEST_F(TankScenario, NoOccupiedCellBeyondTheWalls) {
   const auto& g = scene_->sensor.geometry;
   const double corner =
       std::hypot(HalfSide(0) + std::abs(Sonar().x()), HalfSide(1) + std::abs(Sonar().y()));
-  const double slack = scene_->sensor.acoustics.pulse_length_m +
+  const double slack = scene_->sensor.acoustics.pulse.length_m +
                        corner * (1.0 / std::cos(g.beam_width_vertical_rad / 2) - 1.0) +
                        0.5 * std::sqrt(3.0) * scene_->mapping.resolution_m;
   std::size_t outside = 0;
@@ -208,7 +208,7 @@ TEST_F(TankScenario, OutputsAreWrittenWithTheReportLast) {
   EXPECT_EQ(report["parameters"]["mapping"]["rays_vertical"], 64);
   // The sensor's settings in force, the ones switched off too.
   const auto& acoustics = report["parameters"]["sensor"]["acoustics"];
-  EXPECT_EQ(acoustics["gain_db"], scene_->sensor.acoustics.gain_db);
+  EXPECT_EQ(acoustics["gain_db"], scene_->sensor.acoustics.gain.gain_db);
   EXPECT_EQ(acoustics["sidelobe_extent_deg"], 0.0);
   EXPECT_EQ(acoustics["sidelobe_rays_vertical"], 10);
   EXPECT_EQ(acoustics["ad_knee"], 100.0);

@@ -52,20 +52,20 @@ double Midpoint(double from, double to, const F& f) {
 // draws: a slot missed with probability 32 · (31/32)^2000 < 1e-26).
 TEST(BeamPattern, RaysFillTheirStrataWithThePatternsWeights) {
   SensorModel scaled;
-  scaled.acoustics.aperture_scale_horizontal = 2.0;
-  scaled.acoustics.aperture_scale_vertical = 0.5;
+  scaled.acoustics.pattern.aperture_scale_horizontal = 2.0;
+  scaled.acoustics.pattern.aperture_scale_vertical = 0.5;
   for (const SensorModel& sensor : {SensorModel{}, scaled}) {
     const mapping::SensorGeometry& g = sensor.geometry;
     const Acoustics& a = sensor.acoustics;
-    SCOPED_TRACE(a.aperture_scale_horizontal);
+    SCOPED_TRACE(a.pattern.aperture_scale_horizontal);
     const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
     const RayTracer tracer(meshes);
     const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
     constexpr int kSlots = BeamPattern::kJitterSlots;
-    const double stratum_h =
-        a.aperture_scale_horizontal * g.beam_width_horizontal_rad / a.rays_horizontal;
+    const double stratum_h = a.pattern.aperture_scale_horizontal * g.beam_width_horizontal_rad /
+                             a.pattern.rays_horizontal;
     const double stratum_v =
-        a.aperture_scale_vertical * g.beam_width_vertical_rad / a.rays_vertical;
+        a.pattern.aperture_scale_vertical * g.beam_width_vertical_rad / a.pattern.rays_vertical;
     const double k_h = 4.0 * std::log(2.0) / std::pow(g.beam_width_horizontal_rad, 2);
     const double k_v = 4.0 * std::log(2.0) / std::pow(g.beam_width_vertical_rad, 2);
     Rng rng(3);
@@ -75,17 +75,20 @@ TEST(BeamPattern, RaysFillTheirStrataWithThePatternsWeights) {
     for (int ping = 0; ping < 2000; ++ping) {
       const double sum =
           synthesizer.pattern().DrawRays(Eigen::Matrix3d::Identity(), rng, directions, patterns);
-      ASSERT_EQ(directions.size(), static_cast<std::size_t>(a.rays_horizontal * a.rays_vertical));
+      ASSERT_EQ(directions.size(),
+                static_cast<std::size_t>(a.pattern.rays_horizontal * a.pattern.rays_vertical));
       EXPECT_NEAR(sum, std::accumulate(patterns.begin(), patterns.end(), 0.0), 1e-9 * sum);
-      for (int i = 0, r = 0; i < a.rays_horizontal; ++i) {
-        for (int j = 0; j < a.rays_vertical; ++j, ++r) {
+      for (int i = 0, r = 0; i < a.pattern.rays_horizontal; ++i) {
+        for (int j = 0; j < a.pattern.rays_vertical; ++j, ++r) {
           if (ping > 0 && r > 0) break;  // every ray of the first ping, then ray 0's slots
           const Eigen::Vector3d d = directions[static_cast<std::size_t>(r)].cast<double>();
           const double theta = std::atan2(d.y(), d.x());
           const double epsilon = std::asin(d.z());
           // Positions in slots of the stratum: within float rounding of a slot centre.
-          const double slot_h = (theta / stratum_h + 0.5 * a.rays_horizontal - i) * kSlots - 0.5;
-          const double slot_v = (epsilon / stratum_v + 0.5 * a.rays_vertical - j) * kSlots - 0.5;
+          const double slot_h =
+              (theta / stratum_h + 0.5 * a.pattern.rays_horizontal - i) * kSlots - 0.5;
+          const double slot_v =
+              (epsilon / stratum_v + 0.5 * a.pattern.rays_vertical - j) * kSlots - 0.5;
           ASSERT_NEAR(slot_h, std::round(slot_h), 1e-2) << "ray " << i << ", " << j;
           ASSERT_NEAR(slot_v, std::round(slot_v), 1e-2) << "ray " << i << ", " << j;
           ASSERT_GE(std::round(slot_h), 0);
@@ -112,14 +115,14 @@ TEST(BeamPattern, OneWayPatternBoundIsNeverUnderThePattern) {
   const SensorModel tank_sensor = LoadScene(test::SourcePath("scenes/cras-tank.yaml")).sensor;
   const SensorModel main_lobe = [&] {
     SensorModel sensor = tank_sensor;
-    sensor.acoustics.sidelobe_extent_deg = 0.0;
+    sensor.acoustics.pattern.sidelobe_extent_deg = 0.0;
     return sensor;
   }();
   for (const SensorModel* with : {&tank_sensor, &main_lobe}) {
     const char* what = with == &main_lobe ? "the tank without sidelobes" : "the tank";
     for (const bool back_lobe : {true, false}) {
       SensorModel sensor = *with;
-      if (!back_lobe) sensor.acoustics.back_lobe_width_deg = 0.0;
+      if (!back_lobe) sensor.acoustics.pattern.back_lobe_width_deg = 0.0;
       const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
       Rng rng(91);
       for (int i = 0; i < 20000; ++i) {
@@ -151,18 +154,19 @@ TEST(BeamPattern, OneWayPatternBoundIsNeverUnderThePattern) {
 TEST(BeamPattern, SidelobesHearPlatesOffTheAxisAsThePatternSays) {
   SensorModel sensor = QuietSensor();
   Acoustics& a = sensor.acoustics;
-  a.sidelobe_extent_deg = 24.0;  // (24 - 1.5) / 45: 0.5° strata, edges on whole half degrees
-  a.sidelobe_db = -20.0;
-  a.sidelobe_width_deg = 5.0;
-  a.sidelobe_rays_horizontal = 45;
-  a.sidelobe_rays_vertical = 40;
+  a.pattern.sidelobe_extent_deg =
+      24.0;  // (24 - 1.5) / 45: 0.5° strata, edges on whole half degrees
+  a.pattern.sidelobe_db = -20.0;
+  a.pattern.sidelobe_width_deg = 5.0;
+  a.pattern.sidelobe_rays_horizontal = 45;
+  a.pattern.sidelobe_rays_vertical = 40;
   const double deg = mapping::kDegToRad;
   const double main_lobe = TotalPowerOverPings(sensor, Plate(2.0, 0.0, 1.5 * deg, 4.0));
   const double left = TotalPowerOverPings(sensor, Plate(2.0, 10.0 * deg, 2.0 * deg, 4.0));
   const double right = TotalPowerOverPings(sensor, Plate(2.0, -20.0 * deg, 2.0 * deg, 4.0));
   const double w = sensor.geometry.beam_width_horizontal_rad;
-  const double s = std::pow(10.0, a.sidelobe_db / 10.0);
-  const double ts2 = std::pow(a.sidelobe_width_deg * deg, 2);
+  const double s = std::pow(10.0, a.pattern.sidelobe_db / 10.0);
+  const double ts2 = std::pow(a.pattern.sidelobe_width_deg * deg, 2);
   const auto integral = [&](double from_deg, double to_deg) {
     return Midpoint(from_deg * deg, to_deg * deg, [&](double theta) {
       const double falloff = ts2 / (ts2 + theta * theta);
@@ -176,7 +180,7 @@ TEST(BeamPattern, SidelobesHearPlatesOffTheAxisAsThePatternSays) {
   EXPECT_GT(expected_left / expected_right, 4.0);  // the falloff itself is what is measured
 
   SensorModel narrow = sensor;
-  narrow.acoustics.sidelobe_extent_deg = 0.0;
+  narrow.acoustics.pattern.sidelobe_extent_deg = 0.0;
   EXPECT_EQ(TotalPowerOverPings(narrow, Plate(2.0, 10.0 * deg, 2.0 * deg, 4.0)), 0.0);
 }
 
@@ -184,8 +188,8 @@ TEST(BeamPattern, SidelobesHearPlatesOffTheAxisAsThePatternSays) {
 // wall ahead, is heard at its range but not reported as what the beam hit.
 TEST(BeamPattern, SidelobesLeaveTheFirstHitToTheMainLobe) {
   SensorModel sensor = QuietSensor();
-  sensor.acoustics.sidelobe_extent_deg = 24.0;
-  sensor.acoustics.sidelobe_db = -10.0;
+  sensor.acoustics.pattern.sidelobe_extent_deg = 24.0;
+  sensor.acoustics.pattern.sidelobe_db = -10.0;
   const double deg = mapping::kDegToRad;
   std::vector<TriangleMesh> meshes = Wall(3.0, 0.0);
   meshes.push_back(Plate(1.0, 15.0 * deg, 3.0 * deg, 4.0).front());
@@ -214,9 +218,9 @@ TEST(BeamPattern, SidelobesLeaveTheFirstHitToTheMainLobe) {
 TEST(BeamPattern, BackLobeHearsAPlateBehindAsItsPatternSays) {
   SensorModel sensor = QuietSensor();
   Acoustics& a = sensor.acoustics;
-  a.back_lobe_width_deg = 20.0;
-  a.back_lobe_db = -10.0;
-  a.back_lobe_rays = 24;
+  a.pattern.back_lobe_width_deg = 20.0;
+  a.pattern.back_lobe_db = -10.0;
+  a.pattern.back_lobe_rays = 24;
   const double deg = mapping::kDegToRad;
   const double reach = std::tan(65.0 * deg);
   const std::vector<TriangleMesh> ahead = Plate(1.0, 0.0, 65.0 * deg, 2.0 * reach);
@@ -233,14 +237,14 @@ TEST(BeamPattern, BackLobeHearsAPlateBehindAsItsPatternSays) {
       integral(17.5, [&](double e) { return std::exp(-k_v * e * e) * std::cos(e); });
   const double k_b = 1.0 / std::pow(20.0 * deg, 2);
   const double expected_back =
-      std::pow(10.0, 2.0 * a.back_lobe_db / 10.0) *
+      std::pow(10.0, 2.0 * a.pattern.back_lobe_db / 10.0) *
       integral(60.0, [&](double p) { return std::exp(-k_b * p * p) * std::cos(p); }) *
       integral(60.0, [&](double e) { return std::exp(-k_b * e * e) * std::pow(std::cos(e), 2); });
   EXPECT_NEAR(back_lobe / main_lobe, expected_back / expected_main,
               0.01 * expected_back / expected_main);
 
   SensorModel none = sensor;
-  none.acoustics.back_lobe_width_deg = 0.0;
+  none.acoustics.pattern.back_lobe_width_deg = 0.0;
   EXPECT_EQ(TotalPowerOverPings(none, behind), 0.0);
   EXPECT_EQ(TotalPowerOverPings(none, ahead), main_lobe);
 }

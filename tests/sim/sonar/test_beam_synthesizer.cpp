@@ -67,7 +67,7 @@ TEST(BeamSynthesizer, WallAtKnownRangeEchoesInItsBin) {
     // The strongest bin lies within the pulse behind the leading edge: most power arrives from
     // near the axis, at ranges d .. d + L.
     const auto peak = std::max_element(beam.echo_power.begin(), beam.echo_power.end());
-    const long pulse_bins = static_cast<long>(std::ceil(sensor.acoustics.pulse_length_m / bin));
+    const long pulse_bins = static_cast<long>(std::ceil(sensor.acoustics.pulse.length_m / bin));
     EXPECT_GE(peak - beam.echo_power.begin(), first - beam.echo_power.begin());
     EXPECT_LE(peak - first, pulse_bins);
     // The ground truth beside the beam knows the wall's range.
@@ -161,11 +161,11 @@ TEST(BeamSynthesizer, VehiclePartShadowsTheSceneBehindIt) {
 TEST(BeamSynthesizer, VehicleEchoesHaveNoSkirtsSecondTripOrReverberation) {
   const SensorModel quiet = QuietSensor();
   SensorModel tank = quiet;
-  tank.acoustics.pulse_skirt_length_m = 0.05;
-  tank.acoustics.pulse_skirt_db = 3.0;
-  tank.acoustics.second_trip_db = 0.0;
-  tank.acoustics.reverberation_length_m = 0.5;
-  tank.acoustics.reverberation_db = -3.0;
+  tank.acoustics.pulse.skirt_length_m = 0.05;
+  tank.acoustics.pulse.skirt_db = 3.0;
+  tank.acoustics.tail.second_trip_db = 0.0;
+  tank.acoustics.tail.reverberation_length_m = 0.5;
+  tank.acoustics.tail.reverberation_db = -3.0;
   const MeshSpec plane = PartAhead(quiet, 1.0, 20.0, 0.0);
   const std::vector<TriangleMesh> far = Wall(50.0, 0.0);
   const RayTracer far_tracer(far);
@@ -209,9 +209,9 @@ TEST(BeamSynthesizer, EchoFollowsLambertsLawWithIncidence) {
 // exactly 10^(-((S - G)·log10 2 + α·Δr)/10), S spreading, G gain per decade, α absorption.
 TEST(BeamSynthesizer, EchoFollowsSpreadingAndAbsorptionWithRange) {
   SensorModel sensor = QuietSensor();
-  sensor.acoustics.spreading_db_per_decade = 40.0;
-  sensor.acoustics.tvg_db_per_decade = 10.0;
-  sensor.acoustics.absorption_db_per_m = 0.5;
+  sensor.acoustics.gain.spreading_db_per_decade = 40.0;
+  sensor.acoustics.gain.tvg_db_per_decade = 10.0;
+  sensor.acoustics.gain.absorption_db_per_m = 0.5;
   // Absorption depends on each ray's own range, so compare ray by ray: use a narrow fan where
   // every ray's range is within 0.1% of the axis range.
   sensor.geometry.beam_width_vertical_rad = 3.0 * kDegToRad;

@@ -102,7 +102,7 @@ TEST(Multipath, MultipathOffAMirrorFloorLiesWithinItsMirrorPaths) {
   const std::vector<double> direct = ping(0);
   const std::vector<double> multipath = ping(1);
   const double bin = sensor.geometry.bin_size_m;
-  const double pulse = sensor.acoustics.pulse_length_m;
+  const double pulse = sensor.acoustics.pulse.length_m;
   const auto last_direct = static_cast<std::size_t>((1.0444 + pulse) / bin);
   const auto last_mirror = static_cast<std::size_t>((1.1277 + pulse) / bin);
   double past_direct = 0.0;
@@ -127,8 +127,8 @@ TEST(Multipath, MultipathOffAMirrorFloorLiesWithinItsMirrorPaths) {
 // weights). At 30° incidence, with σ = 2°, α ≥ 56.5° and the glint is nothing (e^-399).
 TEST(Multipath, GlintIsTheMirrorLobeTowardsTheSonar) {
   SensorModel sensor = QuietSensor();
-  sensor.acoustics.aperture_scale_horizontal = 0.1;
-  sensor.acoustics.aperture_scale_vertical = 0.1;
+  sensor.acoustics.pattern.aperture_scale_horizontal = 0.1;
+  sensor.acoustics.pattern.aperture_scale_vertical = 0.1;
   Material plain;
   plain.reflectivity = 0.2;
   plain.backscatter_exponent = 0.0;
@@ -159,14 +159,14 @@ TEST(Multipath, GlintIsTheMirrorLobeTowardsTheSonar) {
 // wall); the same wall as a diffuse reflector gains a tail and a second trip.
 TEST(Multipath, GlintsFeedNoReverberationOrSecondTrip) {
   SensorModel skirts = QuietSensor();
-  skirts.acoustics.aperture_scale_horizontal = 0.1;
-  skirts.acoustics.aperture_scale_vertical = 0.1;
-  skirts.acoustics.pulse_skirt_length_m = 0.05;
-  skirts.acoustics.pulse_skirt_db = 3.0;
+  skirts.acoustics.pattern.aperture_scale_horizontal = 0.1;
+  skirts.acoustics.pattern.aperture_scale_vertical = 0.1;
+  skirts.acoustics.pulse.skirt_length_m = 0.05;
+  skirts.acoustics.pulse.skirt_db = 3.0;
   SensorModel tank = skirts;
-  tank.acoustics.second_trip_db = 0.0;
-  tank.acoustics.reverberation_length_m = 0.5;
-  tank.acoustics.reverberation_db = -3.0;
+  tank.acoustics.tail.second_trip_db = 0.0;
+  tank.acoustics.tail.reverberation_length_m = 0.5;
+  tank.acoustics.tail.reverberation_db = -3.0;
   Material glint;
   glint.reflectivity = 0.0;
   glint.specular_spread_rad = 20.0 * kDegToRad;
@@ -203,8 +203,8 @@ TEST(Multipath, GlintsFeedNoReverberationOrSecondTrip) {
 // the glint there is of the order of g, where the walls' own (at 45°) is e^-162 g.
 TEST(Multipath, CornerSendsItsGlintStraightBack) {
   SensorModel sensor = QuietSensor();
-  sensor.acoustics.aperture_scale_horizontal = 0.1;
-  sensor.acoustics.aperture_scale_vertical = 0.1;
+  sensor.acoustics.pattern.aperture_scale_horizontal = 0.1;
+  sensor.acoustics.pattern.aperture_scale_vertical = 0.1;
   std::vector<TriangleMesh> meshes;
   for (const double turn : {45.0, -45.0}) {
     MeshSpec wall;
@@ -236,7 +236,7 @@ TEST(Multipath, CornerSendsItsGlintStraightBack) {
   const std::vector<double> direct = ping(0);
   const std::vector<double> back = ping(1);
   const double bin = sensor.geometry.bin_size_m;
-  const double pulse = sensor.acoustics.pulse_length_m;
+  const double pulse = sensor.acoustics.pulse.length_m;
   const auto first = static_cast<std::size_t>(2.0 / bin);
   const auto last = static_cast<std::size_t>((2.0 / std::cos(1.75 * kDegToRad) + pulse) / bin);
   double inside = 0.0;
@@ -446,8 +446,8 @@ TEST(Multipath, BackLobeHearsAMirrorPathsLastLegInProportionToItsLevel) {
   const auto power_at_3m = [&](double back_lobe_width_deg, double back_lobe_db) {
     SensorModel sensor = QuietSensor();
     sensor.acoustics.max_bounces = 1;
-    sensor.acoustics.back_lobe_width_deg = back_lobe_width_deg;
-    sensor.acoustics.back_lobe_db = back_lobe_db;
+    sensor.acoustics.pattern.back_lobe_width_deg = back_lobe_width_deg;
+    sensor.acoustics.pattern.back_lobe_db = back_lobe_db;
     const BeamSynthesizer synthesizer(sensor, tracer, {mirror, plate});
     const SynthesizedBeam beam =
         synthesizer.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 11);

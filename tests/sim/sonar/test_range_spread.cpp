@@ -33,7 +33,7 @@ struct SecondTripAt3Db {
   SecondTripAt3Db() : sensor(Sensor()), tracer(Wall(1.0, 0.0)), synthesizer(sensor, tracer, {{}}) {}
   static SensorModel Sensor() {
     SensorModel s = QuietSensor();
-    s.acoustics.second_trip_db = 3.0;
+    s.acoustics.tail.second_trip_db = 3.0;
     return s;
   }
   SensorModel sensor;
@@ -51,8 +51,8 @@ struct SecondTripAt3Db {
 TEST(RangeSpread, ReverberationTailDecaysAtItsLengthAndHoldsItsShare) {
   SensorModel dry = QuietSensor();
   SensorModel wet = dry;
-  wet.acoustics.reverberation_length_m = 0.2;
-  wet.acoustics.reverberation_db = -3.0;
+  wet.acoustics.tail.reverberation_length_m = 0.2;
+  wet.acoustics.tail.reverberation_db = -3.0;
   const SynthesizedBeam echo = Ping(dry, Wall(0.5, 0.0));
   const SynthesizedBeam heard = Ping(wet, Wall(0.5, 0.0));
   const std::vector<double>& p = echo.echo_power;
@@ -85,8 +85,8 @@ TEST(RangeSpread, ReverberationTailDecaysAtItsLengthAndHoldsItsShare) {
 // 0.
 TEST(RangeSpread, PulseSkirtsShareTheEchoExponentiallyOnBothSides) {
   SensorModel sensor = QuietSensor();
-  sensor.acoustics.pulse_skirt_length_m = 0.05;
-  sensor.acoustics.pulse_skirt_db = 3.0;
+  sensor.acoustics.pulse.skirt_length_m = 0.05;
+  sensor.acoustics.pulse.skirt_db = 3.0;
   const RayTracer tracer(Wall(1.0, 0.0));
   const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
   const auto bins = static_cast<std::size_t>(sensor.geometry.num_bins);
@@ -126,8 +126,8 @@ TEST(RangeSpread, PulseSkirtsShareTheEchoExponentiallyOnBothSides) {
 TEST(RangeSpread, WallEchoGainsSkirtsAndKeepsItsPower) {
   const SensorModel bare = QuietSensor();
   SensorModel skirted = bare;
-  skirted.acoustics.pulse_skirt_length_m = 0.04;
-  skirted.acoustics.pulse_skirt_db = 0.0;
+  skirted.acoustics.pulse.skirt_length_m = 0.04;
+  skirted.acoustics.pulse.skirt_db = 0.0;
   const std::vector<TriangleMesh> wall = Wall(2.0, 0.0);
   const SynthesizedBeam without = Ping(bare, wall);
   const SynthesizedBeam with = Ping(skirted, wall);
@@ -232,10 +232,10 @@ TEST(RangeSpread, SecondTripIsTheScalarSumBitForBit) {
 // centre of mass is theirs summed, and it holds T times their powers' product.
 TEST(RangeSpread, WallRingsAgainAtTwiceItsRange) {
   SensorModel flat = QuietSensor();
-  flat.acoustics.spreading_db_per_decade = 0.0;
-  flat.acoustics.tvg_db_per_decade = 0.0;
+  flat.acoustics.gain.spreading_db_per_decade = 0.0;
+  flat.acoustics.gain.tvg_db_per_decade = 0.0;
   SensorModel ringing = flat;
-  ringing.acoustics.second_trip_db = -3.0;
+  ringing.acoustics.tail.second_trip_db = -3.0;
   const std::vector<TriangleMesh> wall = Wall(1.0, 0.0);
   const SynthesizedBeam once = Ping(flat, wall);
   const SynthesizedBeam twice = Ping(ringing, wall);
@@ -259,7 +259,7 @@ TEST(RangeSpread, WallRingsAgainAtTwiceItsRange) {
   // The first trip's impulse response: the same rays' echoes, each over one bin, which a pulse
   // one bin long gives.
   SensorModel short_pulse = flat;
-  short_pulse.acoustics.pulse_length_m = flat.geometry.bin_size_m;
+  short_pulse.acoustics.pulse.length_m = flat.geometry.bin_size_m;
   const std::vector<double>& h = Ping(short_pulse, wall).echo_power;
   const std::size_t wall_bin = first_of(p);
   EXPECT_EQ(wall_bin, static_cast<std::size_t>(1.0 / flat.geometry.bin_size_m));
@@ -288,16 +288,16 @@ TEST(RangeSpread, WallRingsAgainAtTwiceItsRange) {
 // its total, the product under 5e-6.
 TEST(RangeSpread, SecondTripReverberatesOnEachTrip) {
   SensorModel flat = QuietSensor();
-  flat.acoustics.spreading_db_per_decade = 0.0;
-  flat.acoustics.tvg_db_per_decade = 0.0;
-  flat.acoustics.reverberation_length_m = 0.1;
-  flat.acoustics.reverberation_db = -3.0;
+  flat.acoustics.gain.spreading_db_per_decade = 0.0;
+  flat.acoustics.gain.tvg_db_per_decade = 0.0;
+  flat.acoustics.tail.reverberation_length_m = 0.1;
+  flat.acoustics.tail.reverberation_db = -3.0;
   SensorModel ringing = flat;
-  ringing.acoustics.second_trip_db = -3.0;
+  ringing.acoustics.tail.second_trip_db = -3.0;
   SensorModel impulse = QuietSensor();
-  impulse.acoustics.spreading_db_per_decade = 0.0;
-  impulse.acoustics.tvg_db_per_decade = 0.0;
-  impulse.acoustics.pulse_length_m = flat.geometry.bin_size_m;
+  impulse.acoustics.gain.spreading_db_per_decade = 0.0;
+  impulse.acoustics.gain.tvg_db_per_decade = 0.0;
+  impulse.acoustics.pulse.length_m = flat.geometry.bin_size_m;
   const std::vector<TriangleMesh> wall = Wall(1.0, 0.0);
   const double once = TotalPower(Ping(flat, wall));
   const double twice = TotalPower(Ping(ringing, wall));

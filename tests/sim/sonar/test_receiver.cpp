@@ -49,12 +49,12 @@ LevelJitterDeviations MeasureLevelJitter(double bin_correlation) {
   Material wall;
   wall.reflectivity = 0.5;
   SensorModel sensor = QuietSensor();
-  sensor.acoustics.speckle_correlation_m = 0.05;
-  sensor.acoustics.level_jitter_db = 2.0;
-  sensor.acoustics.level_jitter_bin_correlation = bin_correlation;
+  sensor.acoustics.speckle.correlation_m = 0.05;
+  sensor.acoustics.noise.level_jitter_db = 2.0;
+  sensor.acoustics.noise.level_jitter_bin_correlation = bin_correlation;
   const Acoustics& a = sensor.acoustics;
-  const double sigma = a.level_jitter_db;
-  const double step = a.ad_span_db / 255.0;
+  const double sigma = a.noise.level_jitter_db;
+  const double step = a.converter.span_db / 255.0;
   const BeamSynthesizer synthesizer(sensor, tracer, {wall}, 7);
   const auto reference = synthesizer.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 0);
   // Bins whose exact level lies 4σ inside the AD window: no clipping at 0 or 255.
@@ -64,7 +64,9 @@ LevelJitterDeviations MeasureLevelJitter(double bin_correlation) {
     const double p = reference.echo_power[k];
     if (p <= 0.0) continue;
     const double db = 10.0 * std::log10(p);
-    if (db < a.ad_low_db + 4.0 * sigma || db > a.ad_low_db + a.ad_span_db - 4.0 * sigma) continue;
+    if (db < a.converter.low_db + 4.0 * sigma ||
+        db > a.converter.low_db + a.converter.span_db - 4.0 * sigma)
+      continue;
     bright.push_back(k);
     exact_db.push_back(db);
   }
@@ -76,7 +78,7 @@ LevelJitterDeviations MeasureLevelJitter(double bin_correlation) {
     EXPECT_EQ(beam.echo_power, reference.echo_power);  // the echoes are the place's
     const std::size_t first = out.deviations.size();
     for (std::size_t i = 0; i < bright.size(); ++i) {
-      const double level = a.ad_low_db + beam.beam.intensities[bright[i]] * step;
+      const double level = a.converter.low_db + beam.beam.intensities[bright[i]] * step;
       out.deviations.push_back(level - exact_db[i]);
       for (std::size_t lag = 1; lag <= 2 && lag <= i; ++lag) {
         if (bright[i] != bright[i - lag] + lag) continue;
@@ -109,8 +111,9 @@ TEST(Receiver, QuantisedPowersAndTabledLossesMatchTheirFormulas) {
   const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
   const Acoustics& a = sensor.acoustics;
   int compared = 0;
-  for (double db = a.ad_low_db - 20.0; db <= a.ad_low_db + a.ad_span_db + 20.0; db += 0.0137) {
-    const double steps = (db - a.ad_low_db) / a.ad_span_db * 255.0;
+  for (double db = a.converter.low_db - 20.0; db <= a.converter.low_db + a.converter.span_db + 20.0;
+       db += 0.0137) {
+    const double steps = (db - a.converter.low_db) / a.converter.span_db * 255.0;
     if (std::abs(steps - std::round(steps - 0.5) - 0.5) < 1e-9) continue;  // on an edge
     ASSERT_EQ(synthesizer.receiver().QuantisePower(std::pow(10.0, db / 10.0)),
               synthesizer.receiver().Quantise(db))
@@ -122,18 +125,19 @@ TEST(Receiver, QuantisedPowersAndTabledLossesMatchTheirFormulas) {
   // AD windows of other spans: the table's buckets narrow with the step, the result stays exact.
   for (const double span : {3.0, 120.0}) {
     SensorModel other = sensor;
-    other.acoustics.ad_span_db = span;
+    other.acoustics.converter.span_db = span;
     const BeamSynthesizer s(other, tracer, {Material{}});
-    for (double db = a.ad_low_db - 5.0; db <= a.ad_low_db + span + 5.0; db += span / 2917.0) {
-      const double steps = (db - a.ad_low_db) / span * 255.0;
+    for (double db = a.converter.low_db - 5.0; db <= a.converter.low_db + span + 5.0;
+         db += span / 2917.0) {
+      const double steps = (db - a.converter.low_db) / span * 255.0;
       if (std::abs(steps - std::round(steps - 0.5) - 0.5) < 1e-9) continue;
       ASSERT_EQ(s.receiver().QuantisePower(std::pow(10.0, db / 10.0)), s.receiver().Quantise(db))
           << db << " dB, span " << span;
     }
   }
-  for (const double spreading : {a.spreading_db_per_decade, a.tvg_db_per_decade + 20.0}) {
+  for (const double spreading : {a.gain.spreading_db_per_decade, a.gain.tvg_db_per_decade + 20.0}) {
     SensorModel steep = sensor;
-    steep.acoustics.spreading_db_per_decade = spreading;
+    steep.acoustics.gain.spreading_db_per_decade = spreading;
     const BeamSynthesizer s(steep, tracer, {Material{}});
     const double bin = steep.geometry.bin_size_m;
     for (double r = 0.5 * bin; r <= steep.geometry.MaxRangeM() + 2 * bin; r += 0.0173 * bin) {
@@ -162,7 +166,7 @@ TEST(Receiver, LevelJitterIsTheReceiversPerBinAndPerPing) {
   EXPECT_NEAR(mean, 0.0, 5.0 * std::sqrt(expected / n));
   EXPECT_NEAR(variance, expected, 5.0 * expected * std::sqrt(2.0 / n));
   const double sigma = std::sqrt(m.jitter_variance);
-  const double step = QuietSensor().acoustics.ad_span_db / 255.0;
+  const double step = QuietSensor().acoustics.converter.span_db / 255.0;
   const double rounding = 0.5 * step / sigma / std::sqrt(2.0 * std::numbers::pi);
   std::vector<double> z;
   for (double d : m.deviations) z.push_back(d / sigma);
@@ -195,14 +199,15 @@ TEST(Receiver, LevelJitterCorrelatesNeighbouringBinsAsConfigured) {
 
 TEST(Receiver, NoiseFloorMatchesItsConfiguredDistribution) {
   SensorModel sensor = QuietSensor();
-  sensor.acoustics.noise_level_db = -43.0;
+  sensor.acoustics.noise.level_db = -43.0;
   const Acoustics& a = sensor.acoustics;
   const std::vector<TriangleMesh> meshes = Wall(100.0, 0.0);  // out of range: no echo
   const RayTracer tracer(meshes);
   const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
   // Byte 0 means a level under ad_low + half a step (rounding).
-  const double floor_power = std::pow(10.0, (a.ad_low_db + 0.5 * a.ad_span_db / 255.0) / 10.0);
-  const double p = 1.0 - std::exp(-floor_power / std::pow(10.0, a.noise_level_db / 10.0));
+  const double floor_power =
+      std::pow(10.0, (a.converter.low_db + 0.5 * a.converter.span_db / 255.0) / 10.0);
+  const double p = 1.0 - std::exp(-floor_power / std::pow(10.0, a.noise.level_db / 10.0));
   double zeros = 0.0;
   double n = 0.0;
   for (std::uint64_t b = 0; b < 200; ++b) {
@@ -226,17 +231,18 @@ TEST(Receiver, NoiseFloorMatchesItsConfiguredDistribution) {
 TEST(Receiver, NoiseBeforeTheGainRisesWithRangeAsTheGainDoes) {
   SensorModel sensor = QuietSensor();
   Acoustics& a = sensor.acoustics;
-  a.noise_level_db = -46.0;
+  a.noise.level_db = -46.0;
   const std::vector<TriangleMesh> meshes = Wall(100.0, 0.0);  // out of range: no echo
   const RayTracer tracer(meshes);
   const BeamSynthesizer output_only(sensor, tracer, {Material{}});
-  a.noise_before_tvg_db = -100.0;
+  a.noise.before_tvg_db = -100.0;
   const BeamSynthesizer none(sensor, tracer, {Material{}});
-  a.noise_before_tvg_db = -50.0;
+  a.noise.before_tvg_db = -50.0;
   const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
-  const double floor_power = std::pow(10.0, (a.ad_low_db + 0.5 * a.ad_span_db / 255.0) / 10.0);
-  const double n_power = std::pow(10.0, a.noise_level_db / 10.0);
-  const double p_power = std::pow(10.0, a.noise_before_tvg_db / 10.0);
+  const double floor_power =
+      std::pow(10.0, (a.converter.low_db + 0.5 * a.converter.span_db / 255.0) / 10.0);
+  const double n_power = std::pow(10.0, a.noise.level_db / 10.0);
+  const double p_power = std::pow(10.0, a.noise.before_tvg_db / 10.0);
   constexpr int kBeams = 400;
   const std::array<std::array<std::size_t, 2>, 2> bands = {{{80, 160}, {320, 399}}};
   std::array<double, 2> zeros{};
@@ -272,11 +278,11 @@ TEST(Receiver, NoiseBeforeTheGainRisesWithRangeAsTheGainDoes) {
 // draws are the same.
 TEST(Receiver, BlankingZeroesTheBinsThatBeginWithinIt) {
   SensorModel sensor = QuietSensor();
-  sensor.acoustics.noise_level_db = 0.0;
+  sensor.acoustics.noise.level_db = 0.0;
   const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
   const RayTracer tracer(meshes);
   const BeamSynthesizer plain(sensor, tracer, {Material{}});
-  sensor.acoustics.blanking_range_m = 0.025;
+  sensor.acoustics.noise.blanking_range_m = 0.025;
   const BeamSynthesizer blanked(sensor, tracer, {Material{}});
   const auto lit = plain.Synthesize(0.0, 0.0, Eigen::Isometry3d::Identity(), 9).beam.intensities;
   auto expected = lit;
@@ -295,12 +301,12 @@ TEST(Receiver, QuantisationFollowsTheAdWindow) {
   const RayTracer tracer(meshes);
   const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
   const Acoustics& a = sensor.acoustics;
-  EXPECT_EQ(synthesizer.receiver().Quantise(a.ad_low_db - 1.0), 0);
-  EXPECT_EQ(synthesizer.receiver().Quantise(a.ad_low_db), 0);
-  EXPECT_EQ(synthesizer.receiver().Quantise(a.ad_low_db + a.ad_span_db / 2),
+  EXPECT_EQ(synthesizer.receiver().Quantise(a.converter.low_db - 1.0), 0);
+  EXPECT_EQ(synthesizer.receiver().Quantise(a.converter.low_db), 0);
+  EXPECT_EQ(synthesizer.receiver().Quantise(a.converter.low_db + a.converter.span_db / 2),
             128);  // 127.5 rounds up
-  EXPECT_EQ(synthesizer.receiver().Quantise(a.ad_low_db + a.ad_span_db), 255);
-  EXPECT_EQ(synthesizer.receiver().Quantise(a.ad_low_db + 2 * a.ad_span_db), 255);
+  EXPECT_EQ(synthesizer.receiver().Quantise(a.converter.low_db + a.converter.span_db), 255);
+  EXPECT_EQ(synthesizer.receiver().Quantise(a.converter.low_db + 2 * a.converter.span_db), 255);
 }
 
 // The receiver's ceiling: below its knee the AD window alone; above it the output
@@ -311,19 +317,22 @@ TEST(Receiver, QuantisationFollowsTheAdWindow) {
 TEST(Receiver, ReceiverCeilingCompressesAboveItsKneeAndNeverPassesIt) {
   SensorModel sensor = QuietSensor();
   Acoustics& a = sensor.acoustics;
-  a.ad_knee = 170.0;
-  a.ad_ceiling = 191.0;
+  a.converter.knee = 170.0;
+  a.converter.ceiling = 191.0;
   const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
   const RayTracer tracer(meshes);
   const BeamSynthesizer ceiling(sensor, tracer, {Material{}});
   const BeamSynthesizer plain(QuietSensor(), tracer, {Material{}});
-  const auto level = [&](double steps) { return a.ad_low_db + steps / 255.0 * a.ad_span_db; };
+  const auto level = [&](double steps) {
+    return a.converter.low_db + steps / 255.0 * a.converter.span_db;
+  };
   for (double x = 0.0; x < 169.5; x += 0.25) {
     ASSERT_EQ(ceiling.receiver().Quantise(level(x)), plain.receiver().Quantise(level(x))) << x;
   }
-  const double w = a.ad_ceiling - a.ad_knee;
+  const double w = a.converter.ceiling - a.converter.knee;
   for (const int y : {171, 175, 180, 185, 190}) {
-    EXPECT_EQ(ceiling.receiver().Quantise(level(a.ad_knee + w * std::atanh((y - a.ad_knee) / w))),
+    EXPECT_EQ(ceiling.receiver().Quantise(
+                  level(a.converter.knee + w * std::atanh((y - a.converter.knee) / w))),
               y);
   }
   EXPECT_EQ(ceiling.receiver().Quantise(level(255.0)), 191);
@@ -335,7 +344,8 @@ TEST(Receiver, ReceiverCeilingCompressesAboveItsKneeAndNeverPassesIt) {
     ASSERT_GE(q, previous) << x;
     ASSERT_LE(q, 191) << x;
     previous = q;
-    const double y = x <= a.ad_knee ? x : a.ad_knee + w * std::tanh((x - a.ad_knee) / w);
+    const double y =
+        x <= a.converter.knee ? x : a.converter.knee + w * std::tanh((x - a.converter.knee) / w);
     if (std::abs(y - std::round(y - 0.5) - 0.5) < 1e-9) continue;  // on an edge
     ASSERT_EQ(ceiling.receiver().QuantisePower(std::pow(10.0, level(x) / 10.0)), q) << x;
     ++compared;
@@ -343,7 +353,7 @@ TEST(Receiver, ReceiverCeilingCompressesAboveItsKneeAndNeverPassesIt) {
   EXPECT_EQ(previous, 191);
   EXPECT_GT(compared, 40000);
 
-  a.ad_knee = 191.0;
+  a.converter.knee = 191.0;
   const BeamSynthesizer clip(sensor, tracer, {Material{}});
   EXPECT_EQ(clip.receiver().Quantise(level(190.4)), 190);
   EXPECT_EQ(clip.receiver().Quantise(level(190.6)), 191);
@@ -362,11 +372,13 @@ TEST(Receiver, ReceiverCeilingCompressesAboveItsKneeAndNeverPassesIt) {
 TEST(Receiver, ConverterReadingsAreReportedOnThe8BitScale) {
   SensorModel sensor = QuietSensor();
   Acoustics& a = sensor.acoustics;
-  a.ad_levels = 160;
+  a.converter.levels = 160;
   const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
   const RayTracer tracer(meshes);
   const BeamSynthesizer converter(sensor, tracer, {Material{}});
-  const auto level = [&](double steps) { return a.ad_low_db + steps / 255.0 * a.ad_span_db; };
+  const auto level = [&](double steps) {
+    return a.converter.low_db + steps / 255.0 * a.converter.span_db;
+  };
   const double step = 255.0 / 160.0;
   std::set<int> expected;
   for (int k = 0; k <= 160; ++k) expected.insert(k * 255 / 160);
@@ -390,8 +402,8 @@ TEST(Receiver, ConverterReadingsAreReportedOnThe8BitScale) {
         << k;
     EXPECT_EQ(converter.receiver().Quantise(level((k - 0.5) * step + 1e-6)), k * 255 / 160) << k;
   }
-  a.ad_knee = 100.0;
-  a.ad_ceiling = 191.0;
+  a.converter.knee = 100.0;
+  a.converter.ceiling = 191.0;
   const BeamSynthesizer tank(sensor, tracer, {Material{}});
   EXPECT_EQ(tank.receiver().Quantise(level(2000.0)), 191);
   EXPECT_EQ(tank.receiver().QuantisePower(std::pow(10.0, level(2000.0) / 10.0)), 191);
@@ -401,12 +413,12 @@ TEST(Receiver, ConverterReadingsAreReportedOnThe8BitScale) {
 // ceiling of 191 (knee 170) it crowds just under 191, and no bin passes it.
 TEST(Receiver, ASaturatingEchoStaysUnderTheReceiversCeiling) {
   SensorModel sensor = QuietSensor();
-  sensor.acoustics.gain_db = 40.0;
+  sensor.acoustics.gain.gain_db = 40.0;
   const std::vector<TriangleMesh> wall = Wall(2.0, 0.0);
   const SynthesizedBeam open = Ping(sensor, wall);
   EXPECT_EQ(*std::ranges::max_element(open.beam.intensities), 255);
-  sensor.acoustics.ad_knee = 170.0;
-  sensor.acoustics.ad_ceiling = 191.0;
+  sensor.acoustics.converter.knee = 170.0;
+  sensor.acoustics.converter.ceiling = 191.0;
   const SynthesizedBeam capped = Ping(sensor, wall);
   EXPECT_EQ(*std::ranges::max_element(capped.beam.intensities), 191);
   EXPECT_EQ(capped.echo_power, open.echo_power);  // the ceiling is the receiver's, not the echo's

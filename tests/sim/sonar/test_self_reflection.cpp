@@ -33,7 +33,7 @@ using mapping::kDegToRad;
 // the spreads tested below (1.5 dB).
 SensorModel RingingSensor(std::size_t bins) {
   SensorModel sensor = QuietSensor();
-  sensor.acoustics.self_reflection_db.assign(bins, -21.0);
+  sensor.acoustics.self_reflection.profile_db.assign(bins, -21.0);
   return sensor;
 }
 
@@ -41,9 +41,9 @@ SensorModel RingingSensor(std::size_t bins) {
 std::vector<double> RingingDeviations(const SensorModel& sensor, const SynthesizedBeam& beam) {
   const Acoustics& a = sensor.acoustics;
   std::vector<double> out;
-  for (std::size_t k = 0; k < a.self_reflection_db.size(); ++k) {
-    out.push_back(a.ad_low_db + beam.beam.intensities[k] * a.ad_span_db / 255.0 -
-                  a.self_reflection_db[k]);
+  for (std::size_t k = 0; k < a.self_reflection.profile_db.size(); ++k) {
+    out.push_back(a.converter.low_db + beam.beam.intensities[k] * a.converter.span_db / 255.0 -
+                  a.self_reflection.profile_db[k]);
   }
   return out;
 }
@@ -53,7 +53,7 @@ std::vector<double> RingingDeviations(const SensorModel& sensor, const Synthesiz
 // whatever the ping and head angle.
 TEST(SelfReflection, SelfReflectionIsTheSonarsOwnNotThePlacesSpeckle) {
   SensorModel sensor = RingingSensor(40);
-  sensor.acoustics.speckle = true;
+  sensor.acoustics.speckle.on = true;
   const std::vector<TriangleMesh> meshes = Wall(2.0, 0.0);
   const RayTracer tracer(meshes);
   const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
@@ -78,13 +78,13 @@ TEST(SelfReflection, SelfReflectionIsTheSonarsOwnNotThePlacesSpeckle) {
 TEST(SelfReflection, SelfReflectionVariesFromPingToPingInItsRingingBins) {
   SensorModel sensor = RingingSensor(40);
   Acoustics& a = sensor.acoustics;
-  a.self_reflection_ping_spread_db = 1.5;
-  a.self_reflection_ringing_range_m = 20 * sensor.geometry.bin_size_m;
+  a.self_reflection.ping_spread_db = 1.5;
+  a.self_reflection.ringing_range_m = 20 * sensor.geometry.bin_size_m;
   const std::vector<TriangleMesh> none;
   const RayTracer tracer(none);
   const BeamSynthesizer synthesizer(sensor, tracer, {Material{}});
-  const double sigma = a.self_reflection_ping_spread_db;
-  const double step = a.ad_span_db / 255.0;
+  const double sigma = a.self_reflection.ping_spread_db;
+  const double step = a.converter.span_db / 255.0;
   std::vector<double> d;
   std::vector<double> power;
   double lag_one = 0.0;
@@ -137,8 +137,8 @@ TEST(SelfReflection, SelfReflectionVariesWithHeadAngleAlikeSweepAfterSweep) {
   constexpr std::size_t kBins = 200;
   SensorModel sensor = RingingSensor(kBins);
   Acoustics& a = sensor.acoustics;
-  a.self_reflection_angle_spread_db = 1.5;
-  a.self_reflection_angle_correlation_deg = 5.0;
+  a.self_reflection.angle_spread_db = 1.5;
+  a.self_reflection.angle_correlation_deg = 5.0;
   const std::vector<TriangleMesh> none;
   const RayTracer tracer(none);
   const BeamSynthesizer synthesizer(sensor, tracer, {Material{}}, 3);
@@ -152,10 +152,10 @@ TEST(SelfReflection, SelfReflectionVariesWithHeadAngleAlikeSweepAfterSweep) {
     ASSERT_EQ(beam.beam.intensities, again.beam.intensities) << "head step " << j;
     dev.push_back(RingingDeviations(sensor, beam));
   }
-  const double sigma = a.self_reflection_angle_spread_db;
-  const double step = a.ad_span_db / 255.0;
+  const double sigma = a.self_reflection.angle_spread_db;
+  const double step = a.converter.span_db / 255.0;
   const double q = std::exp(-sensor.geometry.step_angle_rad /
-                            (a.self_reflection_angle_correlation_deg * kDegToRad));
+                            (a.self_reflection.angle_correlation_deg * kDegToRad));
   const auto r_c = [&](int m) {
     return std::pow(q, std::abs(m)) * (1.0 + std::abs(m) * (1.0 - q * q) / (1.0 + q * q));
   };

@@ -129,8 +129,8 @@ TEST(Speckle, SpeckleIsFrozenPerPlaceWithACorrelationLength) {
   Material wall;
   wall.reflectivity = 0.5;
   SensorModel sensor;
-  sensor.acoustics.noise_level_db = -300.0;
-  sensor.acoustics.speckle_correlation_m = 0.05;
+  sensor.acoustics.noise.level_db = -300.0;
+  sensor.acoustics.speckle.correlation_m = 0.05;
   const BeamSynthesizer frozen(sensor, tracer, {wall}, 7);
   Eigen::Isometry3d here = Eigen::Isometry3d::Identity();
   here.translation() = Eigen::Vector3d(0.01, 0.01, 0.01);
@@ -159,7 +159,7 @@ TEST(Speckle, SpeckleIsFrozenPerPlaceWithACorrelationLength) {
   along.translation().y() += 0.03;  // the next cell
   const auto [next_cell_differ, bins] = differing(frozen.Synthesize(0.0, 0.0, along, 3));
   EXPECT_GE(2 * next_cell_differ, bins);
-  sensor.acoustics.speckle_correlation_m = 0.0;
+  sensor.acoustics.speckle.correlation_m = 0.0;
   const BeamSynthesizer fresh(sensor, tracer, {wall}, 7);
   EXPECT_NE(fresh.Synthesize(0.0, 0.0, here, 1).beam.intensities,
             fresh.Synthesize(8.5, 0.0, here, 2).beam.intensities);
@@ -213,13 +213,13 @@ TEST(Speckle, SpeckleIsExponentialAndCorrelatedOverThePulse) {
 // rounded; a pulse shorter than half a bin still has a window of one.
 TEST(Speckle, SpeckleWindowSpansThePulseAndItsSkirts) {
   SensorModel sensor;
-  sensor.acoustics.pulse_length_m = 0.05;
+  sensor.acoustics.pulse.length_m = 0.05;
   const RayTracer tracer(Wall(1.0, 0.0));
   EXPECT_EQ(BeamSynthesizer(sensor, tracer, {Material{}}).speckle().window, 4);
-  sensor.acoustics.pulse_skirt_length_m = 0.05;
+  sensor.acoustics.pulse.skirt_length_m = 0.05;
   EXPECT_EQ(BeamSynthesizer(sensor, tracer, {Material{}}).speckle().window, 12);
-  sensor.acoustics.pulse_skirt_length_m = 0.0;
-  sensor.acoustics.pulse_length_m = 0.005;
+  sensor.acoustics.pulse.skirt_length_m = 0.0;
+  sensor.acoustics.pulse.length_m = 0.005;
   EXPECT_EQ(BeamSynthesizer(sensor, tracer, {Material{}}).speckle().window, 1);
 }
 
@@ -234,7 +234,7 @@ TEST(Speckle, SpeckleWindowSpansThePulseAndItsSkirts) {
 // The weights' squares sum to 1, they are symmetric, and they reach further than the pattern.
 TEST(Speckle, AngularCorrelationConvolvesTheSectorsWithAnExponential) {
   SensorModel micron = QuietSensor();
-  micron.acoustics.speckle_correlation_m = 0.05;
+  micron.acoustics.speckle.correlation_m = 0.05;
   const std::vector<TriangleMesh> none;
   const RayTracer tracer(none);
   const std::vector<double> p = BeamSynthesizer(micron, tracer, {Material{}}).speckle().weights;
@@ -248,7 +248,7 @@ TEST(Speckle, AngularCorrelationConvolvesTheSectorsWithAnExponential) {
   const double kTolerance = 2.0 * std::sqrt(0.5e-3) + 1e-3;
   for (const double degrees : {7.2, 14.4}) {
     SCOPED_TRACE(degrees);
-    micron.acoustics.speckle_angular_correlation_deg = degrees;
+    micron.acoustics.speckle.angular_correlation_deg = degrees;
     const std::vector<double> w = BeamSynthesizer(micron, tracer, {Material{}}).speckle().weights;
     ASSERT_EQ(w.size() % 2, 1u);
     EXPECT_GT(w.size(), p.size());
@@ -331,7 +331,7 @@ TEST(Speckle, EachHeadStepHearsItsOwnShareOfTheSpeckle) {
   const std::vector<double> sectors =
       BeamSynthesizer(micron, tracer, {Material{}}).speckle().weights;
   constexpr double kOwn = 0.3;
-  micron.acoustics.speckle_own_share = kOwn;
+  micron.acoustics.speckle.own_share = kOwn;
   const std::vector<double> w = BeamSynthesizer(micron, tracer, {Material{}}).speckle().weights;
   ASSERT_EQ(w.size(), sectors.size() + 1);
   double squares = 0.0;

@@ -230,7 +230,7 @@ TEST(SceneFile, ExtendsChangesOnlyWhatItNames) {
   EXPECT_EQ(derived.start_head_angle_rad, base.start_head_angle_rad);
   // Acoustics: the base's gain and bounces kept, the noise changed.
   sim::Acoustics acoustics = base.sensor.acoustics;
-  acoustics.noise_level_db = -50.0;
+  acoustics.noise.level_db = -50.0;
   EXPECT_EQ(derived.sensor.acoustics, acoustics);
   // Materials by name: sand replaced whole (its exponent back to the default), steel added.
   ASSERT_EQ(derived.materials.size(), 3u);

@@ -38,16 +38,16 @@ TEST(SensorModelFile, SonarAcousticsOverrideTheModelsKeysItNames) {
   const sim::SensorModel model =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
   const sim::Scene scene = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
-  EXPECT_EQ(scene.sensor.acoustics.gain_db, 6.0);
+  EXPECT_EQ(scene.sensor.acoustics.gain.gain_db, 6.0);
   EXPECT_EQ(scene.sensor.acoustics.max_bounces, 8);
-  EXPECT_EQ(scene.sensor.acoustics.speckle_correlation_m, 0.05);
-  EXPECT_EQ(model.acoustics.speckle_correlation_m, 0.0);
-  EXPECT_NE(model.acoustics.gain_db, 5.0);
-  EXPECT_EQ(scene.sensor.acoustics.rays_vertical, model.acoustics.rays_vertical);
+  EXPECT_EQ(scene.sensor.acoustics.speckle.correlation_m, 0.05);
+  EXPECT_EQ(model.acoustics.speckle.correlation_m, 0.0);
+  EXPECT_NE(model.acoustics.gain.gain_db, 5.0);
+  EXPECT_EQ(scene.sensor.acoustics.pattern.rays_vertical, model.acoustics.pattern.rays_vertical);
   // The tank keeps the model's ringing (bins 0-27) and replaces its tail by its vehicle's parts
   // and a weaker tail all round.
-  const std::vector<double>& own = scene.sensor.acoustics.self_reflection_db;
-  const std::vector<double>& models = model.acoustics.self_reflection_db;
+  const std::vector<double>& own = scene.sensor.acoustics.self_reflection.profile_db;
+  const std::vector<double>& models = model.acoustics.self_reflection.profile_db;
   ASSERT_EQ(own.size(), models.size());
   for (std::size_t k = 0; k < own.size(); ++k) {
     if (k < 28) {
@@ -141,22 +141,22 @@ TEST(SensorModelFile, SpecularSpreadIsReadInDegrees) {
 TEST(SensorModelFile, ReverberationIsTheScenes) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
-  EXPECT_EQ(micron.acoustics.reverberation_length_m, 0.0);
-  EXPECT_EQ(micron.acoustics.second_trip_db, -100.0);
-  EXPECT_EQ(micron.acoustics.pulse_skirt_length_m, 0.0);
+  EXPECT_EQ(micron.acoustics.tail.reverberation_length_m, 0.0);
+  EXPECT_EQ(micron.acoustics.tail.second_trip_db, -100.0);
+  EXPECT_EQ(micron.acoustics.pulse.skirt_length_m, 0.0);
   const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
-  EXPECT_EQ(tank.sensor.acoustics.reverberation_length_m, 0.9);
-  EXPECT_EQ(tank.sensor.acoustics.reverberation_db, -4.0);
-  EXPECT_EQ(micron.acoustics.back_lobe_width_deg, 0.0);
-  EXPECT_EQ(tank.sensor.acoustics.back_lobe_width_deg, 30.0);
-  EXPECT_EQ(tank.sensor.acoustics.back_lobe_db, -15.0);
-  EXPECT_EQ(tank.sensor.acoustics.second_trip_db, 7.75);
-  EXPECT_EQ(tank.sensor.acoustics.pulse_skirt_length_m, 0.05);
-  EXPECT_EQ(tank.sensor.acoustics.pulse_skirt_db, 3.0);
-  EXPECT_EQ(micron.acoustics.level_jitter_db, 0.0);
-  EXPECT_EQ(tank.sensor.acoustics.level_jitter_db, 0.19);
-  EXPECT_EQ(micron.acoustics.level_jitter_bin_correlation, 0.0);
-  EXPECT_EQ(tank.sensor.acoustics.level_jitter_bin_correlation, 0.36);
+  EXPECT_EQ(tank.sensor.acoustics.tail.reverberation_length_m, 0.9);
+  EXPECT_EQ(tank.sensor.acoustics.tail.reverberation_db, -4.0);
+  EXPECT_EQ(micron.acoustics.pattern.back_lobe_width_deg, 0.0);
+  EXPECT_EQ(tank.sensor.acoustics.pattern.back_lobe_width_deg, 30.0);
+  EXPECT_EQ(tank.sensor.acoustics.pattern.back_lobe_db, -15.0);
+  EXPECT_EQ(tank.sensor.acoustics.tail.second_trip_db, 7.75);
+  EXPECT_EQ(tank.sensor.acoustics.pulse.skirt_length_m, 0.05);
+  EXPECT_EQ(tank.sensor.acoustics.pulse.skirt_db, 3.0);
+  EXPECT_EQ(micron.acoustics.noise.level_jitter_db, 0.0);
+  EXPECT_EQ(tank.sensor.acoustics.noise.level_jitter_db, 0.19);
+  EXPECT_EQ(micron.acoustics.noise.level_jitter_bin_correlation, 0.0);
+  EXPECT_EQ(tank.sensor.acoustics.noise.level_jitter_bin_correlation, 0.36);
   for (const char* key : {"reverberation_db", "second_trip_db", "pulse_skirt_db", "level_jitter_db",
                           "level_jitter_bin_correlation"}) {
     test::TempDir dir;
@@ -190,10 +190,10 @@ TEST(SensorModelFile, AngularCorrelationAndOwnShareNeedThePlacesSpeckle) {
                               {"'sonar_acoustics.speckle_own_share'", "'1'"});
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
-  EXPECT_EQ(micron.acoustics.speckle_own_share, 0.0);
+  EXPECT_EQ(micron.acoustics.speckle.own_share, 0.0);
   const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
-  EXPECT_EQ(tank.sensor.acoustics.speckle_angular_correlation_deg, 6.5);
-  EXPECT_EQ(tank.sensor.acoustics.speckle_own_share, 0.19);
+  EXPECT_EQ(tank.sensor.acoustics.speckle.angular_correlation_deg, 6.5);
+  EXPECT_EQ(tank.sensor.acoustics.speckle.own_share, 0.19);
 }
 
 // The speckle's looks and window are the tank's (the sensor model keeps one look over the
@@ -201,11 +201,11 @@ TEST(SensorModelFile, AngularCorrelationAndOwnShareNeedThePlacesSpeckle) {
 TEST(SensorModelFile, SpeckleLooksAndWindowAreTheTanks) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
-  EXPECT_EQ(micron.acoustics.speckle_looks, 1);
-  EXPECT_EQ(micron.acoustics.speckle_window_m, 0.0);
+  EXPECT_EQ(micron.acoustics.speckle.looks, 1);
+  EXPECT_EQ(micron.acoustics.speckle.window_m, 0.0);
   const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
-  EXPECT_EQ(tank.sensor.acoustics.speckle_looks, 3);
-  EXPECT_EQ(tank.sensor.acoustics.speckle_window_m, 0.063);
+  EXPECT_EQ(tank.sensor.acoustics.speckle.looks, 3);
+  EXPECT_EQ(tank.sensor.acoustics.speckle.window_m, 0.063);
   const std::pair<std::string, std::vector<std::string>> cases[] = {
       {"  speckle_looks: 2\n  speckle: false\n",
        {"'sonar_acoustics.speckle_looks'", "speckle: true", "got speckle: false"}},
@@ -221,11 +221,11 @@ TEST(SensorModelFile, SpeckleLooksAndWindowAreTheTanks) {
 TEST(SensorModelFile, SelfReflectionSpreadsAreTheSonars) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
-  EXPECT_EQ(micron.acoustics.self_reflection_ping_spread_db, 0.97);
-  EXPECT_EQ(micron.acoustics.self_reflection_ringing_range_m, 0.35);
-  EXPECT_EQ(micron.acoustics.self_reflection_angle_spread_db, 1.6);
-  EXPECT_EQ(micron.acoustics.self_reflection_angle_correlation_deg, 5.0);
-  EXPECT_EQ(micron.acoustics.self_reflection_db.size(), 66u);
+  EXPECT_EQ(micron.acoustics.self_reflection.ping_spread_db, 0.97);
+  EXPECT_EQ(micron.acoustics.self_reflection.ringing_range_m, 0.35);
+  EXPECT_EQ(micron.acoustics.self_reflection.angle_spread_db, 1.6);
+  EXPECT_EQ(micron.acoustics.self_reflection.angle_correlation_deg, 5.0);
+  EXPECT_EQ(micron.acoustics.self_reflection.profile_db.size(), 66u);
   const std::pair<std::string, std::vector<std::string>> cases[] = {
       {"  self_reflection_db: []\n",
        {"'sonar_acoustics.self_reflection_ping_spread_db'", "a self-reflection profile"}},
@@ -246,8 +246,8 @@ TEST(SensorModelFile, SelfReflectionSpreadsAreTheSonars) {
 TEST(SensorModelFile, ReceiverCeilingIsCheckedAgainstItsKnee) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
-  EXPECT_EQ(micron.acoustics.ad_knee, 255.0);
-  EXPECT_EQ(micron.acoustics.ad_ceiling, 255.0);
+  EXPECT_EQ(micron.acoustics.converter.knee, 255.0);
+  EXPECT_EQ(micron.acoustics.converter.ceiling, 255.0);
   const std::pair<std::string, std::vector<std::string>> cases[] = {
       {"  ad_ceiling: 191\n",
        {"'sonar_acoustics.ad_knee'", "at or below ad_ceiling (191)", "got 255"}},
@@ -262,7 +262,7 @@ TEST(SensorModelFile, ReceiverCeilingIsCheckedAgainstItsKnee) {
 TEST(SensorModelFile, SidelobesMustReachPastTheMainLobe) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
-  EXPECT_EQ(micron.acoustics.sidelobe_extent_deg, 0.0);
+  EXPECT_EQ(micron.acoustics.pattern.sidelobe_extent_deg, 0.0);
   EXPECT_EQ(sim::PrimaryRays(micron.acoustics), 640u);
   const std::pair<std::string, std::vector<std::string>> cases[] = {
       {"  sidelobe_extent_deg: 1.5\n",
@@ -279,10 +279,10 @@ TEST(SensorModelFile, SidelobesMustReachPastTheMainLobe) {
 TEST(SensorModelFile, BackLobeIsOffUnlessAskedForAndChecked) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
-  EXPECT_EQ(micron.acoustics.back_lobe_width_deg, 0.0);
+  EXPECT_EQ(micron.acoustics.pattern.back_lobe_width_deg, 0.0);
   sim::Acoustics with_back_lobe = micron.acoustics;
-  with_back_lobe.back_lobe_width_deg = 30.0;
-  with_back_lobe.back_lobe_rays = 8;
+  with_back_lobe.pattern.back_lobe_width_deg = 30.0;
+  with_back_lobe.pattern.back_lobe_rays = 8;
   EXPECT_EQ(sim::PrimaryRays(with_back_lobe), 640u + 64u);
   const std::pair<std::string, std::vector<std::string>> cases[] = {
       {"  back_lobe_db: 1\n  back_lobe_width_deg: 30\n", {"'sonar_acoustics.back_lobe_db'", "'1'"}},
@@ -306,8 +306,8 @@ TEST(SensorModelFile, LevelJitterCorrelationNeedsAJitter) {
 TEST(SensorModelFile, ConverterStepsAreTheMicronsAndChecked) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
-  EXPECT_EQ(micron.acoustics.ad_levels, 160);
-  EXPECT_EQ(sim::Acoustics{}.ad_levels, 255);
+  EXPECT_EQ(micron.acoustics.converter.levels, 160);
+  EXPECT_EQ(sim::Acoustics{}.converter.levels, 255);
   const std::pair<std::string, std::vector<std::string>> cases[] = {
       {"  ad_levels: 1\n", {"'sonar_acoustics.ad_levels'", "'1'"}},
       {"  ad_levels: 256\n", {"'sonar_acoustics.ad_levels'", "'256'"}},
@@ -320,8 +320,8 @@ TEST(SensorModelFile, ConverterStepsAreTheMicronsAndChecked) {
 TEST(SensorModelFile, BlankingIsTheMicronsAndChecked) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
-  EXPECT_EQ(micron.acoustics.blanking_range_m, 0.025);
-  EXPECT_EQ(sim::Acoustics{}.blanking_range_m, 0.0);
+  EXPECT_EQ(micron.acoustics.noise.blanking_range_m, 0.025);
+  EXPECT_EQ(sim::Acoustics{}.noise.blanking_range_m, 0.0);
   ExpectSonarAcousticsRefused("  blanking_range_m: -0.01\n",
                               {"'sonar_acoustics.blanking_range_m'", "'-0.01'"});
 }
@@ -331,11 +331,11 @@ TEST(SensorModelFile, BlankingIsTheMicronsAndChecked) {
 TEST(SensorModelFile, NoiseBeforeTheGainIsTheTanksAndChecked) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
-  EXPECT_EQ(micron.acoustics.noise_before_tvg_db, -100.0);
-  EXPECT_EQ(sim::Acoustics{}.noise_before_tvg_db, -100.0);
+  EXPECT_EQ(micron.acoustics.noise.before_tvg_db, -100.0);
+  EXPECT_EQ(sim::Acoustics{}.noise.before_tvg_db, -100.0);
   const sim::Scene tank = sim::LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
-  EXPECT_EQ(tank.sensor.acoustics.noise_before_tvg_db, -59.5);
-  EXPECT_EQ(tank.sensor.acoustics.noise_level_db, -47.0);
+  EXPECT_EQ(tank.sensor.acoustics.noise.before_tvg_db, -59.5);
+  EXPECT_EQ(tank.sensor.acoustics.noise.level_db, -47.0);
   ExpectSonarAcousticsRefused("  noise_before_tvg_db: 200\n",
                               {"'sonar_acoustics.noise_before_tvg_db'", "'200'"});
 }

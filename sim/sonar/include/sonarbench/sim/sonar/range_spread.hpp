@@ -21,7 +21,9 @@ void AddPulseSkirts(const SensorModel& sensor, std::vector<double>& echo_power);
 void AddReverberation(const SensorModel& sensor, std::vector<double>& echo_power);
 
 /// Whether the acoustics have a second trip (second_trip_db above -100).
-[[nodiscard]] inline bool HasSecondTrip(const Acoustics& a) { return a.second_trip_db > -100.0; }
+[[nodiscard]] inline bool HasSecondTrip(const Acoustics& a) {
+  return a.tail.second_trip_db > -100.0;
+}
 
 /// Adds the second trip: the echo the head reflects goes out again, so trips to r and r' are
 /// heard at r + r', P2(R) = T g(R) Σ_{r + r' = R} (P(r) / g(r)) (h(r') / g(r')), T the trip's
