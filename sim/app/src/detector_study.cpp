@@ -14,6 +14,7 @@
 #include "sonarbench/sim/app/map_log.hpp"
 #include "sonarbench/sim/app/simulated_scene.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
+#include "sonarbench/sim/eval/verdict.hpp"
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
@@ -88,6 +89,15 @@ json MetricsJson(const MapMetrics& m) {
           {"coverage", m.coverage},
           {"occupied_cells", m.occupied_cells}};
 }
+
+// The figures the scene's maps are held to the log's by: their names in study.json and
+// fidelity.json, and the criteria metrics (MetricValue) they are.
+const std::pair<const char*, const char*> kAgreementFigures[] = {
+    {"precision_1", "occupied_precision_within_1"},
+    {"recall_1", "occupied_recall_within_1"},
+    {"f1_1", "occupied_f1_within_1"},
+    {"ghost_arc_share", "ghost_arc_share"},
+    {"ghost_echo_share", "ghost_echo_share"}};
 
 const std::vector<std::string> kMetricColumns = {
     "precision",   "recall",          "precision_1",      "recall_1",         "f1_1",
@@ -169,7 +179,10 @@ double Spearman(const std::vector<double>& a, const std::vector<double>& b) {
   const std::vector<double> ra = ranks(a), rb = ranks(b);
   const double n = static_cast<double>(a.size());
   double ma = 0.0, mb = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) ma += ra[i] / n, mb += rb[i] / n;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ma += ra[i] / n;
+    mb += rb[i] / n;
+  }
   double cov = 0.0, va = 0.0, vb = 0.0;
   for (std::size_t i = 0; i < a.size(); ++i) {
     cov += (ra[i] - ma) * (rb[i] - mb);
@@ -182,12 +195,11 @@ double Spearman(const std::vector<double>& a, const std::vector<double>& b) {
 std::vector<Agreement> StudyAgreement(const std::vector<DetectorRow>& rows) {
   std::vector<Agreement> out;
   if (rows.empty() || !rows.front().log) return out;
-  for (const char* figure :
-       {"precision_1", "recall_1", "f1_1", "ghost_arc_share", "ghost_echo_share"}) {
+  for (const auto& [figure, metric] : kAgreementFigures) {
     std::vector<double> sim, log;
     for (const DetectorRow& row : rows) {
-      sim.push_back(MetricsJson(row.scene).at(figure).get<double>());
-      log.push_back(MetricsJson(*row.log).at(figure).get<double>());
+      sim.push_back(MetricValue(row.scene, metric));
+      log.push_back(MetricValue(*row.log, metric));
     }
     Agreement a{figure, Spearman(sim, log), 0.0, 0.0};
     for (std::size_t i = 0; i < sim.size(); ++i) {
@@ -259,10 +271,9 @@ json MapFidelity(const Scene& scene, DetectorStudyOptions options, const MapGoal
     json table = json::array();
     for (const DetectorRow& row : rows) {
       json scene_values, log_values;
-      for (const char* key :
-           {"precision_1", "recall_1", "f1_1", "ghost_arc_share", "ghost_echo_share"}) {
-        scene_values[key] = MetricsJson(row.scene).at(key);
-        log_values[key] = MetricsJson(*row.log).at(key);
+      for (const auto& [figure, metric] : kAgreementFigures) {
+        scene_values[figure] = MetricValue(row.scene, metric);
+        log_values[figure] = MetricValue(*row.log, metric);
       }
       table.push_back({{"name", row.item.name}, {"scene", scene_values}, {"log", log_values}});
     }
