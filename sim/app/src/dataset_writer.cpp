@@ -201,14 +201,14 @@ std::string SceneConfigHash(const Scene& scene, std::uint64_t seed) {
                  {"sensor_model_sha256", io::Sha256OfFile(scene.sensor_model_file)}};
   json meshes = json::array();
   for (const MeshSpec& mesh : scene.meshes) {
-    meshes.push_back(mesh.file.empty() ? json(nullptr) : json(io::Sha256OfFile(mesh.file)));
+    meshes.push_back(mesh.file.path.empty() ? json(nullptr) : json(io::Sha256OfFile(mesh.file.path)));
   }
   inputs["mesh_files_sha256"] = meshes;
   // The vehicle's part files too (a scene without parts hashes as it always did).
   if (!scene.vehicle.empty()) {
     json parts = json::array();
     for (const MeshSpec& part : scene.vehicle) {
-      parts.push_back(part.file.empty() ? json(nullptr) : json(io::Sha256OfFile(part.file)));
+      parts.push_back(part.file.path.empty() ? json(nullptr) : json(io::Sha256OfFile(part.file.path)));
     }
     inputs["vehicle_files_sha256"] = parts;
   }
@@ -226,7 +226,7 @@ std::vector<std::string> SceneInputFiles(const Scene& scene) {
   files.insert(files.end(), scene.extends.begin(), scene.extends.end());
   for (const auto* list : {&scene.meshes, &scene.vehicle}) {
     for (const MeshSpec& mesh : *list) {
-      if (!mesh.file.empty()) files.push_back(mesh.file);
+      if (!mesh.file.path.empty()) files.push_back(mesh.file.path);
     }
   }
   return files;

@@ -17,6 +17,7 @@
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/report/images.hpp"
+#include "sonarbench/sim/report/map_report.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/report/report_page.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
@@ -171,15 +172,9 @@ SceneScore ScoreLogMap(const LogMapResult& result, const Scene& scene) {
 
 namespace {
 
-// report.html of a mapped log: what was mapped, the scores and criteria when scored, the images.
-std::string LogMapHtml(const LogMapResult& result, const Scene* scene,
-                       const std::vector<ReportImage>& images, const MapCells& cells) {
-  const Verdict* verdict = result.score ? &result.score->verdict : nullptr;
-  const std::string name = std::filesystem::path(result.input).filename().string();
+// report.html's lines before the criteria: what was mapped, the mapping, the scene, warnings.
+std::string LogMapIntroHtml(const LogMapResult& result, const Scene* scene, const MapCells& cells) {
   std::ostringstream html;
-  html << HtmlPageStart(
-      "sonarbench map: " + name + (verdict ? (verdict->passed ? " PASS" : " FAIL") : ""),
-      "sonarbench map: " + name + (scene ? " against " + scene->name : ""), verdict);
   const auto& t = result.totals;
   html << TableHtml("Log and map",
                     {{"input", result.input},
@@ -199,9 +194,6 @@ std::string LogMapHtml(const LogMapResult& result, const Scene* scene,
   for (const std::string& warning : result.warnings) {
     html << "<p class=\"acceptable\">" << XmlEscape(warning) << "</p>\n";
   }
-  if (verdict) html << CriteriaHtml(*verdict);
-  if (result.score) html << MetricsHtml(result.score->metrics);
-  html << ImagesHtmlAndEnd(images);
   return html.str();
 }
 
@@ -313,50 +305,32 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
   const std::string name = fs::path(result.input).filename().string();
   const bool scored = scene && result.score;
   MapCells cells;
-  std::vector<ReportImage> images =
-      WriteMapAndImages(dir, result, scored ? scene : nullptr, name, cells);
-  const bool certainty = scored && result.certainty;
-  if (certainty) images.push_back(CertaintyImage(*result.certainty, scene->name + ", " + name));
-  WriteReportImages(out_dir, images);
-  if (certainty) {
-    WriteFileAtomically((dir / "certainty.csv").string(),
-                        [&](std::ostream& out) { out << CertaintyCsv(*result.certainty); });
-  }
+  MapReport r;
+  r.images = WriteMapAndImages(dir, result, scored ? scene : nullptr, name, cells);
+  r.files = {"map.bt", "map.ot"};
+  r.json = LogMapReportJson(result, cells);
   if (scored) {
-    WriteFileAtomically((dir / "junit.xml").string(), [&](std::ostream& out) {
-      out << ScoredJunitXml(*scene, "map", result.input,
-                            {{"scene_file", scene->file}, {"input", result.input}},
-                            result.score->verdict, result.import_s + result.map_s);
-    });
+    r.scene = scene;
+    r.score = &*result.score;
+    r.junit = {"map",
+               result.input,
+               {{"scene_file", scene->file}, {"input", result.input}},
+               result.import_s + result.map_s};
+    r.json["outputs"]["junit"] = "junit.xml";
+    r.json["outputs"]["map_side"] = "map_side.png";
+    if (result.certainty) {
+      r.images.push_back(CertaintyImage(*result.certainty, scene->name + ", " + name));
+      WriteFileAtomically((dir / "certainty.csv").string(),
+                          [&](std::ostream& out) { out << CertaintyCsv(*result.certainty); });
+      r.files.push_back("certainty.csv");
+      r.json["outputs"]["certainty"] = {"certainty.csv", "certainty.png"};
+    }
   }
-  WriteFileAtomically((dir / "report.html").string(), [&](std::ostream& out) {
-    out << LogMapHtml(result, scored ? scene : nullptr, images, cells);
-  });
-  nlohmann::json report = LogMapReportJson(result, cells);
-  if (scored) {
-    report["outputs"]["junit"] = "junit.xml";
-    report["outputs"]["map_side"] = "map_side.png";
-  }
-  if (result.score) {
-    report["metrics"] = MetricsJson(result.score->metrics);
-    report["verdict"] = VerdictJson(result.score->verdict);
-    report["criteria"] = CriteriaJson(result.score->verdict);
-  }
-  if (!result.warnings.empty()) report["warnings"] = result.warnings;
-  std::vector<std::string> covered = kLogMapOutputFiles;
-  std::erase(covered, "report.json");
-  if (!scored) {
-    std::erase(covered, "junit.xml");
-    std::erase(covered, "map_side.png");
-  }
-  if (!certainty) {
-    std::erase(covered, "certainty.csv");
-    std::erase(covered, "certainty.png");
-  } else {
-    report["outputs"]["certainty"] = {"certainty.csv", "certainty.png"};
-  }
-  report["files_sha256"] = FilesSha256(out_dir, covered);
-  WriteJson((dir / "report.json").string(), report);
+  if (!result.warnings.empty()) r.json["warnings"] = result.warnings;
+  r.title = "sonarbench map: " + name;
+  r.heading = "sonarbench map: " + name + (scored ? " against " + scene->name : "");
+  r.intro_html = LogMapIntroHtml(result, scored ? scene : nullptr, cells);
+  WriteMapReport(out_dir, r);
 }
 
 }  // namespace sonarbench::sim

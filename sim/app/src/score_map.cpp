@@ -7,6 +7,7 @@
 
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/report/map_report.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/report/report_page.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
@@ -100,12 +101,9 @@ double TotalSeconds(const MapFileScore& s) {
   return s.read_s + s.score.ground_truth_s + s.score.score_s;
 }
 
-std::string ScoreHtml(const Scene& scene, const MapFileScore& s,
-                      const std::vector<ReportImage>& images) {
-  const Verdict& v = s.score.verdict;
+// report.html's lines before the criteria: the map, the scene, the frame check.
+std::string ScoreIntroHtml(const Scene& scene, const MapFileScore& s) {
   std::ostringstream html;
-  html << HtmlPageStart("sonarbench: " + scene.name + " " + (v.passed ? "PASS" : "FAIL"),
-                        "sonarbench score: " + scene.name, &v);
   html << "<p>Map <code>" << XmlEscape(s.map_file) << "</code> (." << s.file.format << ", "
        << s.file.resolution_m << " m cells, " << s.file.nodes << " nodes) against scene <code>"
        << XmlEscape(scene.file) << "</code>, sensor model <code>"
@@ -115,7 +113,6 @@ std::string ScoreHtml(const Scene& scene, const MapFileScore& s,
        << " of the map's occupied cells lie within the sonar's reach, the box "
        << Metres(s.reach_lo_m) << " to " << Metres(s.reach_hi_m) << " m (at least "
        << Percent(kMinOccupiedInReach) << " must).</p>\n";
-  html << CriteriaHtml(v) << MetricsHtml(s.score.metrics) << ImagesHtmlAndEnd(images);
   return html.str();
 }
 
@@ -159,20 +156,20 @@ MapFileScore ScoreMapFile(const std::string& map_file, const Scene& scene, const
 void WriteMapFileScoreOutputs(const std::string& out_dir, const Scene& scene,
                               const MapFileScore& s) {
   CreateOutputDirectory(out_dir);
-  const std::vector<ReportImage> images = MapTruthImages(
+  MapReport r;
+  r.title = "sonarbench: " + scene.name;
+  r.heading = "sonarbench score: " + scene.name;
+  r.intro_html = ScoreIntroHtml(scene, s);
+  r.images = MapTruthImages(
       *s.map, s.score.truth, s.score.observable, s.score.detector_ghosts, s.sonar_start_m,
       scene.name + ", " + std::filesystem::path(s.map_file).filename().string());
-  WriteReportImages(out_dir, images);
-  WriteFileAtomically(out_dir + "/junit.xml", [&](std::ostream& out) {
-    out << ScoredJunitXml(scene, "score", s.map_file,
-                          {{"scene_file", scene.file}, {"map_file", s.map_file}}, s.score.verdict,
-                          TotalSeconds(s));
-  });
-  WriteFileAtomically(out_dir + "/report.html",
-                      [&](std::ostream& out) { out << ScoreHtml(scene, s, images); });
-  nlohmann::json report = ReportHeader();
-  report["schema_version"] = kScenarioReportSchema;
-  report.update({{"scene", SceneJson(scene)},
+  r.scene = &scene;
+  r.score = &s.score;
+  r.junit = {
+      "score", s.map_file, {{"scene_file", scene.file}, {"map_file", s.map_file}}, TotalSeconds(s)};
+  r.json = ReportHeader();
+  r.json["schema_version"] = kScenarioReportSchema;
+  r.json.update({{"scene", SceneJson(scene)},
                  {"map",
                   {{"file", s.map_file},
                    {"format", s.file.format},
@@ -186,9 +183,6 @@ void WriteMapFileScoreOutputs(const std::string& out_dir, const Scene& scene,
                    {"occupied_in_reach", s.occupied_in_reach},
                    {"min_occupied_in_reach", kMinOccupiedInReach}}},
                  {"beams", ScenarioBeamCount(scene)},
-                 {"verdict", VerdictJson(s.score.verdict)},
-                 {"criteria", CriteriaJson(s.score.verdict)},
-                 {"metrics", MetricsJson(s.score.metrics)},
                  {"timing",
                   {{"read_s", s.read_s},
                    {"ground_truth_s", s.score.ground_truth_s},
@@ -199,10 +193,7 @@ void WriteMapFileScoreOutputs(const std::string& out_dir, const Scene& scene,
                    {"map_side", "map_side.png"},
                    {"junit", "junit.xml"},
                    {"html", "report.html"}}}});
-  std::vector<std::string> covered = kMapFileScoreOutputFiles;
-  std::erase(covered, "report.json");
-  report["files_sha256"] = FilesSha256(out_dir, covered);
-  WriteJson(out_dir + "/report.json", report);
+  WriteMapReport(out_dir, r);
 }
 
 }  // namespace sonarbench::sim

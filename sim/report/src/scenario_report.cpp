@@ -10,6 +10,7 @@
 #include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/sim/report/images.hpp"
+#include "sonarbench/sim/report/map_report.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/report/report_page.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
@@ -172,19 +173,19 @@ std::vector<ReportImage> RenderImages(const Scene& scene, const ScenarioResult& 
   return images;
 }
 
-std::string ScenarioHtml(const Scene& scene, const ScenarioResult& result,
-                         const std::vector<ReportImage>& images) {
-  const Verdict& v = result.score.verdict;
+// report.html's lines before the criteria, and the timing table after the metrics.
+std::string ScenarioIntroHtml(const Scene& scene, const ScenarioResult& result) {
   std::ostringstream html;
-  html << HtmlPageStart("sonarbench: " + scene.name + " " + (v.passed ? "PASS" : "FAIL"),
-                        "sonarbench scenario: " + scene.name, &v);
   html << "<p>Scene <code>" << XmlEscape(scene.file) << "</code>, sensor model <code>"
        << XmlEscape(scene.sensor_model_file) << "</code>, seed " << result.seed << ", "
        << result.beams << " beams in " << scene.sweeps << " sweeps, " << result.threads
        << (result.threads == 1 ? " thread, " : " threads, ")
        << Seconds(TotalSeconds(result.timings)) << " s.</p>\n";
-  html << CriteriaHtml(v) << MetricsHtml(result.score.metrics);
-  const StageTimings& t = result.timings;
+  return html.str();
+}
+
+std::string TimingHtml(const StageTimings& t) {
+  std::ostringstream html;
   html << "<h2>Timing</h2>\n<table><tr><th>stage</th><th>seconds</th></tr>\n";
   for (const auto& [stage, seconds] :
        {std::pair{"build scene", t.build_scene_s}, std::pair{"simulate", t.simulate_s},
@@ -192,12 +193,8 @@ std::string ScenarioHtml(const Scene& scene, const ScenarioResult& result,
         std::pair{"score", t.score_s}}) {
     html << "<tr><td>" << stage << "</td><td class=\"n\">" << Seconds(seconds) << "</td></tr>\n";
   }
-  html << "</table>\n" << ImagesHtmlAndEnd(images);
+  html << "</table>\n";
   return html.str();
-}
-
-void WriteText(const std::string& path, const std::string& text) {
-  WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
 }
 
 }  // namespace
@@ -307,14 +304,6 @@ nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& resu
   return report;
 }
 
-std::string ScenarioJunitXml(const Scene& scene, const ScenarioResult& result) {
-  return ScoredJunitXml(
-      scene, "scenario",
-      "seed " + std::to_string(result.seed) + ", " + std::to_string(result.beams) + " beams",
-      {{"scene_file", scene.file}, {"seed", std::to_string(result.seed)}}, result.score.verdict,
-      TotalSeconds(result.timings));
-}
-
 std::string ErrorJunitXml(std::string_view scenario, std::string_view error_type,
                           std::string_view message) {
   const std::string suite = XmlEscape(scenario);
@@ -331,20 +320,24 @@ std::string ErrorJunitXml(std::string_view scenario, std::string_view error_type
 
 void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
                           const ScenarioResult& result) {
-  namespace fs = std::filesystem;
   CreateOutputDirectory(out_dir);
-  const fs::path dir(out_dir);
-  result.mapper->WriteBinary((dir / "map.bt").string());
-  const std::vector<ReportImage> images = RenderImages(scene, result);
-  WriteReportImages(out_dir, images);
-  WriteText((dir / "junit.xml").string(), ScenarioJunitXml(scene, result));
-  WriteText((dir / "report.html").string(), ScenarioHtml(scene, result, images));
-  // The report last, naming what it covers.
-  nlohmann::json report = ScenarioReportJson(scene, result);
-  std::vector<std::string> covered = kScenarioOutputFiles;
-  std::erase(covered, "report.json");
-  report["files_sha256"] = FilesSha256(out_dir, covered);
-  WriteJson((dir / "report.json").string(), report);
+  result.mapper->WriteBinary(out_dir + "/map.bt");
+  MapReport report;
+  report.title = "sonarbench: " + scene.name;
+  report.heading = "sonarbench scenario: " + scene.name;
+  report.intro_html = ScenarioIntroHtml(scene, result);
+  report.after_scores_html = TimingHtml(result.timings);
+  report.images = RenderImages(scene, result);
+  report.json = ScenarioReportJson(scene, result);
+  report.files = {"map.bt"};
+  report.scene = &scene;
+  report.score = &result.score;
+  report.junit = {
+      "scenario",
+      "seed " + std::to_string(result.seed) + ", " + std::to_string(result.beams) + " beams",
+      {{"scene_file", scene.file}, {"seed", std::to_string(result.seed)}},
+      TotalSeconds(result.timings)};
+  WriteMapReport(out_dir, report);
 }
 
 std::string XmlEscape(std::string_view text) {

@@ -35,25 +35,25 @@ MeshEstimate EstimateMesh(const MeshSpec& spec) {
       break;
     case MeshSpec::Type::kHeightField:
       // As BuildMesh grids it: at least one cell each way.
-      e = {2 * std::max(1.0, s[0] / spec.cell_m) * std::max(1.0, s[1] / spec.cell_m), s[0] * s[1],
+      e = {2 * std::max(1.0, s[0] / spec.height_field.cell_m) * std::max(1.0, s[1] / spec.height_field.cell_m), s[0] * s[1],
            0, "cell_m"};
       break;
     case MeshSpec::Type::kFile: {
-      e.triangles = static_cast<double>(spec.file_triangles.size());
+      e.triangles = static_cast<double>(spec.file.triangles.size());
       e.key = "scale";
-      const Eigen::Vector3d scale(spec.scale[0], spec.scale[1], spec.scale[2]);
+      const Eigen::Vector3d scale(spec.file.scale[0], spec.file.scale[1], spec.file.scale[2]);
       Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL);
       Eigen::Vector3d hi = -lo;
       // A vertex that is not finite is CheckMesh's to refuse, with its own message.
-      for (const auto& v : spec.file_vertices) {
+      for (const auto& v : spec.file.vertices) {
         if (!v.allFinite()) continue;
         lo = lo.cwiseMin(scale.cwiseProduct(v));
         hi = hi.cwiseMax(scale.cwiseProduct(v));
       }
-      for (const auto& t : spec.file_triangles) {
-        const Eigen::Vector3d a = scale.cwiseProduct(spec.file_vertices[t[0]]);
-        const Eigen::Vector3d b = scale.cwiseProduct(spec.file_vertices[t[1]]);
-        const Eigen::Vector3d c = scale.cwiseProduct(spec.file_vertices[t[2]]);
+      for (const auto& t : spec.file.triangles) {
+        const Eigen::Vector3d a = scale.cwiseProduct(spec.file.vertices[t[0]]);
+        const Eigen::Vector3d b = scale.cwiseProduct(spec.file.vertices[t[1]]);
+        const Eigen::Vector3d c = scale.cwiseProduct(spec.file.vertices[t[2]]);
         const double area = 0.5 * (b - a).cross(c - a).norm();
         if (!std::isnan(area)) e.area_m2 += area;
       }

@@ -42,9 +42,9 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
       node.Ignore(key);
     }
   } else if (m.type == MeshSpec::Type::kFile) {
-    node.Required("file", m.file, NonEmpty());
-    m.file_where = node.WhereOf("file");
-    node.Optional("scale", m.scale,
+    node.Required("file", m.file.path, NonEmpty());
+    m.file.where = node.WhereOf("file");
+    node.Optional("scale", m.file.scale,
                   YamlReader::Check<std::array<double, 3>>(
                       [](const std::array<double, 3>& s) -> std::optional<std::string> {
                         if (s[0] > 0 && s[1] > 0 && s[2] > 0) return std::nullopt;
@@ -60,10 +60,10 @@ MeshSpec ReadMesh(YamlReader& node, const std::vector<Material>& materials) {
   }
   m.T_world_mesh = ReadPose(node);
   if (m.type == MeshSpec::Type::kHeightField) {
-    node.Required("cell_m", m.cell_m, Positive());
-    node.Optional("amplitude_m", m.amplitude_m, NonNegative());
-    node.Optional("wavelength_m", m.wavelength_m, Positive());
-    node.Optional("roughness_m", m.roughness_m, NonNegative());
+    node.Required("cell_m", m.height_field.cell_m, Positive());
+    node.Optional("amplitude_m", m.height_field.amplitude_m, NonNegative());
+    node.Optional("wavelength_m", m.height_field.wavelength_m, Positive());
+    node.Optional("roughness_m", m.height_field.roughness_m, NonNegative());
   }
   node.Optional("fill", m.fill);
   node.Optional("truth", m.truth);
@@ -315,14 +315,14 @@ void LoadMeshFiles(const YamlReader& root, std::vector<MeshSpec>& meshes, std::s
   for (std::size_t i = first; i < meshes.size(); ++i) {
     MeshSpec& mesh = meshes[i];
     if (mesh.type != MeshSpec::Type::kFile) continue;
-    mesh.file = Resolve(root, mesh.file);
+    mesh.file.path = Resolve(root, mesh.file.path);
     try {
-      MeshFileData data = LoadMeshFile(mesh.file, max_triangles);
-      mesh.file_vertices = std::move(data.vertices);
-      mesh.file_triangles = std::move(data.triangles);
+      MeshFileData data = LoadMeshFile(mesh.file.path, max_triangles);
+      mesh.file.vertices = std::move(data.vertices);
+      mesh.file.triangles = std::move(data.triangles);
     } catch (const InputError& e) {
-      errors.push_back(mesh.file_where + ": mesh '" + mesh.name + "': " + e.what() +
-                       WhereLooked(mesh.file));
+      errors.push_back(mesh.file.where + ": mesh '" + mesh.name + "': " + e.what() +
+                       WhereLooked(mesh.file.path));
     }
   }
 }

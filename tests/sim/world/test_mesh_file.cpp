@@ -36,9 +36,9 @@ TriangleMesh AsMesh(const MeshFileData& data, const std::array<double, 3>& scale
                     const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity()) {
   MeshSpec spec;
   spec.type = MeshSpec::Type::kFile;
-  spec.file_vertices = data.vertices;
-  spec.file_triangles = data.triangles;
-  spec.scale = scale;
+  spec.file.vertices = data.vertices;
+  spec.file.triangles = data.triangles;
+  spec.file.scale = scale;
   spec.T_world_mesh = pose;
   return BuildMesh(spec, 0);
 }

@@ -417,7 +417,7 @@ TEST(SceneFile, PathsResolveBesideTheSceneThenInSonarbenchsFolder) {
       "trajectory: {type: static, position_m: [0, 0, 1]}\n");
   const sim::Scene scene = sim::LoadScene(ok);
   EXPECT_EQ(scene.sensor_model_file, test::SourcePath("sensor-models/shad-micron.yaml"));
-  EXPECT_EQ(scene.meshes[0].file, test::SourcePath("scenes/meshes/rock.obj"));
+  EXPECT_EQ(scene.meshes[0].file.path, test::SourcePath("scenes/meshes/rock.obj"));
   const std::string bad =
       test::WriteFile(dir, "bad.yaml",
                       "name: s\nsensor_model: models/none.yaml\nsweeps: 1\n"

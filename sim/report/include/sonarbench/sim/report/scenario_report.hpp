@@ -33,11 +33,6 @@ inline constexpr int kScenarioReportSchema = 2;
 /// expected and margin, the verdict, mapping totals and stage timings.
 [[nodiscard]] nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& result);
 
-/// JUnit XML of a run: one test suite per scenario, a test case for the run itself (it fails when
-/// an `expect: fail` scenario passes) and one per criterion (a <failure> when a required criterion
-/// missed its bound; optional and "acceptable" ones pass with the reason in <system-out>).
-[[nodiscard]] std::string ScenarioJunitXml(const Scene& scene, const ScenarioResult& result);
-
 /// JUnit XML for a run that broke before it produced a result: one test case with an <error>
 /// (type "input_error" for bad input, "internal_error" for a bug or the environment).
 [[nodiscard]] std::string ErrorJunitXml(std::string_view scenario, std::string_view error_type,

@@ -43,6 +43,26 @@ struct Material {
   bool operator==(const Material&) const = default;
 };
 
+/// A height field's relief: height = amplitude·sin(2πx/λ)·cos(2πy/λ) plus a seeded random
+/// roughness of the given standard deviation, on a grid of `cell_m` [m].
+struct HeightFieldSpec {
+  double cell_m = 0.1;
+  double amplitude_m = 0.0;
+  double wavelength_m = 5.0;
+  double roughness_m = 0.0;
+};
+
+/// A mesh file: its path (resolved as ResolveScenePath does), where the scene names it
+/// ("FILE:LINE:COLUMN", for messages), the scale applied to its coordinates along its own x, y, z
+/// before the pose, and its triangles as loaded.
+struct MeshFileSpec {
+  std::string path;
+  std::string where;
+  std::array<double, 3> scale{1, 1, 1};
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
 /// A mesh, as the scene file describes it: procedural, or loaded from a mesh file.
 struct MeshSpec {
   enum class Type { kTank, kBox, kPlane, kHeightField, kFile };
@@ -54,20 +74,8 @@ struct MeshSpec {
   /// Pose of the mesh frame in the world. kTank: centre of the floor; kBox: centre;
   /// kPlane: centre, normal along the frame's z; kHeightField: centre at height 0.
   Eigen::Isometry3d T_world_mesh = Eigen::Isometry3d::Identity();
-  /// kHeightField: grid spacing [m], and relief: height = amplitude·sin(2πx/λ)·cos(2πy/λ) plus a
-  /// seeded random roughness of the given standard deviation.
-  double cell_m = 0.1;
-  double amplitude_m = 0.0;
-  double wavelength_m = 5.0;
-  double roughness_m = 0.0;
-  /// kFile: the mesh file (resolved as ResolveScenePath does), where the scene names it
-  /// ("FILE:LINE:COLUMN", for messages), the scale applied to its coordinates along its own x,
-  /// y, z before the pose, and its triangles as loaded.
-  std::string file;
-  std::string file_where;
-  std::array<double, 3> scale{1, 1, 1};
-  std::vector<Eigen::Vector3d> file_vertices;
-  std::vector<std::array<std::uint32_t, 3>> file_triangles;
+  HeightFieldSpec height_field;  ///< kHeightField
+  MeshFileSpec file;             ///< kFile
   std::size_t material = 0;
   /// Count the cells inside the (closed) mesh as occupied truth, not only its surface.
   bool fill = false;
