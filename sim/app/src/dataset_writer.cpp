@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "sonarbench/io/files.hpp"
+#include "sonarbench/io/labels.hpp"
 #include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
@@ -33,6 +34,13 @@ using nlohmann::json;
 // Present while a dataset is being written; holds the configuration's hash so a rerun knows
 // whether the sweeps on disk are its own.
 constexpr const char* kPartialMarker = ".sonarbench-partial.json";
+
+// Sweep `sweep`'s label file: "truth/labels_0012.bin".
+std::string LabelFile(std::size_t sweep) {
+  char name[48];
+  std::snprintf(name, sizeof name, "truth/labels_%04zu.bin", sweep);
+  return name;
+}
 
 void WriteText(const fs::path& path, const std::string& text) {
   WriteFileAtomically(path.string(), [&](std::ostream& out) { out << text; });
@@ -73,6 +81,7 @@ OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sw
     claim.files.push_back(io::SweepFile("beams", s, "bin"));
     claim.files.push_back(io::SweepFile("images", s, "png"));
     if (simulated) claim.files.push_back(io::SweepFile("truth", s, "csv"));
+    if (simulated) claim.files.push_back(LabelFile(s));
   }
   claim.record = "manifest.json";
   claim.force = force;
@@ -154,7 +163,8 @@ void WriteBeams(const fs::path& path, std::span<const mapping::Beam> beams) {
 bool SweepComplete(const fs::path& root, std::size_t sweep, bool with_truth) {
   return fs::is_regular_file(root / io::SweepFile("beams", sweep, "bin")) &&
          fs::is_regular_file(root / io::SweepFile("images", sweep, "png")) &&
-         (!with_truth || fs::is_regular_file(root / io::SweepFile("truth", sweep, "csv")));
+         (!with_truth || (fs::is_regular_file(root / io::SweepFile("truth", sweep, "csv")) &&
+                          fs::is_regular_file(root / LabelFile(sweep))));
 }
 
 std::string TruthCsv(std::span<const SynthesizedBeam> beams, std::size_t first_index,
@@ -175,6 +185,27 @@ std::string TruthCsv(std::span<const SynthesizedBeam> beams, std::size_t first_i
     csv += "\n";
   }
   return csv;
+}
+
+// A sweep's labels as the label file holds them: each bin's shares, mesh and point.
+std::vector<io::BeamLabels> LabelsOf(std::span<const SynthesizedBeam> beams) {
+  std::vector<io::BeamLabels> out(beams.size());
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    const std::vector<BinLabel>& bins = beams[b].labels;
+    io::BeamLabels& labels = out[b];
+    labels.shares.reserve(bins.size());
+    for (const BinLabel& bin : bins) {
+      if (bin.mesh != kNoMesh && bin.mesh >= io::kNoLabelMesh) {
+        throw InputError("the label files number meshes in 16 bits: a scene of at most " +
+                         std::to_string(io::kNoLabelMesh) + " meshes");
+      }
+      labels.shares.push_back(io::ShareOf(bin.energy));
+      labels.mesh.push_back(bin.mesh == kNoMesh ? io::kNoLabelMesh
+                                                : static_cast<std::uint16_t>(bin.mesh));
+      labels.point_sonar_m.push_back(bin.point_sonar_m);
+    }
+  }
+  return out;
 }
 
 void WriteTruthOccupancy(const fs::path& path, const std::vector<TriangleMesh>& meshes,
@@ -318,6 +349,10 @@ json SimulatedManifest(const Scene& scene, const DatasetSummary& summary, std::u
        "truth/sweep_NNNN.csv: beam, time_s, head_angle_rad, first_hit_range_m "
        "(nearest surface any ray of the beam's main lobe hit), first_hit_mesh, "
        "axis_hit_range_m; empty when nothing within range"},
+      {"labels",
+       "truth/labels_NNNN.bin: per bin, each echo path's share of its power, the mesh that "
+       "answers it directly and that mesh's strongest return's point (docs/dataset-format.md)"},
+      {"paths", kEchoPathNames},
       {"occupancy", "truth/occupancy.bt: every cell a mesh surface crosses, at resolution_m"},
       {"resolution_m", scene.mapping.resolution_m}};
   json mesh_names = json::array();
@@ -363,10 +398,12 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
     } else {
       const std::size_t first = s * per_sweep;
       const auto synthesized = SimulateBeams(scene, synthesizer, seed, options.threads, first,
-                                             std::min(beam_count, first + per_sweep));
+                                             std::min(beam_count, first + per_sweep),
+                                             Labels::kKeep);
       const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
       WriteBeams(root / io::SweepFile("beams", s, "bin"), beams);
       WriteText(root / io::SweepFile("truth", s, "csv"), TruthCsv(synthesized, first, scene));
+      io::WriteLabelFile((root / LabelFile(s)).string(), LabelsOf(synthesized));
       WritePolarImage((root / io::SweepFile("images", s, "png")).string(), beams,
                       scene.name + ", seed " + std::to_string(seed) + ": sweep " +
                           std::to_string(s) + ", polar");

@@ -123,6 +123,26 @@ struct OneWayPattern {
   }
 };
 
+// A direct return of the main lobe, for the labels: its range [m], its power after the range
+// loss, its mesh and its ray's direction (world frame).
+struct DirectReturn {
+  double range = 0.0;
+  double power = 0.0;
+  std::uint32_t mesh = 0;
+  Eigen::Vector3f direction;
+};
+
+// The labels' working memory (Labels::kKeep): the scene's echoes by path (direct, sidelobe,
+// multipath), the main lobe's direct returns, each path's power per bin, each bin's receiver
+// noise, and the direct power per bin and scene mesh (bin-major).
+struct LabelScratch {
+  std::array<PulseSpreader, 3> spreaders;
+  std::vector<DirectReturn> direct_returns;
+  std::array<std::vector<double>, kEchoPaths> power;
+  std::vector<double> before;
+  std::vector<double> mesh_power;
+};
+
 // Synthesize()'s working memory, one per thread, kept between beams: a beam allocates only its
 // output.
 struct BeamSynthesizer::Scratch {
@@ -146,6 +166,7 @@ struct BeamSynthesizer::Scratch {
   std::vector<double> powers;
   std::vector<double> self_reflection;
   std::vector<std::uint64_t> sector_seeds;
+  LabelScratch labels;
 };
 
 // One beam's synthesis: what its steps share, each step a method. Synthesize() runs them in
@@ -154,7 +175,7 @@ class BeamSynthesizer::BeamJob {
  public:
   BeamJob(const BeamSynthesizer& synthesizer, double head_angle_rad,
           const Eigen::Isometry3d& T_world_sonar, std::uint64_t seed, Scratch& scratch,
-          SynthesizedBeam& out)
+          SynthesizedBeam& out, Labels labels)
       : s_(synthesizer),
         g_(synthesizer.sensor_.geometry),
         a_(synthesizer.sensor_.acoustics),
@@ -175,6 +196,7 @@ class BeamSynthesizer::BeamJob {
     }
     if (HasSecondTrip(a_)) scratch_.impulse_power.assign(bins_, 0.0);
     scratch_.echo_power.assign(bins_, 0.0);
+    if (labels == Labels::kKeep) StartLabels();
   }
 
   // The echo's own randomness (ray jitter, speckle) is the ping's, or, with a correlation
@@ -195,6 +217,17 @@ class BeamSynthesizer::BeamJob {
   void FormLevels(EchoPower echo_power);
 
  private:
+  // The labels' steps (bin_labels.cpp): their scratch readied; the direct and sidelobe paths'
+  // powers; the power a step adds (`scratch_.labels.before` taken before it) as `path`'s; and
+  // each bin's label from the paths, the speckle, the self-reflection and the noise.
+  void StartLabels();
+  void LabelScenePaths();
+  void LabelAdded(EchoPath path);
+  void FinishLabels(std::span<const double> self_reflection);
+  [[nodiscard]] std::vector<double>& LabelPower(EchoPath path) {
+    return scratch_.labels.power[static_cast<std::size_t>(path)];
+  }
+
   // TraceMultipath's steps: each path mirrored on and traced to its next hit; the echoes heard
   // back along the mirrors, the straight returns collected; those not occluded heard.
   void MirrorPaths();
@@ -225,6 +258,11 @@ class BeamSynthesizer::BeamJob {
     return {s_.receiver_,          g_, a_.pulse.length_m, false, scratch_.vehicle_spreader,
             scratch_.impulse_power};
   }
+  // The labels' echoes of one path (0 direct, 1 sidelobe, 2 multipath): the pulse alone.
+  EchoDeposit PathDeposit(std::size_t path) {
+    return {s_.receiver_,          g_, a_.pulse.length_m, false, scratch_.labels.spreaders[path],
+            scratch_.impulse_power};
+  }
   // The scene's glints: the pulse and its skirts, no second trip or reverberation (FormLevels).
   EchoDeposit GlintDeposit() {
     return {s_.receiver_,          g_, a_.pulse.length_m, false, scratch_.glint_spreader,
@@ -248,6 +286,8 @@ class BeamSynthesizer::BeamJob {
   Rng* echo_rng_ = &rng_;
   // The primary rays' pattern weights' sum (TracePrimaries()).
   double weight_sum_ = 0.0;
+  // Whether the beam carries its bins' labels.
+  bool labels_ = false;
 };
 
 }  // namespace sonarbench::sim

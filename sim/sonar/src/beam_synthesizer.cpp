@@ -119,6 +119,8 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
   EchoDeposit deposit = Deposit();
   EchoDeposit vehicle_deposit = VehicleDeposit();
   EchoDeposit glint_deposit = GlintDeposit();
+  EchoDeposit direct_deposit = PathDeposit(0);
+  EchoDeposit sidelobe_deposit = PathDeposit(1);
   for (std::size_t r = 0; r < rays; ++r) {
     const auto& hit = hits[r];
     if (!hit) continue;
@@ -142,6 +144,14 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
     } else {
       deposit(range, diffuse);
       if (glint > 0.0) glint_deposit(range, glint);
+      if (labels_ && r < main_lobe_rays) {
+        direct_deposit(range, diffuse + glint);
+        scratch_.labels.direct_returns.push_back(
+            {range, (diffuse + glint) * s_.receiver_.RangeLossFromTable(range), hit->mesh,
+             direction});
+      } else if (labels_) {
+        sidelobe_deposit(range, diffuse + glint);
+      }
     }
     if (a_.max_bounces > 0 && material.specular > 0.0 && !on_vehicle) {
       paths.push_back({.from = origin_,
@@ -182,12 +192,17 @@ void BeamSynthesizer::BeamJob::SumEchoes() {
   scratch_.spreader.AddTo(echo);
   for (double& power : echo) power /= weight_sum_;
   AddPulseSkirts(s_.sensor_, echo);
+  if (labels_) LabelScenePaths();
   if (HasSecondTrip(a_)) {
     for (double& power : scratch_.impulse_power) power /= weight_sum_;
+    if (labels_) scratch_.labels.before = echo;
     AddSecondTrip(s_.sensor_, s_.receiver_, echo, scratch_.impulse_power);
+    if (labels_) LabelAdded(EchoPath::kSecondTrip);
   }
   DrawSpeckle();
+  if (labels_) scratch_.labels.before = echo;
   AddReverberation(s_.sensor_, echo);
+  if (labels_) LabelAdded(EchoPath::kReverberation);
   // A glint is the sonar's mirror image, sound that came straight back: it has the pulse's
   // skirts like any echo, but feeds no reverberation and no second trip (the real tank is quiet
   // behind walls met squarely: docs/fidelity.md, behind the walls).
@@ -195,7 +210,11 @@ void BeamSynthesizer::BeamJob::SumEchoes() {
   // The vehicle's echoes are heard as they are: the real log's show no skirts, second trip or
   // reverberation (behind the SHAD's own echo at 0.3 m its beams at head angle 0° are silent
   // from 0.55 m to the floor at 1.45 m), so those are the tank's answers to its own echoes.
-  if (s_.vehicle_tracer_) AddApart(scratch_.vehicle_spreader, false);
+  if (s_.vehicle_tracer_) {
+    if (labels_) scratch_.labels.before = echo;
+    AddApart(scratch_.vehicle_spreader, false);
+    if (labels_) LabelAdded(EchoPath::kVehicle);
+  }
 }
 
 // Echoes heard apart from the scene's diffuse ones, after its second trip and reverberation: a
@@ -237,15 +256,19 @@ void BeamSynthesizer::BeamJob::DrawPowers() {
     double signal = gain * echo[k];
     if (a_.speckle.on) signal *= speckle[k];
     if (k < self_reflection.size()) signal += self_reflection[k];
-    powers[k] = signal + noise_at_bin[k] * rng_.Exponential();
+    const double noise = noise_at_bin[k] * rng_.Exponential();
+    powers[k] = signal + noise;
+    if (labels_) LabelPower(EchoPath::kNoise)[k] = noise;
   }
+  if (labels_) FinishLabels(self_reflection);
   // The receiver's level jitter, the ping's whatever the echoes are.
   s_.receiver_.Jitter(powers, rng_);
 }
 
 SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad,
                                             const Eigen::Isometry3d& T_world_sonar,
-                                            std::uint64_t seed, EchoPower echo_power) const {
+                                            std::uint64_t seed, EchoPower echo_power,
+                                            Labels labels) const {
   SynthesizedBeam out;
   out.beam.time_s = time_s;
   out.beam.head_angle_rad = head_angle_rad;
@@ -253,7 +276,7 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   out.truth.T_world_sonar = T_world_sonar;
   out.beam.bin_size_m = sensor_.geometry.bin_size_m;
   thread_local Scratch scratch;
-  BeamJob job(*this, head_angle_rad, T_world_sonar, seed, scratch, out);
+  BeamJob job(*this, head_angle_rad, T_world_sonar, seed, scratch, out, labels);
   job.SeedPlace();
   job.TracePrimaries();
   job.TraceMultipath();

@@ -127,6 +127,7 @@ void BeamSynthesizer::BeamJob::HearMirrorPaths(const OneWayPattern& one_way_patt
   const double max_range = max_range_;
   EchoDeposit deposit = Deposit();
   EchoDeposit glint_deposit = GlintDeposit();
+  EchoDeposit label_deposit = PathDeposit(2);
   std::vector<MirrorPath>& paths = scratch_.paths;
   const std::vector<MirrorPath>& next_paths = scratch_.next_paths;
   const std::vector<std::optional<Hit>>& hits = scratch_.hits;
@@ -145,10 +146,11 @@ void BeamSynthesizer::BeamJob::HearMirrorPaths(const OneWayPattern& one_way_patt
     const double cos_in = std::abs(hit.normal.dot(was.direction));
     if (path <= max_range) {
       const double way = ReturnPattern(p, one_way_pattern) * was.specular * was.specular;
-      deposit(path, way * m.reflectivity * CosPower(cos_in, m.backscatter_exponent));
-      if (const double glint = way * Glint(m, 2.0 * cos_in * cos_in - 1.0); glint > 0.0) {
-        glint_deposit(path, glint);
-      }
+      const double diffuse = way * m.reflectivity * CosPower(cos_in, m.backscatter_exponent);
+      deposit(path, diffuse);
+      const double glint = way * Glint(m, 2.0 * cos_in * cos_in - 1.0);
+      if (glint > 0.0) glint_deposit(path, glint);
+      if (labels_) label_deposit(path, diffuse + glint);
     }
     QueueStraightReturn(was, hit, m, path, cos_in, one_way_pattern);
   }
@@ -196,6 +198,7 @@ void BeamSynthesizer::BeamJob::QueueStraightReturn(const MirrorPath& was, const 
 void BeamSynthesizer::BeamJob::HearStraightReturns() {
   EchoDeposit deposit = Deposit();
   EchoDeposit glint_deposit = GlintDeposit();
+  EchoDeposit label_deposit = PathDeposit(2);
   const std::vector<StraightReturn>& returns = scratch_.returns;
   s_.tracer_.OccludedStream(scratch_.rays, scratch_.occluded);
   out_.traced_rays += scratch_.rays.size();
@@ -203,6 +206,7 @@ void BeamSynthesizer::BeamJob::HearStraightReturns() {
     if (scratch_.occluded[q]) continue;
     deposit(returns[q].range, returns[q].weight);
     if (returns[q].glint > 0.0) glint_deposit(returns[q].range, returns[q].glint);
+    if (labels_) label_deposit(returns[q].range, returns[q].weight + returns[q].glint);
   }
 }
 

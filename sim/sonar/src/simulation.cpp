@@ -61,7 +61,7 @@ BeamSynthesizer SceneSynthesizer(const Scene& scene, const RayTracer& tracer, st
 
 std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const BeamSynthesizer& synthesizer,
                                            std::uint64_t seed, int threads, std::size_t first,
-                                           std::size_t last) {
+                                           std::size_t last, Labels labels) {
   if (first > last) {
     throw std::invalid_argument("SimulateBeams: beams [" + std::to_string(first) + ", " +
                                 std::to_string(last) + ") run backwards");
@@ -74,7 +74,7 @@ std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const BeamSynthes
     const ScheduledBeam s = ScheduleBeam(scene, index);
     SynthesizedBeam& out = beams[static_cast<std::size_t>(b)];
     out = synthesizer.Synthesize(s.time_s, s.pose.head_angle_rad, s.pose.T_world_sonar,
-                                 DeriveSeed(seed, index), EchoPower::kDrop);
+                                 DeriveSeed(seed, index), EchoPower::kDrop, labels);
     out.beam.T_world_sonar = ReportedSonarPose(scene, index, s.time_s, seed);
   }
   return beams;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/labels.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
@@ -104,9 +105,9 @@ TEST_F(TankDataset, ReadsBackTheSimulatedBeamsAndPoses) {
   EXPECT_EQ(dataset.manifest["seed"], scene_->seed);
   EXPECT_EQ(dataset.sweeps, 3u);
   EXPECT_EQ(dataset.sensor.num_bins, scene_->sensor.geometry.num_bins);
-  // Every file but the manifest is listed with its hash: beams, images and truth per sweep, three
-  // pose files and the truth occupancy.
-  EXPECT_EQ(dataset.manifest["files"].size(), 3u * 3u + 3u + 1u);
+  // Every file but the manifest is listed with its hash: beams, images, truth and labels per
+  // sweep, three pose files and the truth occupancy.
+  EXPECT_EQ(dataset.manifest["files"].size(), 3u * 4u + 3u + 1u);
   EXPECT_FALSE(fs::exists(out / ".sonarbench-partial.json"));
 
   const auto meshes = sim::BuildSceneMeshes(*scene_);
@@ -141,6 +142,29 @@ TEST_F(TankDataset, ReadsBackTheSimulatedBeamsAndPoses) {
   EXPECT_GE(std::stod(f[3]), height / std::sin(edge) - 1e-6);
   EXPECT_LE(std::stod(f[3]), height / std::sin(edge - 35.0 / 160 * M_PI / 180));
   EXPECT_NEAR(std::stod(f[5]), (4.36 / 2 + 0.10) / -std::cos(head), 1e-5);
+
+  // Its labels: the synthesiser's, each bin's shares in 255ths, the meshes and points kept.
+  const std::vector<io::BeamLabels> labels =
+      io::ReadLabelFile((out / "truth/labels_0001.bin").string());
+  ASSERT_EQ(labels.size(), 200u);
+  const sim::BeamSynthesizer synthesizer = sim::SceneSynthesizer(*scene_, tracer, scene_->seed);
+  const auto beam = sim::SimulateBeams(*scene_, synthesizer, scene_->seed, 1, 388, 389,
+                                       sim::Labels::kKeep);
+  const io::BeamLabels& read = labels[188];
+  ASSERT_EQ(read.shares.size(), beam[0].labels.size());
+  std::size_t direct_bins = 0;
+  for (std::size_t k = 0; k < read.shares.size(); ++k) {
+    const sim::BinLabel& bin = beam[0].labels[k];
+    EXPECT_EQ(read.shares[k], io::ShareOf(bin.energy)) << k;
+    if (bin.mesh == sim::kNoMesh) {
+      EXPECT_EQ(read.mesh[k], io::kNoLabelMesh) << k;
+      continue;
+    }
+    ++direct_bins;
+    EXPECT_EQ(read.mesh[k], bin.mesh) << k;
+    EXPECT_EQ(read.point_sonar_m[k], bin.point_sonar_m) << k;
+  }
+  EXPECT_GT(direct_bins, 10u);
 }
 
 TEST_F(TankDataset, ShardsAndResumedRunsGiveTheSameBytesAsOneRun) {
@@ -150,7 +174,8 @@ TEST_F(TankDataset, ShardsAndResumedRunsGiveTheSameBytesAsOneRun) {
   (void)sim::SimulateDataset(*scene_, whole.string(), {});
 
   sim::DatasetOptions first;
-  first.shard = {0, 2};  // sweeps 0 and 2
+  first.shard = {0, 2};  // sweeps 0 and 2, on one thread
+  first.threads = 1;
   const auto partial = sim::SimulateDataset(*scene_, split.string(), first);
   EXPECT_FALSE(partial.complete);
   EXPECT_EQ(partial.sweeps_written, 2u);

@@ -10,6 +10,7 @@
 
 #include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/sim/sonar/beam_pattern.hpp"
+#include "sonarbench/sim/sonar/bin_labels.hpp"
 #include "sonarbench/sim/sonar/multipath.hpp"
 #include "sonarbench/sim/sonar/receiver.hpp"
 #include "sonarbench/sim/sonar/self_reflection.hpp"
@@ -39,6 +40,8 @@ struct SynthesizedBeam {
   /// Noise-free echo power per bin [linear, relative to a perfect reflector at 1 m]; empty
   /// unless asked for (EchoPower::kKeep).
   std::vector<double> echo_power;
+  /// Each bin's truth (BinLabel); empty unless asked for (Labels::kKeep).
+  std::vector<BinLabel> labels;
   /// Rays traced for it: primaries (and their vehicle's parts' bundle), mirrored rays,
   /// occlusion rays and the axis's ray for the truth (for speed reports).
   std::size_t traced_rays = 0;
@@ -47,6 +50,9 @@ struct SynthesizedBeam {
 /// Whether a synthesised beam carries its noise-free echo power (for tests and studies of the
 /// echo itself). A scenario's beams drop it: 8 bytes per bin that nothing downstream reads.
 enum class EchoPower { kKeep, kDrop };
+
+/// Whether a synthesised beam carries its bins' truth (BinLabel): a dataset's labels.
+enum class Labels { kKeep, kDrop };
 
 /// Parts of the vehicle the sonar hears (Scene::vehicle): its meshes in the vehicle's body
 /// frame, where the sonar sits at the sensor's T_vehicle_sonar, and each one's material
@@ -77,11 +83,12 @@ class BeamSynthesizer {
   /// One beam at head angle `head_angle_rad` from a sonar at `T_world_sonar`. `seed` drives its
   /// background noise and, unless the acoustics' speckle_correlation_m is set (then the run seed
   /// and the place do), its ray jitter and speckle. The beam's bytes do not depend on
-  /// `echo_power`.
+  /// `echo_power` or `labels`.
   [[nodiscard]] SynthesizedBeam Synthesize(double time_s, double head_angle_rad,
                                            const Eigen::Isometry3d& T_world_sonar,
                                            std::uint64_t seed,
-                                           EchoPower echo_power = EchoPower::kKeep) const;
+                                           EchoPower echo_power = EchoPower::kKeep,
+                                           Labels labels = Labels::kDrop) const;
 
   /// The vehicle parts' BVH, in the vehicle's frame, or null without parts (for recording its
   /// queries: RayTracer::Record).

@@ -48,11 +48,12 @@ struct ScheduledBeam {
 /// Synthesises beams [first, last) of the scene's run with `synthesizer` (SceneSynthesizer of
 /// the same scene and seed), on `threads` threads (0 = all); beam b draws only from
 /// DeriveSeed(seed, b), so any split of a run gives the same beams. Their echo power is dropped
-/// (EchoPower::kDrop).
+/// (EchoPower::kDrop); their bins' labels kept with Labels::kKeep.
 [[nodiscard]] std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene,
                                                          const BeamSynthesizer& synthesizer,
                                                          std::uint64_t seed, int threads,
-                                                         std::size_t first, std::size_t last);
+                                                         std::size_t first, std::size_t last,
+                                                         Labels labels = Labels::kDrop);
 
 /// The beams alone, as the mapper takes them.
 [[nodiscard]] std::vector<mapping::Beam> BeamsOf(std::span<const SynthesizedBeam> synthesized);

@@ -1,0 +1,54 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sonarbench::io {
+
+/// The paths a range bin's echo energy arrives by, in the label file's order
+/// (docs/dataset-format.md, truth/labels_NNNN.bin).
+enum class EchoPath : std::uint8_t {
+  kDirect,
+  kMultipath,
+  kSidelobe,
+  kSecondTrip,
+  kReverberation,
+  kVehicle,
+  kNoise
+};
+inline constexpr std::size_t kEchoPaths = 7;
+inline constexpr std::array<std::string_view, kEchoPaths> kEchoPathNames = {
+    "direct", "multipath", "sidelobe", "second_trip", "reverberation", "vehicle", "noise"};
+
+/// A bin no scene mesh answers directly.
+inline constexpr std::uint16_t kNoLabelMesh = 0xFFFF;
+
+/// One beam's labels as a label file holds them, per bin: each path's share of the bin's power
+/// in 255ths (summing to 255), the scene mesh with the most direct energy (its index in the
+/// manifest's `meshes`, or kNoLabelMesh), and, where there is one, the point of that mesh's
+/// strongest direct return in the sonar frame [m] (NaN elsewhere).
+struct BeamLabels {
+  std::vector<std::array<std::uint8_t, kEchoPaths>> shares;
+  std::vector<std::uint16_t> mesh;
+  std::vector<Eigen::Vector3f> point_sonar_m;
+};
+
+/// Each path's share of `energy` in 255ths, rounded so that they sum to 255 (largest
+/// remainders); all noise when `energy` sums to nothing.
+[[nodiscard]] std::array<std::uint8_t, kEchoPaths> ShareOf(
+    std::span<const double, kEchoPaths> energy);
+
+/// Writes one sweep's labels: a zstd frame of the little-endian layout of
+/// docs/dataset-format.md ("SBLABEL1", beam count, path count, then per beam its bins).
+void WriteLabelFile(const std::string& path, std::span<const BeamLabels> beams);
+/// Reads a label file; throws InputError naming `path` on a bad frame, magic or size, before
+/// allocating more than the frame says it holds (itself refused over 1 GiB).
+[[nodiscard]] std::vector<BeamLabels> ReadLabelFile(const std::string& path);
+
+}  // namespace sonarbench::io
