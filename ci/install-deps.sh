@@ -7,7 +7,7 @@ packages=(
   build-essential cmake pkg-config git
   libeigen3-dev liboctomap-dev libopencv-dev libembree-dev libyaml-cpp-dev
   libcli11-dev libmatio-dev zlib1g-dev libzstd-dev nlohmann-json3-dev libabsl-dev libassimp-dev
-  libxml2-utils libssl-dev
+  libxml2-utils libssl-dev python3 python3-numpy python3-matplotlib
   libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev libomp-14-dev
 )

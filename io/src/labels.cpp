@@ -149,6 +149,12 @@ BeamLabels ReadBeam(Payload& in, const std::string& path, std::size_t b) {
 
 }  // namespace
 
+std::string LabelFile(std::size_t sweep) {
+  std::string digits = std::to_string(sweep);
+  if (digits.size() < 4) digits.insert(0, 4 - digits.size(), '0');
+  return "truth/labels_" + digits + ".bin";
+}
+
 std::array<std::uint8_t, kEchoPaths> ShareOf(std::span<const double, kEchoPaths> energy) {
   std::array<std::uint8_t, kEchoPaths> shares{};
   double total = 0.0;

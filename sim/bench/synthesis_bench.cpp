@@ -65,8 +65,8 @@ constexpr std::uint64_t kSeed = 1;
 
 // One sweep of `scene`, as SimulateScene makes it, with a synthesizer built beforehand.
 std::vector<SynthesizedBeam> SimulateSweep(const Scene& scene, const BeamSynthesizer& synthesizer,
-                                           int threads) {
-  return SimulateBeams(scene, synthesizer, kSeed, threads, 0, ScenarioBeamCount(scene));
+                                           int threads, Labels labels = Labels::kDrop) {
+  return SimulateBeams(scene, synthesizer, kSeed, threads, 0, ScenarioBeamCount(scene), labels);
 }
 
 // One sweep's primary rays, drawn as the synthesis draws them (BeamPattern::DrawRays: the
@@ -270,6 +270,19 @@ void BM_Synthesis(benchmark::State& state, const std::string& file) {
       g.BeamsPerSweep() / g.beams_per_second * state.iterations(), benchmark::Counter::kIsRate);
 }
 
+// The same on one thread, with and without the bins' labels (a dataset's): their cost is the
+// ratio of the two.
+void BM_SynthesisLabels(benchmark::State& state, const std::string& file, Labels labels) {
+  const BenchScene& bench = TheSetup(file).bench;
+  const BeamSynthesizer synthesizer = SceneSynthesizer(bench.scene, bench.tracer, kSeed);
+  for (auto _ : state) {
+    auto beams = SimulateSweep(bench.scene, synthesizer, 1, labels);
+    benchmark::DoNotOptimize(beams);
+  }
+  state.counters["rays/s"] = benchmark::Counter(
+      PrimaryRaysPerSweep(bench.scene) * state.iterations(), benchmark::Counter::kIsRate);
+}
+
 // The same without multipath: one ray per primary, the raw benchmark's rays exactly.
 void BM_SynthesisNoMultipath(benchmark::State& state, const std::string& file) {
   const BenchScene& bench = TheSetup(file).bench;
@@ -304,6 +317,12 @@ BENCHMARK_CAPTURE(BM_Synthesis, tank, kTank)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK_CAPTURE(BM_SynthesisLabels, tank_unlabelled, kTank, Labels::kDrop)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_SynthesisLabels, tank_labelled, kTank, Labels::kKeep)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_RawEmbree, seabed, kSeabed)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RawEmbreeBundle, seabed, kSeabed)
     ->Unit(benchmark::kMillisecond)
@@ -314,6 +333,12 @@ BENCHMARK_CAPTURE(BM_RawEmbreeReplay, seabed_queries, kSeabed, false)
 BENCHMARK_CAPTURE(BM_Synthesis, seabed, kSeabed)
     ->Arg(1)
     ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_SynthesisLabels, seabed_unlabelled, kSeabed, Labels::kDrop)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_SynthesisLabels, seabed_labelled, kSeabed, Labels::kKeep)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -2,6 +2,7 @@
 #include <memory>
 
 #include "cli.hpp"
+#include "sonarbench/sim/app/numpy_export.hpp"
 #include "sonarbench/sim/app/rosbag_export.hpp"
 
 namespace sonarbench::app {
@@ -15,6 +16,11 @@ struct ExportArgs {
 };
 
 int Export(const ExportArgs& args) {
+  if (args.out.ends_with(".npz")) {
+    sim::WriteNpzFromDataset(args.dataset, args.out, args.force);
+    std::cout << "wrote " << args.out << " (numpy.load reads it: docs/dataset-format.md)\n";
+    return 0;
+  }
   io::RosbagContent bag = sim::RosbagFromDataset(args.dataset);
   bag.sound_speed_m_s = args.sound_speed;
   sim::WriteRosbagFile(bag, args.out, args.force);
@@ -30,17 +36,18 @@ CLI::App* AddOptions(CLI::App& app, ExportArgs& args) {
       "export",
       "Write a dataset as a ROS 2 bag (MCAP, as rosbag2 stores it): a "
       "marine_acoustic_msgs/ProjectedSonarImage a beam, /tf, /tf_static and, for simulated "
-      "data, the true pose (docs/ros2.md).");
+      "data, the true pose (docs/ros2.md); or, when --out ends in .npz, as NumPy arrays, sweeps "
+      "× beams × bins, with a simulated dataset's per-bin labels (docs/dataset-format.md).");
   command->add_option("dataset", args.dataset, "Dataset directory")
       ->required()
       ->check(CLI::ExistingDirectory);
-  command->add_option("-o,--out", args.out, "The bag to write (FILE.mcap)")->required();
+  command->add_option("-o,--out", args.out, "The bag to write (FILE.mcap), or FILE.npz")->required();
   command
       ->add_option("--sound-speed", args.sound_speed,
                    "Speed of sound the ranges were computed at [m/s], for ping_info (default: "
                    "1500, the Micron's default)")
       ->check(CLI::Range(1.0, 10000.0));
-  command->add_flag("--force", args.force, "Replace a bag sonarbench wrote before");
+  command->add_flag("--force", args.force, "Replace a bag or .npz sonarbench wrote before");
   return command;
 }
 

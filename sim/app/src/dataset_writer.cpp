@@ -35,13 +35,6 @@ using nlohmann::json;
 // whether the sweeps on disk are its own.
 constexpr const char* kPartialMarker = ".sonarbench-partial.json";
 
-// Sweep `sweep`'s label file: "truth/labels_0012.bin".
-std::string LabelFile(std::size_t sweep) {
-  char name[48];
-  std::snprintf(name, sizeof name, "truth/labels_%04zu.bin", sweep);
-  return name;
-}
-
 void WriteText(const fs::path& path, const std::string& text) {
   WriteFileAtomically(path.string(), [&](std::ostream& out) { out << text; });
 }
@@ -81,7 +74,7 @@ OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sw
     claim.files.push_back(io::SweepFile("beams", s, "bin"));
     claim.files.push_back(io::SweepFile("images", s, "png"));
     if (simulated) claim.files.push_back(io::SweepFile("truth", s, "csv"));
-    if (simulated) claim.files.push_back(LabelFile(s));
+    if (simulated) claim.files.push_back(io::LabelFile(s));
   }
   claim.record = "manifest.json";
   claim.force = force;
@@ -164,7 +157,7 @@ bool SweepComplete(const fs::path& root, std::size_t sweep, bool with_truth) {
   return fs::is_regular_file(root / io::SweepFile("beams", sweep, "bin")) &&
          fs::is_regular_file(root / io::SweepFile("images", sweep, "png")) &&
          (!with_truth || (fs::is_regular_file(root / io::SweepFile("truth", sweep, "csv")) &&
-                          fs::is_regular_file(root / LabelFile(sweep))));
+                          fs::is_regular_file(root / io::LabelFile(sweep))));
 }
 
 std::string TruthCsv(std::span<const SynthesizedBeam> beams, std::size_t first_index,
@@ -232,14 +225,16 @@ std::string SceneConfigHash(const Scene& scene, std::uint64_t seed) {
                  {"sensor_model_sha256", io::Sha256OfFile(scene.sensor_model_file)}};
   json meshes = json::array();
   for (const MeshSpec& mesh : scene.meshes) {
-    meshes.push_back(mesh.file.path.empty() ? json(nullptr) : json(io::Sha256OfFile(mesh.file.path)));
+    meshes.push_back(mesh.file.path.empty() ? json(nullptr)
+                                            : json(io::Sha256OfFile(mesh.file.path)));
   }
   inputs["mesh_files_sha256"] = meshes;
   // The vehicle's part files too (a scene without parts hashes as it always did).
   if (!scene.vehicle.empty()) {
     json parts = json::array();
     for (const MeshSpec& part : scene.vehicle) {
-      parts.push_back(part.file.path.empty() ? json(nullptr) : json(io::Sha256OfFile(part.file.path)));
+      parts.push_back(part.file.path.empty() ? json(nullptr)
+                                             : json(io::Sha256OfFile(part.file.path)));
     }
     inputs["vehicle_files_sha256"] = parts;
   }
@@ -397,13 +392,13 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
       ++summary.sweeps_skipped;
     } else {
       const std::size_t first = s * per_sweep;
-      const auto synthesized = SimulateBeams(scene, synthesizer, seed, options.threads, first,
-                                             std::min(beam_count, first + per_sweep),
-                                             Labels::kKeep);
+      const auto synthesized =
+          SimulateBeams(scene, synthesizer, seed, options.threads, first,
+                        std::min(beam_count, first + per_sweep), Labels::kKeep);
       const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
       WriteBeams(root / io::SweepFile("beams", s, "bin"), beams);
       WriteText(root / io::SweepFile("truth", s, "csv"), TruthCsv(synthesized, first, scene));
-      io::WriteLabelFile((root / LabelFile(s)).string(), LabelsOf(synthesized));
+      io::WriteLabelFile((root / io::LabelFile(s)).string(), LabelsOf(synthesized));
       WritePolarImage((root / io::SweepFile("images", s, "png")).string(), beams,
                       scene.name + ", seed " + std::to_string(seed) + ": sweep " +
                           std::to_string(s) + ", polar");

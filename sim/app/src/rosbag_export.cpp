@@ -7,6 +7,8 @@
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
+#include "sonarbench/sim/app/numpy_export.hpp"
+#include "sonarbench/sim/report/output_directory.hpp"
 #include "sonarbench/sim/report/report.hpp"
 
 namespace sonarbench::sim {
@@ -51,23 +53,30 @@ io::RosbagContent RosbagFromDataset(const std::string& dir) {
   return bag;
 }
 
-void WriteRosbagFile(const io::RosbagContent& bag, const std::string& path, bool force) {
+void ClaimExportFile(const std::string& path, bool force, bool ours, const std::string& kind) {
   std::error_code error;
   if (fs::exists(path, error) || fs::is_symlink(path, error)) {
     if (!fs::is_regular_file(path, error)) {
       throw InputError(path + ": exists and is not a file; choose another --out");
     }
-    if (io::McapLibrary(path).value_or("").rfind("sonarbench", 0) != 0) {
-      throw InputError(path +
-                       ": exists and is not an MCAP file sonarbench wrote; sonarbench never "
-                       "replaces it (--force neither): choose another --out");
+    if (!ours) {
+      throw InputError(path + ": exists and is not " + kind +
+                       " sonarbench wrote; sonarbench never replaces it (--force neither): "
+                       "choose another --out");
     }
-    if (!force)
-      throw InputError(path + ": exists (a bag sonarbench wrote); pass --force to replace it");
+    if (!force) {
+      throw InputError(path + ": exists (" + kind +
+                       " sonarbench wrote); pass --force to replace it");
+    }
   }
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty()) CheckOutputDirectory(parent.string());
   if (!parent.empty()) CreateOutputDirectory(parent.string());
+}
+
+void WriteRosbagFile(const io::RosbagContent& bag, const std::string& path, bool force) {
+  ClaimExportFile(path, force, io::McapLibrary(path).value_or("").rfind("sonarbench", 0) == 0,
+                  "an MCAP file");
   WriteFileAtomically(path, [&](std::ostream& out) { io::WriteRosbag(out, bag, LibraryName()); });
 }
 

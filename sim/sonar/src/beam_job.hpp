@@ -141,6 +141,7 @@ struct LabelScratch {
   std::array<std::vector<double>, kEchoPaths> power;
   std::vector<double> before;
   std::vector<double> mesh_power;
+  std::vector<std::size_t> strongest;  // per bin, its mesh's strongest return
 };
 
 // Synthesize()'s working memory, one per thread, kept between beams: a beam allocates only its

@@ -83,16 +83,22 @@ void BeamSynthesizer::BeamJob::FinishLabels(std::span<const double> self_reflect
   }
   std::vector<double>& strongest = l.before;
   strongest.assign(bins_, 0.0);
-  const Eigen::Matrix3f R_sonar_world = T_world_sonar_.linear().transpose().cast<float>();
-  const Eigen::Matrix3f R_beam_world = R_world_beam_.transpose().cast<float>();
-  for (const DirectReturn& r : l.direct_returns) {
+  l.strongest.resize(bins_);
+  for (std::size_t i = 0; i < l.direct_returns.size(); ++i) {
+    const DirectReturn& r = l.direct_returns[i];
     each_covered(r, [&](std::size_t k, double power) {
       if (r.mesh != labels[k].mesh || power <= strongest[k]) return;
       strongest[k] = power;
-      labels[k].elevation_rad =
-          std::asin(std::clamp((R_beam_world * r.direction).z(), -1.0f, 1.0f));
-      labels[k].point_sonar_m = static_cast<float>(r.range) * (R_sonar_world * r.direction);
+      l.strongest[k] = i;
     });
+  }
+  const Eigen::Matrix3f R_sonar_world = T_world_sonar_.linear().transpose().cast<float>();
+  const Eigen::Matrix3f R_beam_world = R_world_beam_.transpose().cast<float>();
+  for (std::size_t k = 0; k < bins_; ++k) {
+    if (labels[k].mesh == kNoMesh) continue;
+    const DirectReturn& r = l.direct_returns[l.strongest[k]];
+    labels[k].elevation_rad = std::asin(std::clamp((R_beam_world * r.direction).z(), -1.0f, 1.0f));
+    labels[k].point_sonar_m = static_cast<float>(r.range) * (R_sonar_world * r.direction);
   }
 }
 

@@ -39,6 +39,9 @@ struct BeamLabels {
   std::vector<Eigen::Vector3f> point_sonar_m;
 };
 
+/// Sweep `sweep`'s label file in a dataset: "truth/labels_0012.bin".
+[[nodiscard]] std::string LabelFile(std::size_t sweep);
+
 /// Each path's share of `energy` in 255ths, rounded so that they sum to 255 (largest
 /// remainders); all noise when `energy` sums to nothing.
 [[nodiscard]] std::array<std::uint8_t, kEchoPaths> ShareOf(
