@@ -46,8 +46,21 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
       if (options.progress) options.progress(stage, done, total);
     };
   };
-  const std::vector<SynthesizedBeam> synthesized =
-      SimulateScene(scene, tracer, result.seed, result.threads, report("simulate"));
+  // The labels' direct echoes, a check of the score's geometric ones (MapMetrics).
+  DirectEchoes labelled;
+  const auto& g = scene.sensor.geometry;
+  labelled.half_width_horizontal_rad = 0.5 * g.beam_width_horizontal_rad;
+  labelled.half_width_vertical_rad = 0.5 * g.beam_width_vertical_rad;
+  labelled.tolerance_m = 0.5 * std::sqrt(3.0) * scene.mapping.resolution_m;
+  const auto take_labels = [&](std::span<const SynthesizedBeam> sweep) {
+    for (const SynthesizedBeam& beam : sweep) {
+      labelled.beams.push_back(
+          LabelledDirectBeam({beam.truth.T_world_sonar, beam.beam.head_angle_rad}, beam.labels,
+                             g.bin_size_m, labelled.tolerance_m));
+    }
+  };
+  const std::vector<SynthesizedBeam> synthesized = SimulateScene(
+      scene, tracer, result.seed, result.threads, report("simulate"), take_labels);
   result.beams = synthesized.size();
   result.timings.simulate_s = clock.Lap();
 
@@ -65,7 +78,7 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
   for (std::size_t b = 0; b < synthesized.size(); ++b) poses.push_back(ScheduleBeam(scene, b).pose);
   if (!poses.empty()) result.sonar_start_m = poses.front().T_world_sonar.translation();
   result.score = ScoreAgainstScene(result.mapper->tree(), scene, meshes, tracer, poses,
-                                   scene.sensor.geometry, options.progress);
+                                   scene.sensor.geometry, options.progress, &labelled);
   result.timings.ground_truth_s = result.score.ground_truth_s;
   result.timings.score_s = result.score.score_s;
   return result;

@@ -186,6 +186,26 @@ std::vector<std::pair<double, double>> RangeIntervals(std::vector<float>& hits, 
 
 }  // namespace
 
+DirectEchoes::Beam LabelledDirectBeam(const BeamPose& pose, std::span<const BinLabel> labels,
+                                      double bin_size_m, double tolerance_m) {
+  DirectEchoes::Beam beam;
+  beam.origin = pose.T_world_sonar.translation();
+  beam.world_to_head = (pose.T_world_sonar.linear() *
+                        Eigen::AngleAxisd(pose.head_angle_rad, Vector3d::UnitZ()).toRotationMatrix())
+                           .transpose();
+  for (std::size_t k = 0; k < labels.size(); ++k) {
+    if (labels[k].mesh == kNoMesh) continue;
+    const double lo = static_cast<double>(k) * bin_size_m - tolerance_m;
+    const double hi = static_cast<double>(k + 1) * bin_size_m + tolerance_m;
+    if (!beam.ranges.empty() && lo <= beam.ranges.back().second) {
+      beam.ranges.back().second = hi;
+    } else {
+      beam.ranges.emplace_back(lo, hi);
+    }
+  }
+  return beam;
+}
+
 bool DirectEchoes::Explains(const Vector3d& centre, double cell_half_diagonal_m) const {
   // A cell's angular radius stays under 30° beyond two half-diagonals, so a direction further
   // than that past the aperture's edge cannot be in it: a cheap test before the angles.

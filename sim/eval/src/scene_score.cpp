@@ -7,7 +7,7 @@ namespace sonarbench::sim {
 SceneScore ScoreAgainstScene(const octomap::OcTree& map, const Scene& scene,
                              std::span<const TriangleMesh> meshes, const RayTracer& tracer,
                              std::span<const BeamPose> poses, const mapping::SensorGeometry& sensor,
-                             const ScoreProgress& progress) {
+                             const ScoreProgress& progress, const DirectEchoes* labelled) {
   auto stage = [&progress](std::string_view name) -> StageProgress {
     if (!progress) return {};
     return [&progress, name](std::size_t done, std::size_t total) { progress(name, done, total); };
@@ -25,6 +25,7 @@ SceneScore ScoreAgainstScene(const octomap::OcTree& map, const Scene& scene,
   start = Clock::now();
   s.metrics =
       ScoreMap(map, s.truth, s.observable, meshes, stage("score"), &s.direct, &s.detector_ghosts);
+  if (labelled) s.metrics.labelled_ghost_split = SplitGhostsBy(map, s.truth, *labelled);
   s.verdict = Evaluate(scene.criteria, s.metrics);
   s.score_s = seconds(start);
   return s;

@@ -172,6 +172,23 @@ void SplitGhosts(const octomap::OcTree& map, const std::vector<Key>& ghosts,
   m.ghost_echo_share = Ratio(ghosts.size() - arc, m.occupied_cells);
 }
 
+}  // namespace
+
+std::pair<double, double> SplitGhostsBy(const octomap::OcTree& map, const mapping::KeySet& truth,
+                                        const DirectEchoes& direct) {
+  const MapCells cells = CollectMapCells(map);
+  std::vector<Key> ghosts;
+  for (const Key& key : cells.occupied) {
+    if (!AnyWithin(truth, key, 2)) ghosts.push_back(key);
+  }
+  MapMetrics m;
+  m.occupied_cells = cells.occupied.size();
+  SplitGhosts(map, ghosts, direct, m, nullptr);
+  return {*m.ghost_arc_share, *m.ghost_echo_share};
+}
+
+namespace {
+
 // Column precision and recall: the cells' (x, y) columns, top down.
 void CountColumns(const MapCells& cells, const mapping::KeySet& truth,
                   const mapping::KeySet& observable, MapMetrics& m) {

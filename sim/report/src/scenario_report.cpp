@@ -258,6 +258,10 @@ nlohmann::json MetricsJson(const MapMetrics& m) {
                            {"free_on_surface_cells", m.free_on_surface_cells}}}};
   if (m.ghost_arc_share) json["ghost_arc_share"] = *m.ghost_arc_share;
   if (m.ghost_echo_share) json["ghost_echo_share"] = *m.ghost_echo_share;
+  if (m.labelled_ghost_split) {
+    json["ghost_split_from_labels"] = {{"arc_share", m.labelled_ghost_split->first},
+                                       {"echo_share", m.labelled_ghost_split->second}};
+  }
   return json;
 }
 

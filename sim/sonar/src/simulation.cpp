@@ -82,7 +82,8 @@ std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const BeamSynthes
 
 std::vector<SynthesizedBeam> SimulateScene(
     const Scene& scene, const RayTracer& tracer, std::uint64_t seed, int threads,
-    const std::function<void(std::size_t done, std::size_t total)>& on_sweep) {
+    const std::function<void(std::size_t done, std::size_t total)>& on_sweep,
+    const std::function<void(std::span<const SynthesizedBeam>)>& on_labels) {
   const std::size_t count = ScenarioBeamCount(scene);
   const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
   const auto sweeps = static_cast<std::size_t>(scene.sweeps);
@@ -91,7 +92,12 @@ std::vector<SynthesizedBeam> SimulateScene(
   beams.reserve(count);
   for (std::size_t sweep = 0; sweep < sweeps; ++sweep) {
     auto part = SimulateBeams(scene, synthesizer, seed, threads, sweep * per_sweep,
-                              std::min(count, (sweep + 1) * per_sweep));
+                              std::min(count, (sweep + 1) * per_sweep),
+                              on_labels ? Labels::kKeep : Labels::kDrop);
+    if (on_labels) {
+      on_labels(part);
+      for (SynthesizedBeam& beam : part) beam.labels = {};
+    }
     std::move(part.begin(), part.end(), std::back_inserter(beams));
     if (on_sweep) on_sweep(sweep + 1, sweeps);
   }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sonarbench/mapping/beam_cells.hpp"
+#include "sonarbench/sim/sonar/bin_labels.hpp"
 #include "sonarbench/sim/world/geometry.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
 #include "sonarbench/sim/world/ray_tracer.hpp"
@@ -48,6 +49,13 @@ struct DirectEchoes {
   /// direct echoes explains.
   [[nodiscard]] bool Explains(const Eigen::Vector3d& centre, double cell_half_diagonal_m) const;
 };
+
+/// A beam's direct echoes as the simulator's labels name them: the bins a main-lobe return of a
+/// scene surface is heard in (BinLabel::mesh), each widened by `tolerance_m` on both sides. Its
+/// pose is `pose`'s. Add it to a DirectEchoes whose widths and tolerance are the sensor's.
+[[nodiscard]] DirectEchoes::Beam LabelledDirectBeam(const BeamPose& pose,
+                                                    std::span<const BinLabel> labels,
+                                                    double bin_size_m, double tolerance_m);
 
 /// Cells a perfect sensor with the same beams, poses and range could see: the cell of the first
 /// surface along each ray of a dense regular rays_h × rays_v grid across every beam's full

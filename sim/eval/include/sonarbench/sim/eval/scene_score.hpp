@@ -35,11 +35,13 @@ using ScoreProgress =
 /// Scores `map` against `scene` the one way every command does: the scene's `meshes` voxelised at
 /// the map's resolution, the cells a perfect sensor sees from the beams at `poses` with the
 /// beams' geometry `sensor` (PerfectSensorCells over `tracer`, built from `meshes`), ScoreMap,
-/// and the scene's criteria.
+/// and the scene's criteria. With `labelled` (a simulated run's LabelledDirectBeam), the ghosts
+/// are split by it too (MapMetrics::labelled_ghost_split).
 [[nodiscard]] SceneScore ScoreAgainstScene(const octomap::OcTree& map, const Scene& scene,
                                            std::span<const TriangleMesh> meshes,
                                            const RayTracer& tracer, std::span<const BeamPose> poses,
                                            const mapping::SensorGeometry& sensor,
-                                           const ScoreProgress& progress = {});
+                                           const ScoreProgress& progress = {},
+                                           const DirectEchoes* labelled = nullptr);
 
 }  // namespace sonarbench::sim

@@ -59,6 +59,9 @@ struct MapMetrics {
   /// ghost_share.
   std::optional<double> ghost_arc_share;
   std::optional<double> ghost_echo_share;
+  /// The same split by the direct echoes the simulator's labels name (LabelledDirectBeam), for a
+  /// simulated run: arc and echo shares, a check of the geometric split.
+  std::optional<std::pair<double, double>> labelled_ghost_split;
   /// Top down, over (x, y) columns of cells: columns holding an occupied cell that hold a truth
   /// cell / columns holding an occupied cell; columns of observable cells that hold an occupied
   /// cell / columns of observable cells. Fair to a static sonar, whose echo's elevation on its
@@ -100,6 +103,12 @@ struct MapMetrics {
                                   const StageProgress& progress = {},
                                   const DirectEchoes* direct = nullptr,
                                   mapping::KeySet* detector_ghosts = nullptr);
+
+/// The ghosts of `map` (occupied, more than 2 cells from every `truth` cell) on an echo of
+/// `direct`'s arc and the others, as shares of its occupied cells.
+[[nodiscard]] std::pair<double, double> SplitGhostsBy(const octomap::OcTree& map,
+                                                      const mapping::KeySet& truth,
+                                                      const DirectEchoes& direct);
 
 /// Leaf cells of `map` at its finest resolution, split by occupancy.
 struct MapCells {

@@ -33,10 +33,12 @@ struct ScheduledBeam {
 /// Beam b draws only from DeriveSeed(seed, b): the output does not depend on the thread count.
 /// Each beam is rendered from the true pose and carries the reported one (ReportedSonarPose) in
 /// `beam.T_world_sonar`; the true one is in `truth.T_world_sonar`. `on_sweep`, when set, is
-/// called after each sweep with the sweeps done and the total.
+/// called after each sweep with the sweeps done and the total; `on_labels`, when set, with each
+/// sweep's beams and their labels (Labels::kKeep), which the beams returned no longer hold.
 [[nodiscard]] std::vector<SynthesizedBeam> SimulateScene(
     const Scene& scene, const RayTracer& tracer, std::uint64_t seed, int threads,
-    const std::function<void(std::size_t done, std::size_t total)>& on_sweep = {});
+    const std::function<void(std::size_t done, std::size_t total)>& on_sweep = {},
+    const std::function<void(std::span<const SynthesizedBeam>)>& on_labels = {});
 
 /// The synthesizer of a scene's run: its sensor, its meshes' materials (mesh i's at i, as
 /// BuildSceneMeshes orders them), its vehicle's parts (BuildVehicleMeshes) and the run seed.
