@@ -167,6 +167,13 @@ const std::map<std::string, std::string>& Definitions() {
        "marine_acoustic_msgs/SonarImageData image\n"},
       {kTfMessage, "geometry_msgs/TransformStamped[] transforms\n"},
       {kPoseStamped, "std_msgs/Header header\ngeometry_msgs/Pose pose\n"},
+      {"sensor_msgs/PointField",
+       "uint8 INT8 = 1\nuint8 UINT8 = 2\nuint8 INT16 = 3\nuint8 UINT16 = 4\nuint8 INT32 = 5\n"
+       "uint8 UINT32 = 6\nuint8 FLOAT32 = 7\nuint8 FLOAT64 = 8\nstring name\nuint32 offset\n"
+       "uint8 datatype\nuint32 count\n"},
+      {kPointCloud2,
+       "std_msgs/Header header\nuint32 height\nuint32 width\nsensor_msgs/PointField[] fields\n"
+       "bool is_bigendian\nuint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense\n"},
   };
   return d;
 }
@@ -184,6 +191,7 @@ std::string Definition(const std::string& type) {
       {kPoseStamped,
        {"std_msgs/Header", "builtin_interfaces/Time", "geometry_msgs/Pose", "geometry_msgs/Point",
         "geometry_msgs/Quaternion"}},
+      {kPointCloud2, {"std_msgs/Header", "builtin_interfaces/Time", "sensor_msgs/PointField"}},
   };
   std::string text = Definitions().at(type);
   for (const std::string& dep : dependencies.at(type)) {
@@ -206,6 +214,26 @@ std::string Encode(const ProjectedSonarImage& m) {
   w.Put(m.dtype);
   w.Put(m.beam_count);
   w.Sequence(m.data);
+  return w.Bytes();
+}
+
+std::string Encode(const PointCloud2& m) {
+  CdrWriter w;
+  w.Header(m.header);
+  w.Put(m.height);
+  w.Put(m.width);
+  w.Put<std::uint32_t>(static_cast<std::uint32_t>(m.fields.size()));
+  for (const PointField& f : m.fields) {
+    w.String(f.name);
+    w.Put(f.offset);
+    w.Put(f.datatype);
+    w.Put(f.count);
+  }
+  w.Put<std::uint8_t>(0);  // is_bigendian
+  w.Put(m.point_step);
+  w.Put<std::uint32_t>(m.point_step * m.width);  // row_step
+  w.Sequence(m.data);
+  w.Put<std::uint8_t>(1);  // is_dense: every point finite
   return w.Bytes();
 }
 

@@ -39,7 +39,29 @@ struct TransformStamped {
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
 };
 
+/// sensor_msgs/msg/PointField.
+struct PointField {
+  static constexpr std::uint8_t kUint8 = 2;
+  static constexpr std::uint8_t kUint16 = 4;
+  static constexpr std::uint8_t kFloat32 = 7;
+  std::string name;
+  std::uint32_t offset = 0;
+  std::uint8_t datatype = 0;
+  std::uint32_t count = 1;
+};
+
+/// sensor_msgs/msg/PointCloud2: one row of `width` points.
+struct PointCloud2 {
+  Header header;
+  std::uint32_t height = 1;
+  std::uint32_t width = 0;
+  std::vector<PointField> fields;
+  std::uint32_t point_step = 0;
+  std::vector<std::uint8_t> data;
+};
+
 [[nodiscard]] std::string Encode(const ProjectedSonarImage& m);
+[[nodiscard]] std::string Encode(const PointCloud2& m);
 [[nodiscard]] std::string EncodeTfMessage(const std::vector<TransformStamped>& transforms);
 /// geometry_msgs/msg/PoseStamped.
 [[nodiscard]] std::string EncodePoseStamped(const Header& header, const Eigen::Isometry3d& pose);
@@ -53,7 +75,8 @@ struct TransformStamped {
 inline constexpr const char* kProjectedSonarImage = "marine_acoustic_msgs/msg/ProjectedSonarImage";
 inline constexpr const char* kTfMessage = "tf2_msgs/msg/TFMessage";
 inline constexpr const char* kPoseStamped = "geometry_msgs/msg/PoseStamped";
-/// The `ros2msg` definition of `type` (one of the three above) with its dependencies.
+inline constexpr const char* kPointCloud2 = "sensor_msgs/msg/PointCloud2";
+/// The `ros2msg` definition of `type` (one of the four above) with its dependencies.
 [[nodiscard]] std::string Definition(const std::string& type);
 
 }  // namespace sonarbench::io::ros2

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <numbers>
 #include <optional>
+#include <stdexcept>
 
 #include "ros2_messages.hpp"
 #include "sonarbench/io/mcap.hpp"
@@ -59,12 +61,53 @@ ros2::ProjectedSonarImage ImageMessage(const Beam& beam, const RosbagContent& ba
   return m;
 }
 
+// The beam with each bin's dominant path (io::EchoPath, the largest share) for its intensity.
+Beam PathBeam(const Beam& beam, const BeamLabels& labels) {
+  Beam path = beam;
+  for (std::size_t k = 0; k < path.intensities.size() && k < labels.shares.size(); ++k) {
+    const auto& shares = labels.shares[k];
+    path.intensities[k] =
+        static_cast<std::uint8_t>(std::max_element(shares.begin(), shares.end()) - shares.begin());
+  }
+  return path;
+}
+
+// The bins a scene mesh answers directly, as points in the sonar frame: x, y, z (float32), the
+// mesh (uint16) and the direct share (uint8, 255ths).
+ros2::PointCloud2 DirectPoints(const BeamLabels& labels, const ros2::Header& header) {
+  ros2::PointCloud2 cloud;
+  cloud.header = header;
+  cloud.fields = {{"x", 0, ros2::PointField::kFloat32},
+                  {"y", 4, ros2::PointField::kFloat32},
+                  {"z", 8, ros2::PointField::kFloat32},
+                  {"mesh", 12, ros2::PointField::kUint16},
+                  {"direct_share", 14, ros2::PointField::kUint8}};
+  cloud.point_step = 16;
+  for (std::size_t k = 0; k < labels.mesh.size(); ++k) {
+    if (labels.mesh[k] == kNoLabelMesh) continue;
+    char point[16] = {};
+    std::memcpy(point, labels.point_sonar_m[k].data(), 12);
+    std::memcpy(point + 12, &labels.mesh[k], 2);
+    point[14] = static_cast<char>(labels.shares[k][static_cast<std::size_t>(EchoPath::kDirect)]);
+    cloud.data.insert(cloud.data.end(), point, point + 16);
+    ++cloud.width;
+  }
+  return cloud;
+}
+
 }  // namespace
 
 void WriteRosbag(std::ostream& out, const RosbagContent& bag, const std::string& library) {
+  const bool labels = !bag.labels.empty();
+  if (labels && bag.labels.size() != bag.beams.size()) {
+    throw std::invalid_argument("WriteRosbag: " + std::to_string(bag.labels.size()) +
+                                " beams' labels for " + std::to_string(bag.beams.size()) +
+                                " beams");
+  }
   McapWriter w(out, "ros2", library);
-  const char* types[] = {ros2::kProjectedSonarImage, ros2::kTfMessage, ros2::kPoseStamped};
-  for (std::uint16_t id = 1; id <= 3; ++id) {
+  const char* types[] = {ros2::kProjectedSonarImage, ros2::kTfMessage, ros2::kPoseStamped,
+                         ros2::kPointCloud2};
+  for (std::uint16_t id = 1; id <= (labels ? 4 : 3); ++id) {
     w.Add(McapSchema{id, types[id - 1], "ros2msg", ros2::Definition(types[id - 1])});
   }
   const bool truth = !bag.true_vehicle.empty();
@@ -75,7 +118,12 @@ void WriteRosbag(std::ostream& out, const RosbagContent& bag, const std::string&
     w.Add(
         McapChannel{4, 3, kGroundTruthTopic, "cdr", {{"offered_qos_profiles", QosProfile(false)}}});
   }
-  std::uint32_t sequence[5] = {};
+  if (labels) {
+    w.Add(McapChannel{5, 1, kLabelPathTopic, "cdr", {{"offered_qos_profiles", QosProfile(false)}}});
+    w.Add(
+        McapChannel{6, 4, kLabelPointsTopic, "cdr", {{"offered_qos_profiles", QosProfile(false)}}});
+  }
+  std::uint32_t sequence[7] = {};
   const auto write = [&](std::uint16_t channel, std::uint64_t ns, std::string data) {
     w.Write(McapMessage{channel, sequence[channel]++, ns, ns, std::move(data)});
   };
@@ -91,6 +139,10 @@ void WriteRosbag(std::ostream& out, const RosbagContent& bag, const std::string&
               {{Stamp(ns, kWorldFrame), kVehicleFrame, beam.T_world_sonar * sonar_vehicle}}));
     write(1, ns, ros2::Encode(ImageMessage(beam, bag, ns)));
     if (truth) write(4, ns, ros2::EncodePoseStamped(Stamp(ns, kWorldFrame), bag.true_vehicle[b]));
+    if (labels) {
+      write(5, ns, ros2::Encode(ImageMessage(PathBeam(beam, bag.labels[b]), bag, ns)));
+      write(6, ns, ros2::Encode(DirectPoints(bag.labels[b], Stamp(ns, kSonarFrame))));
+    }
   }
   w.Finish();
 }
@@ -263,7 +315,8 @@ const McapChannel& SonarChannel(const McapFile& file, const std::string& path,
   for (const McapChannel& c : file.channels) {
     const bool sonar =
         types.count(c.schema_id) && types.at(c.schema_id) == ros2::kProjectedSonarImage;
-    if (topic.empty() ? sonar : c.topic == topic) {
+    // Unnamed, the sonar's topic is the one that is not the labels' (a simulated bag's).
+    if (topic.empty() ? sonar && c.topic != kLabelPathTopic : c.topic == topic) {
       if (!sonar) {
         throw InputError(path + ": topic " + Quoted(topic) + " is not of type " +
                          ros2::kProjectedSonarImage);

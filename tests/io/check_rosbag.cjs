@@ -64,7 +64,13 @@ async function main() {
     "/tf": ["tf2_msgs/msg/TFMessage", beams],
     "/tf_static": ["tf2_msgs/msg/TFMessage", 1],
   };
-  if (simulated) expected["/ground_truth/pose"] = ["geometry_msgs/msg/PoseStamped", beams];
+  if (simulated) {
+    expected["/ground_truth/pose"] = ["geometry_msgs/msg/PoseStamped", beams];
+    expected["/sonar/labels/path"] = ["marine_acoustic_msgs/msg/ProjectedSonarImage", beams];
+    expected["/sonar/labels/points"] = ["sensor_msgs/msg/PointCloud2", beams];
+  }
+  const maxRange = manifest.sensor.num_bins * manifest.sensor.bin_size_m;
+  let points = 0;
   const decoders = new Map();
   check(reader.channelsById.size === Object.keys(expected).length, "channel count");
   for (const [id, channel] of reader.channelsById) {
@@ -109,6 +115,26 @@ async function main() {
       near(decoded.ping_info.tx_beamwidths[0], manifest.sensor.beam_width_vertical_deg * Math.PI / 180, 1e-6, "vertical width");
       near(decoded.ping_info.rx_beamwidths[0], manifest.sensor.beam_width_horizontal_deg * Math.PI / 180, 1e-6, "horizontal width");
     }
+    if (channel.topic === "/sonar/labels/path") {
+      check(decoded.image.data.every((v) => v < 7), `${channel.topic} ${n}: a path index 0-6 a bin`);
+      check(decoded.ranges.length === manifest.sensor.num_bins, `${channel.topic} ${n}: a range a bin`);
+    }
+    if (channel.topic === "/sonar/labels/points") {
+      // x, y, z (float32), mesh (uint16), direct_share (uint8), 16 bytes a point, in the sonar
+      // frame, within the beam's reach.
+      const names = decoded.fields.map((f) => `${f.name}@${f.offset}:${f.datatype}`).join(",");
+      check(names === "x@0:7,y@4:7,z@8:7,mesh@12:4,direct_share@14:2", `fields ${names}`);
+      check(decoded.point_step === 16 && decoded.data.length === 16 * decoded.width &&
+            decoded.height === 1 && header.frame_id === "sonar", `${channel.topic} ${n}: layout`);
+      const view = new DataView(decoded.data.buffer, decoded.data.byteOffset, decoded.data.length);
+      for (let i = 0; i < decoded.width; ++i) {
+        const [x, y, z] = [0, 4, 8].map((o) => view.getFloat32(16 * i + o, true));
+        const r = Math.hypot(x, y, z);
+        check(r > 0 && r <= maxRange + 1e-3, `${channel.topic} ${n}: point ${i} at ${r} m`);
+        check(view.getUint16(16 * i + 12, true) < manifest.meshes.length, `point ${i}'s mesh`);
+        points += 1;
+      }
+    }
     if (channel.topic === "/tf" && n === 1) {
       const t = decoded.transforms[0];
       check(t.header.frame_id === "map" && t.child_frame_id === "base_link", "/tf map → base_link");
@@ -124,6 +150,7 @@ async function main() {
   for (const [topic, want] of Object.entries(expected)) {
     check((seen[topic] || 0) === want[1], `${topic}: read ${seen[topic]} messages`);
   }
+  if (simulated) check(points > 0, "direct returns on /sonar/labels/points");
   await fd.close();
   console.log(`${bagPath}: ${Object.entries(seen).map(([t, n]) => `${t} ${n}`).join(", ")}; ` +
               `${failures} failures`);

@@ -26,6 +26,9 @@ int Export(const ExportArgs& args) {
   sim::WriteRosbagFile(bag, args.out, args.force);
   std::cout << bag.beams.size() << " beams on " << io::kSonarTopic << ", /tf, /tf_static"
             << (bag.true_vehicle.empty() ? "" : std::string(", ") + io::kGroundTruthTopic)
+            << (bag.labels.empty()
+                    ? ""
+                    : std::string(", ") + io::kLabelPathTopic + ", " + io::kLabelPointsTopic)
             << "\nwrote " << args.out << "\n";
   return 0;
 }
@@ -41,7 +44,8 @@ CLI::App* AddOptions(CLI::App& app, ExportArgs& args) {
   command->add_option("dataset", args.dataset, "Dataset directory")
       ->required()
       ->check(CLI::ExistingDirectory);
-  command->add_option("-o,--out", args.out, "The bag to write (FILE.mcap), or FILE.npz")->required();
+  command->add_option("-o,--out", args.out, "The bag to write (FILE.mcap), or FILE.npz")
+      ->required();
   command
       ->add_option("--sound-speed", args.sound_speed,
                    "Speed of sound the ranges were computed at [m/s], for ping_info (default: "

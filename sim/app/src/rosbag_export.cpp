@@ -4,6 +4,7 @@
 
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/files.hpp"
+#include "sonarbench/io/labels.hpp"
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
@@ -29,6 +30,19 @@ io::RosbagContent RosbagFromDataset(const std::string& dir) {
   io::RosbagContent bag;
   bag.sensor = dataset.sensor;
   bag.beams = std::move(dataset.beams);
+  // A simulated dataset's labels, sweep by sweep (none in a dataset written without them).
+  if (dataset.manifest.value("source", "") == "simulate" &&
+      fs::exists(fs::path(dir) / io::LabelFile(0))) {
+    for (std::size_t s = 0; s < dataset.sweeps; ++s) {
+      const std::string file = (fs::path(dir) / io::LabelFile(s)).string();
+      std::vector<io::BeamLabels> sweep = io::ReadLabelFile(file);
+      std::move(sweep.begin(), sweep.end(), std::back_inserter(bag.labels));
+    }
+    if (bag.labels.size() != bag.beams.size()) {
+      throw InputError(dir + ": the label files hold " + std::to_string(bag.labels.size()) +
+                       " beams, expected one for each of the " + std::to_string(bag.beams.size()));
+    }
+  }
   const fs::path vehicle_file = fs::path(dir) / "poses/vehicle.tum";
   const fs::path sonar_file = fs::path(dir) / "poses/sonar_true.tum";
   if (!fs::exists(vehicle_file) || !fs::exists(sonar_file)) return bag;

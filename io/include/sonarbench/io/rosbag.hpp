@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "sonarbench/io/labels.hpp"
 #include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
@@ -23,6 +24,10 @@ using mapping::SensorGeometry;
 ///                       each beam's time
 ///   /tf_static          base_link → sonar, the mounting
 ///   /ground_truth/pose  geometry_msgs/msg/PoseStamped: the true base_link pose (simulated data)
+///   /sonar/labels/path  ProjectedSonarImage beside each beam, each bin's dominant echo path
+///                       (io::EchoPath) for its value (simulated data with labels)
+///   /sonar/labels/points sensor_msgs/msg/PointCloud2 beside each beam: its bins' direct
+///                       returns in frame `sonar` (x, y, z, mesh, direct_share)
 struct RosbagContent {
   SensorGeometry sensor;
   /// Beams with their reported T_world_sonar.
@@ -31,12 +36,16 @@ struct RosbagContent {
   Eigen::Isometry3d T_vehicle_sonar = Eigen::Isometry3d::Identity();
   /// The true T_world_vehicle at each beam (simulated data), or empty.
   std::vector<Eigen::Isometry3d> true_vehicle;
+  /// Each beam's labels (a simulated dataset's), or empty.
+  std::vector<BeamLabels> labels;
   /// The speed of sound [m/s] that ranges were computed at.
   float sound_speed_m_s = 1500.0F;
 };
 
 inline constexpr const char* kSonarTopic = "/sonar/image";
 inline constexpr const char* kGroundTruthTopic = "/ground_truth/pose";
+inline constexpr const char* kLabelPathTopic = "/sonar/labels/path";
+inline constexpr const char* kLabelPointsTopic = "/sonar/labels/points";
 
 /// Writes `bag` as an MCAP file to `out`; its header names `library`.
 void WriteRosbag(std::ostream& out, const RosbagContent& bag, const std::string& library);
