@@ -134,14 +134,15 @@ struct DirectReturn {
 
 // The labels' working memory (Labels::kKeep): the scene's echoes by path (direct, sidelobe,
 // multipath), the main lobe's direct returns, each path's power per bin, each bin's receiver
-// noise, and the direct power per bin and scene mesh (bin-major).
+// noise, and the direct power per bin and scene mesh (bin-major) with the strongest return.
 struct LabelScratch {
   std::array<PulseSpreader, 3> spreaders;
   std::vector<DirectReturn> direct_returns;
   std::array<std::vector<double>, kEchoPaths> power;
   std::vector<double> before;
   std::vector<double> mesh_power;
-  std::vector<std::size_t> strongest;  // per bin, its mesh's strongest return
+  std::vector<double> mesh_strongest;  // per bin and mesh, its strongest return's power
+  std::vector<std::size_t> strongest;  // and that return's index
 };
 
 // Synthesize()'s working memory, one per thread, kept between beams: a beam allocates only its

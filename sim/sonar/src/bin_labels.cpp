@@ -57,46 +57,42 @@ void BeamSynthesizer::BeamJob::FinishLabels(std::span<const double> self_reflect
       labels[k].energy[static_cast<std::size_t>(EchoPath::kVehicle)] += self_reflection[k];
     }
   }
-  // Each bin's direct power by mesh, from the returns whose pulse covers it; its mesh the one
-  // with the most, its point that mesh's strongest return's.
+  // Each bin's direct power by mesh, from the returns whose pulse covers it, and each mesh's
+  // strongest there, in one pass; the bin's mesh the one with the most, its point that mesh's
+  // strongest return's.
   const std::size_t meshes = s_.vehicle_first_mesh_;
+  if (meshes == 0) return;
   l.mesh_power.assign(bins_ * meshes, 0.0);
-  const double pulse_bins = a_.pulse.length_m / g_.bin_size_m;
-  const auto each_covered = [&](const DirectReturn& r, const auto& visit) {
-    const double start = r.range / g_.bin_size_m;
+  l.mesh_strongest.assign(bins_ * meshes, 0.0);
+  l.strongest.resize(bins_ * meshes);
+  const double bins_per_m = 1.0 / g_.bin_size_m;
+  const double pulse_bins = a_.pulse.length_m * bins_per_m;
+  for (std::size_t i = 0; i < l.direct_returns.size(); ++i) {
+    const DirectReturn& r = l.direct_returns[i];
+    const double start = r.range * bins_per_m;
     const double end = start + pulse_bins;
     const auto last = std::min(bins_, static_cast<std::size_t>(std::ceil(end)));
     for (auto k = static_cast<std::size_t>(start); k < last; ++k) {
       const double covered =
           std::min(end, static_cast<double>(k + 1)) - std::max(start, static_cast<double>(k));
-      if (const double power = r.power * covered; power > 0.0) visit(k, power);
+      const double power = r.power * covered;
+      const std::size_t at = k * meshes + r.mesh;
+      l.mesh_power[at] += power;
+      if (power > l.mesh_strongest[at]) {
+        l.mesh_strongest[at] = power;
+        l.strongest[at] = i;
+      }
     }
-  };
-  for (const DirectReturn& r : l.direct_returns) {
-    each_covered(r,
-                 [&](std::size_t k, double power) { l.mesh_power[k * meshes + r.mesh] += power; });
-  }
-  for (std::size_t k = 0; k < bins_; ++k) {
-    const auto first = l.mesh_power.begin() + static_cast<std::ptrdiff_t>(k * meshes);
-    const auto most = std::max_element(first, first + static_cast<std::ptrdiff_t>(meshes));
-    if (*most > 0.0) labels[k].mesh = static_cast<std::uint32_t>(most - first);
-  }
-  std::vector<double>& strongest = l.before;
-  strongest.assign(bins_, 0.0);
-  l.strongest.resize(bins_);
-  for (std::size_t i = 0; i < l.direct_returns.size(); ++i) {
-    const DirectReturn& r = l.direct_returns[i];
-    each_covered(r, [&](std::size_t k, double power) {
-      if (r.mesh != labels[k].mesh || power <= strongest[k]) return;
-      strongest[k] = power;
-      l.strongest[k] = i;
-    });
   }
   const Eigen::Matrix3f R_sonar_world = T_world_sonar_.linear().transpose().cast<float>();
   const Eigen::Matrix3f R_beam_world = R_world_beam_.transpose().cast<float>();
   for (std::size_t k = 0; k < bins_; ++k) {
-    if (labels[k].mesh == kNoMesh) continue;
-    const DirectReturn& r = l.direct_returns[l.strongest[k]];
+    const auto first = l.mesh_power.begin() + static_cast<std::ptrdiff_t>(k * meshes);
+    const auto most = std::max_element(first, first + static_cast<std::ptrdiff_t>(meshes));
+    if (!(*most > 0.0)) continue;
+    const auto mesh = static_cast<std::size_t>(most - first);
+    labels[k].mesh = static_cast<std::uint32_t>(mesh);
+    const DirectReturn& r = l.direct_returns[l.strongest[k * meshes + mesh]];
     labels[k].elevation_rad = std::asin(std::clamp((R_beam_world * r.direction).z(), -1.0f, 1.0f));
     labels[k].point_sonar_m = static_cast<float>(r.range) * (R_sonar_world * r.direction);
   }
