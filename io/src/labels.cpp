@@ -155,10 +155,10 @@ std::string LabelFile(std::size_t sweep) {
   return "truth/labels_" + digits + ".bin";
 }
 
-std::array<std::uint8_t, kEchoPaths> ShareOf(std::span<const double, kEchoPaths> energy) {
+std::array<std::uint8_t, kEchoPaths> ShareOf(std::span<const float, kEchoPaths> energy) {
   std::array<std::uint8_t, kEchoPaths> shares{};
   double total = 0.0;
-  for (const double e : energy) total += std::max(e, 0.0);
+  for (const float e : energy) total += std::max<double>(e, 0.0);
   if (!(total > 0.0)) {
     shares[static_cast<std::size_t>(EchoPath::kNoise)] = 255;
     return shares;
@@ -166,7 +166,7 @@ std::array<std::uint8_t, kEchoPaths> ShareOf(std::span<const double, kEchoPaths>
   std::array<double, kEchoPaths> rest{};
   int given = 0;
   for (std::size_t p = 0; p < kEchoPaths; ++p) {
-    const double exact = 255.0 * std::max(energy[p], 0.0) / total;
+    const double exact = 255.0 * std::max<double>(energy[p], 0.0) / total;
     shares[p] = static_cast<std::uint8_t>(std::min(255.0, std::floor(exact)));
     rest[p] = exact - shares[p];
     given += shares[p];

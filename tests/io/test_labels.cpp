@@ -15,7 +15,7 @@ namespace {
 
 // Each share within one 255th of its exact value, and 255 in all.
 TEST(Labels, SharesRoundToTwoHundredFiftyFifths) {
-  const std::array<double, kEchoPaths> energy = {3.0, 1.0, 0.0, 0.5, 0.25, 0.0, 1.0 / 3.0};
+  const std::array<float, kEchoPaths> energy = {3.0F, 1.0F, 0.0F, 0.5F, 0.25F, 0.0F, 1.0F / 3.0F};
   const auto shares = ShareOf(energy);
   const double total = std::accumulate(energy.begin(), energy.end(), 0.0);
   EXPECT_EQ(std::accumulate(shares.begin(), shares.end(), 0U), 255U);
@@ -23,7 +23,7 @@ TEST(Labels, SharesRoundToTwoHundredFiftyFifths) {
     EXPECT_LT(std::abs(shares[p] - 255.0 * energy[p] / total), 1.0) << p;
   }
   EXPECT_EQ(shares[2], 0);
-  const std::array<double, kEchoPaths> nothing{};
+  const std::array<float, kEchoPaths> nothing{};
   EXPECT_EQ(ShareOf(nothing)[static_cast<std::size_t>(EchoPath::kNoise)], 255);
 }
 

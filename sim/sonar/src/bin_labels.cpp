@@ -49,12 +49,11 @@ void BeamSynthesizer::BeamJob::FinishLabels(std::span<const double> self_reflect
   const double gain = std::pow(10.0, a_.gain.gain_db / 10.0);
   for (std::size_t k = 0; k < bins_; ++k) {
     const double factor = a_.speckle.on ? gain * scratch_.speckle[k] : gain;
+    const double self = k < self_reflection.size() ? self_reflection[k] : 0.0;
     for (std::size_t p = 0; p < kEchoPaths; ++p) {
-      labels[k].energy[p] =
-          l.power[p][k] * (p == static_cast<std::size_t>(EchoPath::kNoise) ? 1.0 : factor);
-    }
-    if (k < self_reflection.size()) {
-      labels[k].energy[static_cast<std::size_t>(EchoPath::kVehicle)] += self_reflection[k];
+      const auto path = static_cast<EchoPath>(p);
+      const double power = path == EchoPath::kNoise ? l.power[p][k] : l.power[p][k] * factor;
+      labels[k].energy[p] = static_cast<float>(path == EchoPath::kVehicle ? power + self : power);
     }
   }
   // Each bin's direct power by mesh, from the returns whose pulse covers it, and each mesh's
@@ -85,7 +84,6 @@ void BeamSynthesizer::BeamJob::FinishLabels(std::span<const double> self_reflect
     }
   }
   const Eigen::Matrix3f R_sonar_world = T_world_sonar_.linear().transpose().cast<float>();
-  const Eigen::Matrix3f R_beam_world = R_world_beam_.transpose().cast<float>();
   for (std::size_t k = 0; k < bins_; ++k) {
     const auto first = l.mesh_power.begin() + static_cast<std::ptrdiff_t>(k * meshes);
     const auto most = std::max_element(first, first + static_cast<std::ptrdiff_t>(meshes));
@@ -93,7 +91,6 @@ void BeamSynthesizer::BeamJob::FinishLabels(std::span<const double> self_reflect
     const auto mesh = static_cast<std::size_t>(most - first);
     labels[k].mesh = static_cast<std::uint32_t>(mesh);
     const DirectReturn& r = l.direct_returns[l.strongest[k * meshes + mesh]];
-    labels[k].elevation_rad = std::asin(std::clamp((R_beam_world * r.direction).z(), -1.0f, 1.0f));
     labels[k].point_sonar_m = static_cast<float>(r.range) * (R_sonar_world * r.direction);
   }
 }

@@ -45,7 +45,7 @@ struct BeamLabels {
 /// Each path's share of `energy` in 255ths, rounded so that they sum to 255 (largest
 /// remainders); all noise when `energy` sums to nothing.
 [[nodiscard]] std::array<std::uint8_t, kEchoPaths> ShareOf(
-    std::span<const double, kEchoPaths> energy);
+    std::span<const float, kEchoPaths> energy);
 
 /// Writes one sweep's labels: a zstd frame of the little-endian layout of
 /// docs/dataset-format.md ("SBLABEL1", beam count, path count, then per beam its bins).

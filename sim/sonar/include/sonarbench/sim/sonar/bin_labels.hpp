@@ -24,13 +24,12 @@ using io::kEchoPaths;
 inline constexpr std::uint32_t kNoMesh = std::numeric_limits<std::uint32_t>::max();
 
 /// One range bin's truth: its power before the converter split by path (linear, the units of the
-/// receiver's power; their sum is the bin's power), the scene mesh with the most direct energy in
-/// it, and the strongest direct return whose pulse covers it: its elevation in the beam's frame
-/// [rad] and its point in the sonar frame [m] (kNoMesh and NaN without one).
+/// receiver's power, in float; their sum is the bin's power), the scene mesh with the most direct
+/// energy in it, and that mesh's strongest direct return whose pulse covers the bin: its point in
+/// the sonar frame [m] (kNoMesh and NaN without one), at elevation asin(z / |p|) in the beam.
 struct BinLabel {
-  std::array<double, kEchoPaths> energy{};
+  std::array<float, kEchoPaths> energy{};
   std::uint32_t mesh = kNoMesh;
-  float elevation_rad = std::numeric_limits<float>::quiet_NaN();
   Eigen::Vector3f point_sonar_m =
       Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
 };
