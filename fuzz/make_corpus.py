@@ -4,17 +4,19 @@
 Usage: fuzz/make_corpus.py [DATASET]   (run from anywhere; writes fuzz/corpus/ and fuzz/dict/)
 
 The OctoMap seeds are small trees written in both formats here, byte for byte as OctoMap would;
-the ROS 2 bag seeds are small MCAP files written here record by record (docs/ros2.md).
+the ROS 2 bag seeds are small MCAP files written here record by record (docs/ros2.md); the
+label file seed is written here and compressed by the zstd command.
 DATASET is a folder `sonarbench simulate` wrote; its manifest, first beams and poses seed the
 dataset harness, cut to a few beams. The .mat seeds (the real log's first beams) are written by
 libmatio and kept as they are. Files a harness found are kept in the corpus beside these.
 """
 import hashlib
 import json
+import math
 import pathlib
 import re
-import math
 import struct
+import subprocess
 import sys
 import zlib
 
@@ -239,10 +241,32 @@ def bags():
     write(CORPUS / "rosbag" / "flat.mcap", mcap(messages, False))
 
 
+def label_beam(bins, meshes):
+    """One beam of a label file (docs/dataset-format.md): shares, meshes, points."""
+    shares = [[200 if k % 6 == p else 0 for k in range(bins)] for p in range(6)]
+    points = [k for k, m in enumerate(meshes) if m != 0xFFFF]
+    out = struct.pack("<I", bins) + b"".join(bytes(row) for row in shares)
+    out += b"".join(struct.pack("<H", m) for m in meshes)
+    out += struct.pack("<I", len(points)) + b"".join(struct.pack("<I", k) for k in points)
+    for axis in range(3):
+        out += b"".join(struct.pack("<f", 0.1 * k + axis) for k in points)
+    return out
+
+
+def labels():
+    """A label file of two beams, compressed by the zstd command (Debian's zstd package); the
+    seabed's first sweep beside it is one the simulator wrote, kept as it is."""
+    raw = b"SBLABEL1" + struct.pack("<II", 2, 7)
+    raw += label_beam(12, [0xFFFF] * 4 + [0, 0, 1, 1] + [0xFFFF] * 4) + label_beam(0, [])
+    frame = subprocess.run(["zstd", "-19", "-c"], input=raw, capture_output=True, check=True)
+    write(CORPUS / "labels" / "two_beams.bin", frame.stdout)
+
+
 if __name__ == "__main__":
     scenes()
     meshes()
     octrees()
     bags()
+    labels()
     if len(sys.argv) > 1:
         dataset(sys.argv[1])
