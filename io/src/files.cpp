@@ -50,6 +50,27 @@ void CreateOutputDirectory(const std::string& dir) {
   }
 }
 
+void ClaimExportFile(const std::string& path, bool force, bool ours, const std::string& kind) {
+  std::error_code error;
+  if (std::filesystem::exists(path, error) || std::filesystem::is_symlink(path, error)) {
+    if (!std::filesystem::is_regular_file(path, error)) {
+      throw InputError(path + ": exists and is not a file; choose another --out");
+    }
+    if (!ours) {
+      throw InputError(path + ": exists and is not " + kind +
+                       " sonarbench wrote; sonarbench never replaces it (--force neither): "
+                       "choose another --out");
+    }
+    if (!force) {
+      throw InputError(path + ": exists (" + kind +
+                       " sonarbench wrote); pass --force to replace it");
+    }
+  }
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty()) CheckOutputDirectory(parent.string());
+  if (!parent.empty()) CreateOutputDirectory(parent.string());
+}
+
 namespace {
 
 // What `mode` is, for a refusal: "a FIFO", "a directory".

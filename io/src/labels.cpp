@@ -187,6 +187,25 @@ void WriteLabelFile(const std::string& path, std::span<const BeamLabels> beams) 
   });
 }
 
+std::vector<BeamLabels> ReadDatasetLabels(const std::string& dir, const Dataset& dataset) {
+  std::vector<BeamLabels> beams;
+  const nlohmann::json& files = dataset.manifest["files"];
+  if (std::none_of(files.begin(), files.end(),
+                   [](const nlohmann::json& f) { return f.value("path", "") == LabelFile(0); })) {
+    return beams;
+  }
+  for (std::size_t s = 0; s < dataset.sweeps; ++s) {
+    std::vector<BeamLabels> sweep = ReadLabelFile(dir + "/" + LabelFile(s));
+    std::move(sweep.begin(), sweep.end(), std::back_inserter(beams));
+  }
+  if (beams.size() != dataset.beams.size()) {
+    throw InputError(dir + ": the label files hold " + std::to_string(beams.size()) +
+                     " beams, expected one for each of the " +
+                     std::to_string(dataset.beams.size()));
+  }
+  return beams;
+}
+
 std::vector<BeamLabels> ReadLabelFile(const std::string& path) {
   const std::string raw = Decompress(path);
   Payload in(raw, path);

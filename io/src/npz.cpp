@@ -148,13 +148,12 @@ std::optional<std::string> NpzComment(const std::string& path) {
   std::string bytes(tail, '\0');
   in.seekg(static_cast<std::streamoff>(size - tail));
   in.read(bytes.data(), static_cast<std::streamsize>(tail));
-  for (std::size_t at = tail >= 22 ? tail - 22 : std::string::npos; at != std::string::npos; --at) {
-    if (bytes.compare(at, 4, "PK\x05\x06") == 0) {
-      const std::size_t length = static_cast<unsigned char>(bytes[at + 20]) |
-                                 (static_cast<unsigned char>(bytes[at + 21]) << 8);
-      if (at + 22 + length == tail) return bytes.substr(at + 22, length);
-    }
-    if (at == 0) break;
+  // The end record (22 bytes, its comment after it), searched for from the end.
+  for (std::size_t at = tail < 22 ? 0 : tail - 21; at-- > 0;) {
+    if (bytes.compare(at, 4, "PK\x05\x06") != 0) continue;
+    const std::size_t length = static_cast<unsigned char>(bytes[at + 20]) |
+                               (static_cast<unsigned char>(bytes[at + 21]) << 8);
+    if (at + 22 + length == tail) return bytes.substr(at + 22, length);
   }
   return std::nullopt;
 }

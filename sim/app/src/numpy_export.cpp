@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/io/labels.hpp"
 #include "sonarbench/io/npz.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
@@ -32,30 +33,27 @@ void AddStrings(io::NpzArchive& npz, const std::string& name,
   npz.Add(name, "<U" + std::to_string(width), {strings.size()}, bytes);
 }
 
-// The labels of a simulated dataset, sweep by sweep, into sweeps × beams × bins arrays.
-void AddLabels(io::NpzArchive& npz, const std::string& dir, const io::Dataset& d,
+// A simulated dataset's labels (ReadDatasetLabels: a beam each) as sweeps × beams × bins arrays,
+// beam b in slot b as the intensities are.
+void AddLabels(io::NpzArchive& npz, const std::vector<io::BeamLabels>& labels, const io::Dataset& d,
                std::size_t per_sweep, std::size_t bins) {
   const std::size_t cells = d.sweeps * per_sweep * bins;
   std::vector<std::uint8_t> shares(cells * io::kEchoPaths, 0);
   std::vector<std::uint16_t> mesh(cells, io::kNoLabelMesh);
   std::vector<float> point(cells * 3, std::nanf(""));
-  for (std::size_t s = 0; s < d.sweeps; ++s) {
-    const std::string file = (fs::path(dir) / io::LabelFile(s)).string();
-    const std::vector<io::BeamLabels> labels = io::ReadLabelFile(file);
-    for (std::size_t b = 0; b < labels.size() && b < per_sweep; ++b) {
-      if (labels[b].shares.size() != bins) {
-        throw InputError(file + ": beam " + std::to_string(b) + " has " +
-                         std::to_string(labels[b].shares.size()) + " bins, expected " +
-                         std::to_string(bins));
-      }
-      for (std::size_t k = 0; k < bins; ++k) {
-        const std::size_t at = (s * per_sweep + b) * bins + k;
-        std::copy(labels[b].shares[k].begin(), labels[b].shares[k].end(),
-                  shares.begin() + static_cast<std::ptrdiff_t>(at * io::kEchoPaths));
-        mesh[at] = labels[b].mesh[k];
-        for (int i = 0; i < 3; ++i)
-          point[at * 3 + static_cast<std::size_t>(i)] = labels[b].point_sonar_m[k][i];
-      }
+  for (std::size_t b = 0; b < labels.size(); ++b) {
+    if (labels[b].shares.size() > bins) {
+      throw InputError("label of beam " + std::to_string(b) + ": " +
+                       std::to_string(labels[b].shares.size()) + " bins, expected at most " +
+                       std::to_string(bins));
+    }
+    for (std::size_t k = 0; k < labels[b].shares.size(); ++k) {
+      const std::size_t at = b * bins + k;
+      std::copy(labels[b].shares[k].begin(), labels[b].shares[k].end(),
+                shares.begin() + static_cast<std::ptrdiff_t>(at * io::kEchoPaths));
+      mesh[at] = labels[b].mesh[k];
+      for (int i = 0; i < 3; ++i)
+        point[at * 3 + static_cast<std::size_t>(i)] = labels[b].point_sonar_m[k][i];
     }
   }
   npz.Add("label_shares", "|u1", {d.sweeps, per_sweep, bins, io::kEchoPaths}, Bytes(shares));
@@ -112,7 +110,8 @@ void WriteNpzFromDataset(const std::string& dir, const std::string& path, bool f
     }
     true_pose.resize(slots * 7, 0.0);
     npz.Add("sonar_pose_true", "<f8", {d.sweeps, per_sweep, 7}, Bytes(true_pose));
-    if (fs::exists(fs::path(dir) / io::LabelFile(0))) AddLabels(npz, dir, d, per_sweep, bins);
+    const std::vector<io::BeamLabels> labels = io::ReadDatasetLabels(dir, d);
+    if (!labels.empty()) AddLabels(npz, labels, d, per_sweep, bins);
   }
   WriteFileAtomically(path, [&](std::ostream& out) {
     npz.Write(out, std::string("sonarbench ") + kVersion + ": " + dir);

@@ -8,8 +8,6 @@
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
-#include "sonarbench/sim/app/numpy_export.hpp"
-#include "sonarbench/sim/report/output_directory.hpp"
 #include "sonarbench/sim/report/report.hpp"
 
 namespace sonarbench::sim {
@@ -29,20 +27,8 @@ io::RosbagContent RosbagFromDataset(const std::string& dir) {
   io::Dataset dataset = io::ReadDataset(dir);
   io::RosbagContent bag;
   bag.sensor = dataset.sensor;
+  bag.labels = io::ReadDatasetLabels(dir, dataset);  // before the beams move out
   bag.beams = std::move(dataset.beams);
-  // A simulated dataset's labels, sweep by sweep (none in a dataset written without them).
-  if (dataset.manifest.value("source", "") == "simulate" &&
-      fs::exists(fs::path(dir) / io::LabelFile(0))) {
-    for (std::size_t s = 0; s < dataset.sweeps; ++s) {
-      const std::string file = (fs::path(dir) / io::LabelFile(s)).string();
-      std::vector<io::BeamLabels> sweep = io::ReadLabelFile(file);
-      std::move(sweep.begin(), sweep.end(), std::back_inserter(bag.labels));
-    }
-    if (bag.labels.size() != bag.beams.size()) {
-      throw InputError(dir + ": the label files hold " + std::to_string(bag.labels.size()) +
-                       " beams, expected one for each of the " + std::to_string(bag.beams.size()));
-    }
-  }
   const fs::path vehicle_file = fs::path(dir) / "poses/vehicle.tum";
   const fs::path sonar_file = fs::path(dir) / "poses/sonar_true.tum";
   if (!fs::exists(vehicle_file) || !fs::exists(sonar_file)) return bag;
@@ -65,27 +51,6 @@ io::RosbagContent RosbagFromDataset(const std::string& dir) {
     bag.true_vehicle.push_back(vehicle[b].pose);
   }
   return bag;
-}
-
-void ClaimExportFile(const std::string& path, bool force, bool ours, const std::string& kind) {
-  std::error_code error;
-  if (fs::exists(path, error) || fs::is_symlink(path, error)) {
-    if (!fs::is_regular_file(path, error)) {
-      throw InputError(path + ": exists and is not a file; choose another --out");
-    }
-    if (!ours) {
-      throw InputError(path + ": exists and is not " + kind +
-                       " sonarbench wrote; sonarbench never replaces it (--force neither): "
-                       "choose another --out");
-    }
-    if (!force) {
-      throw InputError(path + ": exists (" + kind +
-                       " sonarbench wrote); pass --force to replace it");
-    }
-  }
-  const fs::path parent = fs::path(path).parent_path();
-  if (!parent.empty()) CheckOutputDirectory(parent.string());
-  if (!parent.empty()) CreateOutputDirectory(parent.string());
 }
 
 void WriteRosbagFile(const io::RosbagContent& bag, const std::string& path, bool force) {

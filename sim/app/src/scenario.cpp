@@ -47,11 +47,8 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
     };
   };
   // The labels' direct echoes, a check of the score's geometric ones (MapMetrics).
-  DirectEchoes labelled;
   const auto& g = scene.sensor.geometry;
-  labelled.half_width_horizontal_rad = 0.5 * g.beam_width_horizontal_rad;
-  labelled.half_width_vertical_rad = 0.5 * g.beam_width_vertical_rad;
-  labelled.tolerance_m = 0.5 * std::sqrt(3.0) * scene.mapping.resolution_m;
+  DirectEchoes labelled = DirectEchoesOf(g, 0.5 * std::sqrt(3.0) * scene.mapping.resolution_m);
   const auto take_labels = [&](std::span<const SynthesizedBeam> sweep) {
     for (const SynthesizedBeam& beam : sweep) {
       labelled.beams.push_back(
@@ -59,8 +56,8 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
                              g.bin_size_m, labelled.tolerance_m));
     }
   };
-  const std::vector<SynthesizedBeam> synthesized = SimulateScene(
-      scene, tracer, result.seed, result.threads, report("simulate"), take_labels);
+  const std::vector<SynthesizedBeam> synthesized =
+      SimulateScene(scene, tracer, result.seed, result.threads, report("simulate"), take_labels);
   result.beams = synthesized.size();
   result.timings.simulate_s = clock.Lap();
 

@@ -168,40 +168,48 @@ std::vector<std::size_t> DistinctBeams(std::span<const BeamPose> beams, std::vec
   return index;
 }
 
+// Appends [lo, hi] to sorted disjoint `intervals`, merged with the last when they overlap.
+void AppendInterval(std::vector<std::pair<double, double>>& intervals, double lo, double hi) {
+  if (!intervals.empty() && lo <= intervals.back().second) {
+    intervals.back().second = hi;
+  } else {
+    intervals.emplace_back(lo, hi);
+  }
+}
+
 // Sorted ranges [m] merged into disjoint intervals, each widened by `tolerance` on both sides.
 std::vector<std::pair<double, double>> RangeIntervals(std::vector<float>& hits, double tolerance) {
   std::sort(hits.begin(), hits.end());
   std::vector<std::pair<double, double>> intervals;
-  for (const float hit : hits) {
-    const double lo = hit - tolerance;
-    const double hi = hit + tolerance;
-    if (!intervals.empty() && lo <= intervals.back().second) {
-      intervals.back().second = hi;
-    } else {
-      intervals.emplace_back(lo, hi);
-    }
-  }
+  for (const float hit : hits) AppendInterval(intervals, hit - tolerance, hit + tolerance);
   return intervals;
 }
 
+// The head's frame in the world: x along the beam, z up (the sonar's axis).
+Eigen::Matrix3d WorldFromHead(const BeamPose& pose) {
+  return pose.T_world_sonar.linear() *
+         Eigen::AngleAxisd(pose.head_angle_rad, Vector3d::UnitZ()).toRotationMatrix();
+}
+
 }  // namespace
+
+DirectEchoes DirectEchoesOf(const mapping::SensorGeometry& sensor, double tolerance_m) {
+  DirectEchoes direct;
+  direct.half_width_horizontal_rad = 0.5 * sensor.beam_width_horizontal_rad;
+  direct.half_width_vertical_rad = 0.5 * sensor.beam_width_vertical_rad;
+  direct.tolerance_m = tolerance_m;
+  return direct;
+}
 
 DirectEchoes::Beam LabelledDirectBeam(const BeamPose& pose, std::span<const BinLabel> labels,
                                       double bin_size_m, double tolerance_m) {
   DirectEchoes::Beam beam;
   beam.origin = pose.T_world_sonar.translation();
-  beam.world_to_head = (pose.T_world_sonar.linear() *
-                        Eigen::AngleAxisd(pose.head_angle_rad, Vector3d::UnitZ()).toRotationMatrix())
-                           .transpose();
+  beam.world_to_head = WorldFromHead(pose).transpose();
   for (std::size_t k = 0; k < labels.size(); ++k) {
     if (labels[k].mesh == kNoMesh) continue;
-    const double lo = static_cast<double>(k) * bin_size_m - tolerance_m;
-    const double hi = static_cast<double>(k + 1) * bin_size_m + tolerance_m;
-    if (!beam.ranges.empty() && lo <= beam.ranges.back().second) {
-      beam.ranges.back().second = hi;
-    } else {
-      beam.ranges.emplace_back(lo, hi);
-    }
+    AppendInterval(beam.ranges, static_cast<double>(k) * bin_size_m - tolerance_m,
+                   static_cast<double>(k + 1) * bin_size_m + tolerance_m);
   }
   return beam;
 }
@@ -243,10 +251,9 @@ mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer, std::span<const 
   std::size_t distinct = 0;
   const std::vector<std::size_t> index = DistinctBeams(beams, first, distinct);
   if (direct) {
+    *direct = DirectEchoesOf(sensor,
+                             0.5 * std::sqrt(3.0) * key_space.getResolution() + sensor.bin_size_m);
     direct->beams.assign(distinct, {});
-    direct->half_width_horizontal_rad = 0.5 * sensor.beam_width_horizontal_rad;
-    direct->half_width_vertical_rad = 0.5 * sensor.beam_width_vertical_rad;
-    direct->tolerance_m = 0.5 * std::sqrt(3.0) * key_space.getResolution() + sensor.bin_size_m;
   }
   std::vector<mapping::KeySet> per_thread(static_cast<std::size_t>(omp_get_max_threads()));
   const auto count = static_cast<std::int64_t>(beams.size());
@@ -259,9 +266,7 @@ mapping::KeySet ObservableSurfaceCells(const RayTracer& tracer, std::span<const 
     if (!first[static_cast<std::size_t>(b)]) continue;
     const BeamPose& pose = beams[static_cast<std::size_t>(b)];
     mapping::KeySet& cells = per_thread[static_cast<std::size_t>(omp_get_thread_num())];
-    const Eigen::Matrix3d R =
-        pose.T_world_sonar.linear() *
-        Eigen::AngleAxisd(pose.head_angle_rad, Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Matrix3d R = WorldFromHead(pose);
     const Eigen::Vector3f origin = pose.T_world_sonar.translation().cast<float>();
     std::vector<float> hits;
     for (const Vector3d& d : directions) {

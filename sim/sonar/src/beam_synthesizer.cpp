@@ -211,9 +211,8 @@ void BeamSynthesizer::BeamJob::SumEchoes() {
   // reverberation (behind the SHAD's own echo at 0.3 m its beams at head angle 0° are silent
   // from 0.55 m to the floor at 1.45 m), so those are the tank's answers to its own echoes.
   if (s_.vehicle_tracer_) {
-    if (labels_) scratch_.labels.before = echo;
     AddApart(scratch_.vehicle_spreader, false);
-    if (labels_) LabelAdded(EchoPath::kVehicle);
+    if (labels_) LabelPower(EchoPath::kVehicle) = scratch_.apart_power;  // what AddApart added
   }
 }
 

@@ -35,8 +35,9 @@ MeshEstimate EstimateMesh(const MeshSpec& spec) {
       break;
     case MeshSpec::Type::kHeightField:
       // As BuildMesh grids it: at least one cell each way.
-      e = {2 * std::max(1.0, s[0] / spec.height_field.cell_m) * std::max(1.0, s[1] / spec.height_field.cell_m), s[0] * s[1],
-           0, "cell_m"};
+      e = {2 * std::max(1.0, s[0] / spec.height_field.cell_m) *
+               std::max(1.0, s[1] / spec.height_field.cell_m),
+           s[0] * s[1], 0, "cell_m"};
       break;
     case MeshSpec::Type::kFile: {
       e.triangles = static_cast<double>(spec.file.triangles.size());

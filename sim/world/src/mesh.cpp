@@ -26,20 +26,24 @@ void AddHeightField(TriangleMesh& mesh, const MeshSpec& spec, std::uint64_t seed
   const double hx = 0.5 * spec.size_m[0];
   const double hy = 0.5 * spec.size_m[1];
   // CheckBudgets refuses far fewer cells; this keeps the int conversions defined.
-  if (!(spec.size_m[0] / spec.height_field.cell_m < 1e7 && spec.size_m[1] / spec.height_field.cell_m < 1e7)) {
-    throw InputError("mesh '" + spec.name + "': 'cell_m' " + std::to_string(spec.height_field.cell_m) +
+  if (!(spec.size_m[0] / spec.height_field.cell_m < 1e7 &&
+        spec.size_m[1] / spec.height_field.cell_m < 1e7)) {
+    throw InputError("mesh '" + spec.name + "': 'cell_m' " +
+                     std::to_string(spec.height_field.cell_m) +
                      " makes over 1e7 cells a side (expected a coarser grid)");
   }
-  const int nx = std::max(1, static_cast<int>(std::lround(spec.size_m[0] / spec.height_field.cell_m)));
-  const int ny = std::max(1, static_cast<int>(std::lround(spec.size_m[1] / spec.height_field.cell_m)));
+  const int nx =
+      std::max(1, static_cast<int>(std::lround(spec.size_m[0] / spec.height_field.cell_m)));
+  const int ny =
+      std::max(1, static_cast<int>(std::lround(spec.size_m[1] / spec.height_field.cell_m)));
   const double k = 2.0 * std::numbers::pi / spec.height_field.wavelength_m;
   for (int j = 0; j <= ny; ++j) {
     for (int i = 0; i <= nx; ++i) {
       const double x = -hx + spec.size_m[0] * i / nx;
       const double y = -hy + spec.size_m[1] * j / ny;
       Rng rng(DeriveSeed(seed, static_cast<std::uint64_t>(j) * (nx + 1) + i));
-      const double z =
-          spec.height_field.amplitude_m * std::sin(k * x) * std::cos(k * y) + spec.height_field.roughness_m * rng.Normal();
+      const double z = spec.height_field.amplitude_m * std::sin(k * x) * std::cos(k * y) +
+                       spec.height_field.roughness_m * rng.Normal();
       mesh.vertices.push_back((T * Eigen::Vector3d(x, y, z)).cast<float>());
     }
   }
@@ -93,7 +97,8 @@ TriangleMesh BuildMesh(const MeshSpec& spec, std::uint64_t seed) {
     case MeshSpec::Type::kFile:
       for (const Eigen::Vector3d& v : spec.file.vertices) {
         mesh.vertices.push_back(
-            p(spec.file.scale[0] * v.x(), spec.file.scale[1] * v.y(), spec.file.scale[2] * v.z()).cast<float>());
+            p(spec.file.scale[0] * v.x(), spec.file.scale[1] * v.y(), spec.file.scale[2] * v.z())
+                .cast<float>());
       }
       mesh.triangles = spec.file.triangles;
       break;
@@ -162,8 +167,9 @@ std::vector<TriangleMesh> BuildMeshes(const Scene& scene, const std::vector<Mesh
     const MeshSpec& spec = specs[i];
     meshes.push_back(BuildMesh(spec, DeriveSeed(scene.seed, seed_base + i)));
     meshes.back().name = spec.name;
-    const std::string where = scene.file + ": mesh '" + spec.name + "'" +
-                              (spec.file.path.empty() ? std::string() : " (" + spec.file.path + ")");
+    const std::string where =
+        scene.file + ": mesh '" + spec.name + "'" +
+        (spec.file.path.empty() ? std::string() : " (" + spec.file.path + ")");
     TriangleMesh& mesh = meshes.back();
     mesh.check = CheckMesh(mesh, where);
     mesh.fill = spec.fill;

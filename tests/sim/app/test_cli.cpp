@@ -191,7 +191,8 @@ TEST(Cli, MessagesNameWhatToDoNext) {
   const auto bag = dir.path() / "ds.mcap";
   ASSERT_EQ(RunCli("export " + ds.string() + " --out " + bag.string(), &output), 0) << output;
   EXPECT_EQ(RunCli("export " + ds.string() + " --out " + bag.string(), &output), 2);
-  EXPECT_NE(output.find("an MCAP file sonarbench wrote); pass --force"), std::string::npos) << output;
+  EXPECT_NE(output.find("an MCAP file sonarbench wrote); pass --force"), std::string::npos)
+      << output;
   EXPECT_EQ(RunCli("import " + bag.string() + " --topic /nope --out " + (dir.path() / "i").string(),
                    &output),
             2);

@@ -148,8 +148,8 @@ TEST_F(TankDataset, ReadsBackTheSimulatedBeamsAndPoses) {
       io::ReadLabelFile((out / "truth/labels_0001.bin").string());
   ASSERT_EQ(labels.size(), 200u);
   const sim::BeamSynthesizer synthesizer = sim::SceneSynthesizer(*scene_, tracer, scene_->seed);
-  const auto beam = sim::SimulateBeams(*scene_, synthesizer, scene_->seed, 1, 388, 389,
-                                       sim::Labels::kKeep);
+  const auto beam =
+      sim::SimulateBeams(*scene_, synthesizer, scene_->seed, 1, 388, 389, sim::Labels::kKeep);
   const io::BeamLabels& read = labels[188];
   ASSERT_EQ(read.shares.size(), beam[0].labels.size());
   std::size_t direct_bins = 0;

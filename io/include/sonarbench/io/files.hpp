@@ -16,6 +16,11 @@ void CheckOutputDirectory(const std::string& dir);
 /// it cannot be (a file in the way, no permission).
 void CreateOutputDirectory(const std::string& dir);
 
+/// Refuses `path` as an exported file unless it is absent, or, with `force`, a file of `kind`
+/// ("an MCAP file") that sonarbench wrote (`ours`): throws InputError naming it. Readies its
+/// folder.
+void ClaimExportFile(const std::string& path, bool force, bool ours, const std::string& kind);
+
 /// The most the readers take from one file, checked before they allocate (bytes).
 /// A YAML file: a scene, a sensor model, a mapping configuration (yaml-cpp takes ~100x its size).
 inline constexpr std::uint64_t kMaxYamlBytes = std::uint64_t{2} << 20;

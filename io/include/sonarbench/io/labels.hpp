@@ -9,6 +9,8 @@
 #include <string_view>
 #include <vector>
 
+#include "sonarbench/io/dataset.hpp"
+
 namespace sonarbench::io {
 
 /// The paths a range bin's echo energy arrives by, in the label file's order
@@ -50,6 +52,12 @@ struct BeamLabels {
 /// Writes one sweep's labels: a zstd frame of the little-endian layout of
 /// docs/dataset-format.md ("SBLABEL1", beam count, path count, then per beam its bins).
 void WriteLabelFile(const std::string& path, std::span<const BeamLabels> beams);
+/// A dataset's labels, beam by beam (every sweep's label file in turn), when its manifest lists
+/// them (a simulated dataset); none otherwise. Throws InputError as ReadLabelFile does, or when
+/// they do not hold one beam for each of `dataset`'s.
+[[nodiscard]] std::vector<BeamLabels> ReadDatasetLabels(const std::string& dir,
+                                                        const Dataset& dataset);
+
 /// Reads a label file; throws InputError naming `path` on a bad frame, magic or size, before
 /// allocating more than the frame says it holds (itself refused over 1 GiB).
 [[nodiscard]] std::vector<BeamLabels> ReadLabelFile(const std::string& path);

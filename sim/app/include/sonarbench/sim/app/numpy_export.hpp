@@ -13,8 +13,4 @@ namespace sonarbench::sim {
 /// `force`. Throws InputError as io::ReadDataset does.
 void WriteNpzFromDataset(const std::string& dir, const std::string& path, bool force);
 
-/// Refuses `path` for an export unless it is absent, or with `force` a file of `kind` that
-/// sonarbench wrote (`ours`); readies its folder.
-void ClaimExportFile(const std::string& path, bool force, bool ours, const std::string& kind);
-
 }  // namespace sonarbench::sim

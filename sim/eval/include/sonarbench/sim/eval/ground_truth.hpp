@@ -50,6 +50,10 @@ struct DirectEchoes {
   [[nodiscard]] bool Explains(const Eigen::Vector3d& centre, double cell_half_diagonal_m) const;
 };
 
+/// No beams yet, the apertures of `sensor`'s beams and `tolerance_m` [m].
+[[nodiscard]] DirectEchoes DirectEchoesOf(const mapping::SensorGeometry& sensor,
+                                          double tolerance_m);
+
 /// A beam's direct echoes as the simulator's labels name them: the bins a main-lobe return of a
 /// scene surface is heard in (BinLabel::mesh), each widened by `tolerance_m` on both sides. Its
 /// pose is `pose`'s. Add it to a DirectEchoes whose widths and tolerance are the sensor's.
