@@ -123,26 +123,45 @@ struct OneWayPattern {
   }
 };
 
-// A direct return of the main lobe, for the labels: its range [m], its power after the range
-// loss, its mesh and its ray's direction (world frame).
-struct DirectReturn {
-  double range = 0.0;
-  double power = 0.0;
-  std::uint32_t mesh = 0;
-  Eigen::Vector3f direction;
+// One scene mesh's main-lobe direct returns in a beam, for the labels: their power per bin,
+// and per start bin (the bin the return's range falls in) the strongest's power after the range
+// loss and its point relative to the sonar (world frame, m). Emptied by the beam's labels.
+struct MeshDirect {
+  PulseSpreader spreader;
+  std::vector<double> power;
+  std::vector<double> strongest;
+  std::vector<Eigen::Vector3f> point;
 };
 
-// The labels' working memory (Labels::kKeep): the scene's echoes by path (direct, sidelobe,
-// multipath), the main lobe's direct returns, each path's power per bin, each bin's receiver
-// noise, and the direct power per bin and scene mesh (bin-major) with the strongest return.
+// The labels' working memory (Labels::kKeep): the scene's echoes off the main lobe's direct
+// path (sidelobe, multipath); the direct path's by mesh, each mesh met in the beam given a slot;
+// each path's power per bin, and the echo before a step that adds one.
 struct LabelScratch {
-  std::array<PulseSpreader, 3> spreaders;
-  std::vector<DirectReturn> direct_returns;
+  std::array<PulseSpreader, 2> spreaders;  // sidelobe, multipath
+  std::vector<MeshDirect> meshes;          // by slot
+  std::vector<std::int32_t> slot_of_mesh;  // -1: not met in this beam
+  std::vector<std::uint32_t> mesh_of_slot;
   std::array<std::vector<double>, kEchoPaths> power;
   std::vector<double> before;
-  std::vector<double> mesh_power;
-  std::vector<double> mesh_strongest;  // per bin and mesh, its strongest return's power
-  std::vector<std::size_t> strongest;  // and that return's index
+  std::vector<double> factor;  // each bin's gain × speckle
+  std::size_t bins = 0;
+
+  // A main-lobe direct return: `echo`, its power after the range loss, per bin over [start,
+  // end) bins, from mesh `mesh` at `point` relative to the sonar (world frame, m).
+  [[gnu::always_inline]] void AddDirect(double start, double end, double echo, std::uint32_t mesh,
+                                        const Eigen::Vector3f& point) {
+    std::int32_t slot = slot_of_mesh[mesh];
+    if (slot < 0) slot = NewSlot(mesh);
+    MeshDirect& m = meshes[static_cast<std::size_t>(slot)];
+    m.spreader.Add(start, end, echo);
+    if (!(start < static_cast<double>(m.strongest.size()))) return;
+    const auto k = static_cast<std::size_t>(start);
+    if (echo > m.strongest[k]) {
+      m.strongest[k] = echo;
+      m.point[k] = point;
+    }
+  }
+  std::int32_t NewSlot(std::uint32_t mesh);
 };
 
 // Synthesize()'s working memory, one per thread, kept between beams: a beam allocates only its
@@ -226,6 +245,7 @@ class BeamSynthesizer::BeamJob {
   void LabelScenePaths();
   void LabelAdded(EchoPath path);
   void FinishLabels(std::span<const double> self_reflection);
+  void LabelMeshes();
   [[nodiscard]] std::vector<double>& LabelPower(EchoPath path) {
     return scratch_.labels.power[static_cast<std::size_t>(path)];
   }
@@ -260,7 +280,8 @@ class BeamSynthesizer::BeamJob {
     return {s_.receiver_,          g_, a_.pulse.length_m, false, scratch_.vehicle_spreader,
             scratch_.impulse_power};
   }
-  // The labels' echoes of one path (0 direct, 1 sidelobe, 2 multipath): the pulse alone.
+  // The labels' echoes of one path off the main lobe's direct one (0 sidelobe, 1 multipath):
+  // the pulse alone.
   EchoDeposit PathDeposit(std::size_t path) {
     return {s_.receiver_,          g_, a_.pulse.length_m, false, scratch_.labels.spreaders[path],
             scratch_.impulse_power};

@@ -119,8 +119,9 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
   EchoDeposit deposit = Deposit();
   EchoDeposit vehicle_deposit = VehicleDeposit();
   EchoDeposit glint_deposit = GlintDeposit();
-  EchoDeposit direct_deposit = PathDeposit(0);
-  EchoDeposit sidelobe_deposit = PathDeposit(1);
+  EchoDeposit sidelobe_deposit = PathDeposit(0);
+  const double bins_per_m = 1.0 / g_.bin_size_m;
+  const double pulse_bins = a_.pulse.length_m * bins_per_m;
   for (std::size_t r = 0; r < rays; ++r) {
     const auto& hit = hits[r];
     if (!hit) continue;
@@ -145,10 +146,10 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
       deposit(range, diffuse);
       if (glint > 0.0) glint_deposit(range, glint);
       if (labels_ && r < main_lobe_rays) {
-        direct_deposit(range, diffuse + glint);
-        scratch_.labels.direct_returns.push_back(
-            {range, (diffuse + glint) * s_.receiver_.RangeLossFromTable(range), hit->mesh,
-             direction});
+        const double start = range * bins_per_m;
+        scratch_.labels.AddDirect(start, start + pulse_bins,
+                                  (diffuse + glint) * s_.receiver_.RangeLossFromTable(range),
+                                  hit->mesh, static_cast<float>(range) * direction);
       } else if (labels_) {
         sidelobe_deposit(range, diffuse + glint);
       }

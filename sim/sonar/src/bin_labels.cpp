@@ -9,9 +9,10 @@ namespace sonarbench::sim {
 
 namespace {
 
-// The spreaders' paths, in LabelScratch::spreaders' order.
-constexpr std::array<EchoPath, 3> kSpreaderPaths = {EchoPath::kDirect, EchoPath::kSidelobe,
-                                                    EchoPath::kMultipath};
+// The paths of the scene's echoes as the rays deposit them, before their share of the rays'
+// weights (BeamJob::weight_sum_).
+constexpr std::array<EchoPath, 3> kScenePaths = {EchoPath::kDirect, EchoPath::kSidelobe,
+                                                 EchoPath::kMultipath};
 
 }  // namespace
 
@@ -22,16 +23,40 @@ void BeamSynthesizer::BeamJob::StartLabels() {
     if (spreader.Bins() != bins_) spreader.Reset(bins_);
   }
   for (std::vector<double>& power : l.power) power.assign(bins_, 0.0);
-  l.direct_returns.clear();
+  l.bins = bins_;
+  l.slot_of_mesh.assign(s_.vehicle_first_mesh_, -1);
+  l.mesh_of_slot.clear();
+}
+
+std::int32_t LabelScratch::NewSlot(std::uint32_t mesh) {
+  const std::size_t slot = mesh_of_slot.size();
+  mesh_of_slot.push_back(mesh);
+  if (meshes.size() == slot) meshes.emplace_back();
+  MeshDirect& m = meshes[slot];
+  if (m.spreader.Bins() != bins) m.spreader.Reset(bins);
+  m.strongest.assign(bins, 0.0);
+  m.point.resize(bins);
+  slot_of_mesh[mesh] = static_cast<std::int32_t>(slot);
+  return static_cast<std::int32_t>(slot);
 }
 
 void BeamSynthesizer::BeamJob::LabelScenePaths() {
   LabelScratch& l = scratch_.labels;
-  for (std::size_t i = 0; i < kSpreaderPaths.size(); ++i) {
-    std::vector<double>& power = LabelPower(kSpreaderPaths[i]);
-    l.spreaders[i].AddTo(power);
-    for (double& p : power) p /= weight_sum_;
-    AddPulseSkirts(s_.sensor_, power);
+  std::vector<double>& direct = LabelPower(EchoPath::kDirect);
+  for (std::size_t slot = 0; slot < l.mesh_of_slot.size(); ++slot) {
+    MeshDirect& m = l.meshes[slot];
+    m.power.assign(bins_, 0.0);
+    m.spreader.AddTo(m.power);
+    for (std::size_t k = 0; k < bins_; ++k) direct[k] += m.power[k];
+  }
+  l.spreaders[0].AddTo(LabelPower(EchoPath::kSidelobe));
+  l.spreaders[1].AddTo(LabelPower(EchoPath::kMultipath));
+  // Their skirts here, their share of the rays' weights in FinishLabels (both linear).
+  for (const EchoPath path : kScenePaths) {
+    std::vector<double>& power = LabelPower(path);
+    if (std::any_of(power.begin(), power.end(), [](double p) { return p != 0.0; })) {
+      AddPulseSkirts(s_.sensor_, power);
+    }
   }
 }
 
@@ -39,7 +64,7 @@ void BeamSynthesizer::BeamJob::LabelAdded(EchoPath path) {
   std::vector<double>& power = LabelPower(path);
   const std::vector<double>& before = scratch_.labels.before;
   const std::vector<double>& echo = scratch_.echo_power;
-  for (std::size_t k = 0; k < bins_; ++k) power[k] += echo[k] - before[k];
+  for (std::size_t k = 0; k < bins_; ++k) power[k] = echo[k] - before[k];
 }
 
 void BeamSynthesizer::BeamJob::FinishLabels(std::span<const double> self_reflection) {
@@ -47,51 +72,59 @@ void BeamSynthesizer::BeamJob::FinishLabels(std::span<const double> self_reflect
   std::vector<BinLabel>& labels = out_.labels;
   labels.assign(bins_, BinLabel{});
   const double gain = std::pow(10.0, a_.gain.gain_db / 10.0);
-  for (std::size_t k = 0; k < bins_; ++k) {
-    const double factor = a_.speckle.on ? gain * scratch_.speckle[k] : gain;
-    const double self = k < self_reflection.size() ? self_reflection[k] : 0.0;
-    for (std::size_t p = 0; p < kEchoPaths; ++p) {
-      const auto path = static_cast<EchoPath>(p);
-      const double power = path == EchoPath::kNoise ? l.power[p][k] : l.power[p][k] * factor;
-      labels[k].energy[p] = static_cast<float>(path == EchoPath::kVehicle ? power + self : power);
+  l.factor.assign(bins_, gain);
+  if (a_.speckle.on) {
+    for (std::size_t k = 0; k < bins_; ++k) l.factor[k] *= scratch_.speckle[k];
+  }
+  std::vector<double>& vehicle = LabelPower(EchoPath::kVehicle);
+  for (std::size_t p = 0; p < kEchoPaths; ++p) {
+    const std::vector<double>& power = l.power[p];
+    const auto path = static_cast<EchoPath>(p);
+    if (path == EchoPath::kNoise) {
+      for (std::size_t k = 0; k < bins_; ++k) labels[k].energy[p] = static_cast<float>(power[k]);
+      continue;
+    }
+    const bool rays = std::find(kScenePaths.begin(), kScenePaths.end(), path) != kScenePaths.end();
+    const double share = rays ? 1.0 / weight_sum_ : 1.0;
+    for (std::size_t k = 0; k < bins_; ++k) {
+      labels[k].energy[p] = static_cast<float>(power[k] * share * l.factor[k]);
     }
   }
-  // Each bin's direct power by mesh, from the returns whose pulse covers it, and each mesh's
-  // strongest there, in one pass; the bin's mesh the one with the most, its point that mesh's
-  // strongest return's.
-  const std::size_t meshes = s_.vehicle_first_mesh_;
-  if (meshes == 0) return;
-  l.mesh_power.assign(bins_ * meshes, 0.0);
-  l.mesh_strongest.assign(bins_ * meshes, 0.0);
-  l.strongest.resize(bins_ * meshes);
-  const double bins_per_m = 1.0 / g_.bin_size_m;
-  const double pulse_bins = a_.pulse.length_m * bins_per_m;
-  for (std::size_t i = 0; i < l.direct_returns.size(); ++i) {
-    const DirectReturn& r = l.direct_returns[i];
-    const double start = r.range * bins_per_m;
-    const double end = start + pulse_bins;
-    const auto last = std::min(bins_, static_cast<std::size_t>(std::ceil(end)));
-    for (auto k = static_cast<std::size_t>(start); k < last; ++k) {
-      const double covered =
-          std::min(end, static_cast<double>(k + 1)) - std::max(start, static_cast<double>(k));
-      const double power = r.power * covered;
-      const std::size_t at = k * meshes + r.mesh;
-      l.mesh_power[at] += power;
-      if (power > l.mesh_strongest[at]) {
-        l.mesh_strongest[at] = power;
-        l.strongest[at] = i;
+  const std::size_t selves = std::min(bins_, self_reflection.size());
+  const auto v = static_cast<std::size_t>(EchoPath::kVehicle);
+  for (std::size_t k = 0; k < selves; ++k) {
+    labels[k].energy[v] = static_cast<float>(vehicle[k] * l.factor[k] + self_reflection[k]);
+  }
+  LabelMeshes();
+}
+
+// Each bin's mesh: the one with the most main-lobe direct power in it; its point: that mesh's
+// strongest return starting from a pulse length (whole bins) before the bin to the bin's end.
+void BeamSynthesizer::BeamJob::LabelMeshes() {
+  const LabelScratch& l = scratch_.labels;
+  const std::size_t slots = l.mesh_of_slot.size();
+  if (slots == 0) return;
+  const auto window = static_cast<std::size_t>(std::ceil(a_.pulse.length_m / g_.bin_size_m - 1e-9));
+  const Eigen::Matrix3f R_sonar_world = T_world_sonar_.linear().transpose().cast<float>();
+  std::vector<BinLabel>& labels = out_.labels;
+  for (std::size_t k = 0; k < bins_; ++k) {
+    std::size_t best = slots;
+    double most = 0.0;
+    for (std::size_t slot = 0; slot < slots; ++slot) {
+      if (l.meshes[slot].power[k] > most) {
+        most = l.meshes[slot].power[k];
+        best = slot;
       }
     }
-  }
-  const Eigen::Matrix3f R_sonar_world = T_world_sonar_.linear().transpose().cast<float>();
-  for (std::size_t k = 0; k < bins_; ++k) {
-    const auto first = l.mesh_power.begin() + static_cast<std::ptrdiff_t>(k * meshes);
-    const auto most = std::max_element(first, first + static_cast<std::ptrdiff_t>(meshes));
-    if (!(*most > 0.0)) continue;
-    const auto mesh = static_cast<std::size_t>(most - first);
-    labels[k].mesh = static_cast<std::uint32_t>(mesh);
-    const DirectReturn& r = l.direct_returns[l.strongest[k * meshes + mesh]];
-    labels[k].point_sonar_m = static_cast<float>(r.range) * (R_sonar_world * r.direction);
+    if (best == slots) continue;
+    const MeshDirect& m = l.meshes[best];
+    std::size_t from = k >= window ? k - window : 0;
+    for (std::size_t j = from + 1; j <= k; ++j) {
+      if (m.strongest[j] > m.strongest[from]) from = j;
+    }
+    if (!(m.strongest[from] > 0.0)) continue;  // a rounding residue past the pulse's end
+    labels[k].mesh = l.mesh_of_slot[best];
+    labels[k].point_sonar_m = R_sonar_world * m.point[from];
   }
 }
 

@@ -127,7 +127,7 @@ void BeamSynthesizer::BeamJob::HearMirrorPaths(const OneWayPattern& one_way_patt
   const double max_range = max_range_;
   EchoDeposit deposit = Deposit();
   EchoDeposit glint_deposit = GlintDeposit();
-  EchoDeposit label_deposit = PathDeposit(2);
+  EchoDeposit label_deposit = PathDeposit(1);
   std::vector<MirrorPath>& paths = scratch_.paths;
   const std::vector<MirrorPath>& next_paths = scratch_.next_paths;
   const std::vector<std::optional<Hit>>& hits = scratch_.hits;
@@ -198,7 +198,7 @@ void BeamSynthesizer::BeamJob::QueueStraightReturn(const MirrorPath& was, const 
 void BeamSynthesizer::BeamJob::HearStraightReturns() {
   EchoDeposit deposit = Deposit();
   EchoDeposit glint_deposit = GlintDeposit();
-  EchoDeposit label_deposit = PathDeposit(2);
+  EchoDeposit label_deposit = PathDeposit(1);
   const std::vector<StraightReturn>& returns = scratch_.returns;
   s_.tracer_.OccludedStream(scratch_.rays, scratch_.occluded);
   out_.traced_rays += scratch_.rays.size();

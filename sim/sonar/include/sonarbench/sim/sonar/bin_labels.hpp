@@ -25,8 +25,9 @@ inline constexpr std::uint32_t kNoMesh = std::numeric_limits<std::uint32_t>::max
 
 /// One range bin's truth: its power before the converter split by path (linear, the units of the
 /// receiver's power, in float; their sum is the bin's power), the scene mesh with the most direct
-/// energy in it, and that mesh's strongest direct return whose pulse covers the bin: its point in
-/// the sonar frame [m] (kNoMesh and NaN without one), at elevation asin(z / |p|) in the beam.
+/// energy in it, and that mesh's strongest direct return starting from a pulse length (whole
+/// bins) before the bin to the bin's end: its point in the sonar frame [m] (kNoMesh and NaN
+/// without one), at elevation asin(z / |p|) in the beam.
 struct BinLabel {
   std::array<float, kEchoPaths> energy{};
   std::uint32_t mesh = kNoMesh;
