@@ -8,8 +8,15 @@ median peak of the smoothed echo, and what each hypothesis predicts: a wall hear
 incidence (its perpendicular range) and the corner itself (a corner reflector returns at the
 edge's range).
 
+With --walls, also each wall at normal incidence, over the beams within --window degrees of its
+normal: where the echo starts in front of the wall (walking back from the strongest bin of the
+beams' mean while the mean stays at or above --ramp-level) and, beam by beam, the median number of
+bins in the run around the strongest bin at or above 110, 130 and 150 (the detector's
+thresholds): how long the wall's echo is, and what a step or fillet at its foot would add.
+
     python3 tools/corner_echoes.py DIR [DIR ...] --tank 4.36 4.48 --sonar 0.10 0.48
                                    [--threshold 110 --smoothing 5 --min-run 3 --window 4]
+                                   [--walls --ramp-level 40]
 
 DIR is a dataset (`sonarbench import LOG.mat` or `sonarbench simulate SCENE`); the tank is
 centred on the origin, its walls square to x and y; --sonar is the sonar's x y in that frame
@@ -64,6 +71,40 @@ def first_echo(row, first, threshold, smoothing, min_run):
     return None
 
 
+def run_width(row, first, level):
+    """Bins in the run at or above `level` around the row's strongest bin past `first`."""
+    top = max(range(first, len(row)), key=lambda k: row[k])
+    if row[top] < level:
+        return 0
+    lo, hi = top, top
+    while lo > first and row[lo - 1] >= level:
+        lo -= 1
+    while hi + 1 < len(row) and row[hi + 1] >= level:
+        hi += 1
+    return hi - lo + 1
+
+
+def walls(directory, all_beams, bin_size, first_bin, args, hx, hy):
+    """Prints each wall's line (--walls)."""
+    sx, sy = args.sonar
+    for name, bearing, normal in (("E", 0.0, hx - sx), ("N", 90.0, hy - sy),
+                                  ("W", 180.0, hx + sx), ("S", 270.0, hy + sy)):
+        rows = [row for head, row in all_beams
+                if abs((head - bearing + 180.0) % 360.0 - 180.0) <= args.window]
+        if not rows:
+            print(f"{directory} {name} {bearing:.0f} {normal:.3f} - - - 0")
+            continue
+        bins = min(len(row) for row in rows)
+        mean = [sum(row[k] for row in rows) / len(rows) for k in range(bins)]
+        k = max(range(first_bin, bins), key=lambda j: mean[j])
+        while k > first_bin and mean[k - 1] >= args.ramp_level:
+            k -= 1
+        widths = "/".join(f"{statistics.median(run_width(row, first_bin, level) for row in rows):.0f}"
+                          for level in (110, 130, 150))
+        print(f"{directory} {name} {bearing:.0f} {normal:.3f} {(k + 0.5) * bin_size:.3f} "
+              f"{normal - (k + 0.5) * bin_size:.3f} {widths} {len(rows)}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("dirs", nargs="+")
@@ -73,14 +114,18 @@ def main():
     parser.add_argument("--smoothing", type=int, default=5)
     parser.add_argument("--min-run", type=int, default=3)
     parser.add_argument("--window", type=float, default=4.0)
+    parser.add_argument("--walls", action="store_true")
+    parser.add_argument("--ramp-level", type=float, default=40)
     args = parser.parse_args()
     hx, hy = args.tank[0] / 2, args.tank[1] / 2
     sx, sy = args.sonar
     print("dataset corner bearing_deg edge_m first_echo_m in_front_m peak walls_normal_m beams")
+    datasets = []
     for directory in args.dirs:
         manifest = json.load(open(os.path.join(directory, "manifest.json")))
         all_beams, bin_size = beams(directory)
         first_bin = math.ceil(manifest["sensor"]["self_reflection_range_m"] / bin_size - 1e-9)
+        datasets.append((directory, all_beams, bin_size, first_bin))
         for name, cx, cy in (("NE", hx, hy), ("NW", -hx, hy), ("SW", -hx, -hy), ("SE", hx, -hy)):
             dx, dy = cx - sx, cy - sy
             bearing = math.degrees(math.atan2(dy, dx)) % 360.0
@@ -101,6 +146,11 @@ def main():
             print(f"{directory} {name} {bearing:.1f} {edge:.3f} {r:.3f} {edge - r:.3f} "
                   f"{statistics.median(peaks):.0f} {abs(dx):.2f}/{abs(dy):.2f} "
                   f"{len(ranges)}/{total}")
+    if args.walls:
+        print("dataset wall bearing_deg normal_m echo_starts_m in_front_m "
+              "run_bins_110/130/150 beams")
+        for directory, all_beams, bin_size, first_bin in datasets:
+            walls(directory, all_beams, bin_size, first_bin, args, hx, hy)
 
 
 if __name__ == "__main__":
