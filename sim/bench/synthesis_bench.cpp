@@ -65,8 +65,8 @@ constexpr std::uint64_t kSeed = 1;
 
 // One sweep of `scene`, as SimulateScene makes it, with a synthesizer built beforehand.
 std::vector<SynthesizedBeam> SimulateSweep(const Scene& scene, const BeamSynthesizer& synthesizer,
-                                           int threads, Labels labels = Labels::kDrop) {
-  return SimulateBeams(scene, synthesizer, kSeed, threads, 0, ScenarioBeamCount(scene), labels);
+                                           int threads) {
+  return SimulateBeams(scene, synthesizer, kSeed, threads, 0, ScenarioBeamCount(scene));
 }
 
 // One sweep's primary rays, drawn as the synthesis draws them (BeamPattern::DrawRays: the
@@ -271,13 +271,15 @@ void BM_Synthesis(benchmark::State& state, const std::string& file) {
 }
 
 // The same on one thread, with and without the bins' labels (a dataset's): their cost is the
-// ratio of the two.
+// ratio of the two. Each sweep into the last one's memory, as `simulate` writes a dataset.
 void BM_SynthesisLabels(benchmark::State& state, const std::string& file, Labels labels) {
   const BenchScene& bench = TheSetup(file).bench;
   const BeamSynthesizer synthesizer = SceneSynthesizer(bench.scene, bench.tracer, kSeed);
+  std::vector<SynthesizedBeam> beams;
   for (auto _ : state) {
-    auto beams = SimulateSweep(bench.scene, synthesizer, 1, labels);
-    benchmark::DoNotOptimize(beams);
+    SimulateBeamsInto(bench.scene, synthesizer, kSeed, 1, 0, ScenarioBeamCount(bench.scene), labels,
+                      beams);
+    benchmark::DoNotOptimize(beams.data());
   }
   state.counters["rays/s"] = benchmark::Counter(
       PrimaryRaysPerSweep(bench.scene) * state.iterations(), benchmark::Counter::kIsRate);

@@ -387,14 +387,14 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
                                ? (summary.sweeps_total - first_sweep + stride - 1) / stride
                                : 0;
   std::size_t handled = 0;
+  std::vector<SynthesizedBeam> synthesized;  // a sweep's, its memory kept for the next
   for (std::size_t s = first_sweep; s < summary.sweeps_total; s += stride) {
     if (SweepComplete(root, s, true)) {
       ++summary.sweeps_skipped;
     } else {
       const std::size_t first = s * per_sweep;
-      const auto synthesized =
-          SimulateBeams(scene, synthesizer, seed, options.threads, first,
-                        std::min(beam_count, first + per_sweep), Labels::kKeep);
+      SimulateBeamsInto(scene, synthesizer, seed, options.threads, first,
+                        std::min(beam_count, first + per_sweep), Labels::kKeep, synthesized);
       const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
       WriteBeams(root / io::SweepFile("beams", s, "bin"), beams);
       WriteText(root / io::SweepFile("truth", s, "csv"), TruthCsv(synthesized, first, scene));

@@ -143,7 +143,6 @@ struct LabelScratch {
   std::vector<std::uint32_t> mesh_of_slot;
   std::array<std::vector<double>, kEchoPaths> power;
   std::vector<double> before;
-  std::vector<double> factor;  // each bin's gain × speckle
   std::size_t bins = 0;
 
   // A main-lobe direct return: `echo`, its power after the range loss, per bin over [start,

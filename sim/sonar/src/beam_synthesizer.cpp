@@ -270,6 +270,24 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
                                             std::uint64_t seed, EchoPower echo_power,
                                             Labels labels) const {
   SynthesizedBeam out;
+  SynthesizeInto(time_s, head_angle_rad, T_world_sonar, seed, echo_power, labels, out);
+  return out;
+}
+
+void BeamSynthesizer::SynthesizeInto(double time_s, double head_angle_rad,
+                                     const Eigen::Isometry3d& T_world_sonar, std::uint64_t seed,
+                                     EchoPower echo_power, Labels labels,
+                                     SynthesizedBeam& out) const {
+  std::vector<std::uint8_t> intensities = std::move(out.beam.intensities);
+  std::vector<double> power = std::move(out.echo_power);
+  std::vector<BinLabel> bin_labels = std::move(out.labels);
+  out = SynthesizedBeam{};
+  intensities.clear();
+  power.clear();
+  bin_labels.clear();
+  out.beam.intensities = std::move(intensities);
+  out.echo_power = std::move(power);
+  out.labels = std::move(bin_labels);
   out.beam.time_s = time_s;
   out.beam.head_angle_rad = head_angle_rad;
   out.beam.T_world_sonar = T_world_sonar;
@@ -281,7 +299,6 @@ SynthesizedBeam BeamSynthesizer::Synthesize(double time_s, double head_angle_rad
   job.TracePrimaries();
   job.TraceMultipath();
   job.FormLevels(echo_power);
-  return out;
 }
 
 }  // namespace sonarbench::sim

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "beam_job.hpp"
 
@@ -70,30 +71,31 @@ void BeamSynthesizer::BeamJob::LabelAdded(EchoPath path) {
 void BeamSynthesizer::BeamJob::FinishLabels(std::span<const double> self_reflection) {
   LabelScratch& l = scratch_.labels;
   std::vector<BinLabel>& labels = out_.labels;
-  labels.assign(bins_, BinLabel{});
+  labels.resize(bins_);
   const double gain = std::pow(10.0, a_.gain.gain_db / 10.0);
-  l.factor.assign(bins_, gain);
-  if (a_.speckle.on) {
-    for (std::size_t k = 0; k < bins_; ++k) l.factor[k] *= scratch_.speckle[k];
-  }
-  std::vector<double>& vehicle = LabelPower(EchoPath::kVehicle);
+  // Each path's factor: the gain (and the rays' weight share for the scene's rays' paths), the
+  // speckle per bin after; the noise as drawn.
+  std::array<double, kEchoPaths> scale{};
   for (std::size_t p = 0; p < kEchoPaths; ++p) {
-    const std::vector<double>& power = l.power[p];
     const auto path = static_cast<EchoPath>(p);
-    if (path == EchoPath::kNoise) {
-      for (std::size_t k = 0; k < bins_; ++k) labels[k].energy[p] = static_cast<float>(power[k]);
-      continue;
-    }
     const bool rays = std::find(kScenePaths.begin(), kScenePaths.end(), path) != kScenePaths.end();
-    const double share = rays ? 1.0 / weight_sum_ : 1.0;
-    for (std::size_t k = 0; k < bins_; ++k) {
-      labels[k].energy[p] = static_cast<float>(power[k] * share * l.factor[k]);
-    }
+    scale[p] = rays ? gain / weight_sum_ : gain;
   }
-  const std::size_t selves = std::min(bins_, self_reflection.size());
-  const auto v = static_cast<std::size_t>(EchoPath::kVehicle);
-  for (std::size_t k = 0; k < selves; ++k) {
-    labels[k].energy[v] = static_cast<float>(vehicle[k] * l.factor[k] + self_reflection[k]);
+  constexpr auto kNoise = static_cast<std::size_t>(EchoPath::kNoise);
+  constexpr auto kVehicle = static_cast<std::size_t>(EchoPath::kVehicle);
+  for (std::size_t k = 0; k < bins_; ++k) {
+    const double speckle = a_.speckle.on ? scratch_.speckle[k] : 1.0;
+    BinLabel& label = labels[k];
+    for (std::size_t p = 0; p < kEchoPaths; ++p) {
+      label.energy[p] = static_cast<float>(l.power[p][k] * scale[p] * speckle);
+    }
+    label.energy[kNoise] = static_cast<float>(l.power[kNoise][k]);
+    if (k < self_reflection.size()) {
+      label.energy[kVehicle] =
+          static_cast<float>(l.power[kVehicle][k] * gain * speckle + self_reflection[k]);
+    }
+    label.mesh = kNoMesh;
+    label.point_sonar_m = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
   }
   LabelMeshes();
 }

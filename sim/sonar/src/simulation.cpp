@@ -62,22 +62,29 @@ BeamSynthesizer SceneSynthesizer(const Scene& scene, const RayTracer& tracer, st
 std::vector<SynthesizedBeam> SimulateBeams(const Scene& scene, const BeamSynthesizer& synthesizer,
                                            std::uint64_t seed, int threads, std::size_t first,
                                            std::size_t last, Labels labels) {
+  std::vector<SynthesizedBeam> beams;
+  SimulateBeamsInto(scene, synthesizer, seed, threads, first, last, labels, beams);
+  return beams;
+}
+
+void SimulateBeamsInto(const Scene& scene, const BeamSynthesizer& synthesizer, std::uint64_t seed,
+                       int threads, std::size_t first, std::size_t last, Labels labels,
+                       std::vector<SynthesizedBeam>& beams) {
   if (first > last) {
     throw std::invalid_argument("SimulateBeams: beams [" + std::to_string(first) + ", " +
                                 std::to_string(last) + ") run backwards");
   }
-  std::vector<SynthesizedBeam> beams(last - first);
+  beams.resize(last - first);
   const int n_threads = threads > 0 ? threads : omp_get_max_threads();
 #pragma omp parallel for num_threads(n_threads) schedule(dynamic, 8)
   for (std::int64_t b = 0; b < static_cast<std::int64_t>(beams.size()); ++b) {
     const std::size_t index = first + static_cast<std::size_t>(b);
     const ScheduledBeam s = ScheduleBeam(scene, index);
     SynthesizedBeam& out = beams[static_cast<std::size_t>(b)];
-    out = synthesizer.Synthesize(s.time_s, s.pose.head_angle_rad, s.pose.T_world_sonar,
-                                 DeriveSeed(seed, index), EchoPower::kDrop, labels);
+    synthesizer.SynthesizeInto(s.time_s, s.pose.head_angle_rad, s.pose.T_world_sonar,
+                               DeriveSeed(seed, index), EchoPower::kDrop, labels, out);
     out.beam.T_world_sonar = ReportedSonarPose(scene, index, s.time_s, seed);
   }
-  return beams;
 }
 
 std::vector<SynthesizedBeam> SimulateScene(
@@ -90,15 +97,19 @@ std::vector<SynthesizedBeam> SimulateScene(
   const BeamSynthesizer synthesizer = SceneSynthesizer(scene, tracer, seed);
   std::vector<SynthesizedBeam> beams;
   beams.reserve(count);
+  std::vector<SynthesizedBeam> part;  // one sweep's, its labels' memory kept for the next
   for (std::size_t sweep = 0; sweep < sweeps; ++sweep) {
-    auto part = SimulateBeams(scene, synthesizer, seed, threads, sweep * per_sweep,
-                              std::min(count, (sweep + 1) * per_sweep),
-                              on_labels ? Labels::kKeep : Labels::kDrop);
-    if (on_labels) {
-      on_labels(part);
-      for (SynthesizedBeam& beam : part) beam.labels = {};
+    SimulateBeamsInto(scene, synthesizer, seed, threads, sweep * per_sweep,
+                      std::min(count, (sweep + 1) * per_sweep),
+                      on_labels ? Labels::kKeep : Labels::kDrop, part);
+    if (on_labels) on_labels(part);
+    for (SynthesizedBeam& b : part) {
+      beams.push_back({.beam = std::move(b.beam),
+                       .truth = b.truth,
+                       .echo_power = std::move(b.echo_power),
+                       .labels = {},
+                       .traced_rays = b.traced_rays});
     }
-    std::move(part.begin(), part.end(), std::back_inserter(beams));
     if (on_sweep) on_sweep(sweep + 1, sweeps);
   }
   return beams;

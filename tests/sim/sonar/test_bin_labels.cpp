@@ -57,6 +57,39 @@ TEST(BinLabels, LeaveTheBeamsAsTheyAre) {
   }
 }
 
+// A beam synthesised into another's memory is the beam synthesised afresh, whatever the other
+// held: labels or none, echo power or none.
+TEST(BinLabels, ABeamSynthesizedIntoAnothersMemoryIsTheFreshOne) {
+  Scene scene = LoadScene(test::SourcePath("scenes/cras-tank.yaml"));
+  const auto meshes = BuildSceneMeshes(scene);
+  const RayTracer tracer(meshes);
+  const BeamSynthesizer synthesizer = SceneSynthesizer(scene, tracer, 3);
+  SynthesizedBeam reused;
+  for (std::size_t b = 0; b < 200; b += 13) {
+    const ScheduledBeam s = ScheduleBeam(scene, b);
+    const Labels labels = (b / 13) % 2 == 0 ? Labels::kKeep : Labels::kDrop;
+    const EchoPower power = (b / 13) % 3 == 0 ? EchoPower::kKeep : EchoPower::kDrop;
+    synthesizer.SynthesizeInto(s.time_s, s.pose.head_angle_rad, s.pose.T_world_sonar,
+                               DeriveSeed(3, b), power, labels, reused);
+    const SynthesizedBeam fresh = synthesizer.Synthesize(
+        s.time_s, s.pose.head_angle_rad, s.pose.T_world_sonar, DeriveSeed(3, b), power, labels);
+    ASSERT_EQ(reused.beam.intensities, fresh.beam.intensities) << b;
+    EXPECT_EQ(reused.truth.first_hit_range_m, fresh.truth.first_hit_range_m) << b;
+    EXPECT_EQ(reused.truth.axis_hit_range_m, fresh.truth.axis_hit_range_m) << b;
+    EXPECT_EQ(reused.echo_power, fresh.echo_power) << b;
+    EXPECT_EQ(reused.traced_rays, fresh.traced_rays) << b;
+    ASSERT_EQ(reused.labels.size(), fresh.labels.size()) << b;
+    for (std::size_t k = 0; k < fresh.labels.size(); ++k) {
+      ASSERT_EQ(reused.labels[k].energy, fresh.labels[k].energy) << b << " bin " << k;
+      ASSERT_EQ(reused.labels[k].mesh, fresh.labels[k].mesh) << b << " bin " << k;
+      for (int i = 0; i < 3; ++i) {
+        const float x = reused.labels[k].point_sonar_m[i], y = fresh.labels[k].point_sonar_m[i];
+        ASSERT_TRUE(x == y || (std::isnan(x) && std::isnan(y))) << b << " bin " << k;
+      }
+    }
+  }
+}
+
 // Without speckle and self-reflection, a bin's paths but the noise sum to its noise-free echo
 // power times the gain, to rounding (each path a float: 2^-24 of it).
 TEST(BinLabels, PathsSumToTheBinsEchoPower) {

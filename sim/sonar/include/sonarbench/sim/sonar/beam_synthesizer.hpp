@@ -89,6 +89,11 @@ class BeamSynthesizer {
                                            std::uint64_t seed,
                                            EchoPower echo_power = EchoPower::kKeep,
                                            Labels labels = Labels::kDrop) const;
+  /// The same into `out`, every field overwritten and its vectors' memory reused: a caller that
+  /// keeps `out` from beam to beam allocates once.
+  void SynthesizeInto(double time_s, double head_angle_rad, const Eigen::Isometry3d& T_world_sonar,
+                      std::uint64_t seed, EchoPower echo_power, Labels labels,
+                      SynthesizedBeam& out) const;
 
   /// The vehicle parts' BVH, in the vehicle's frame, or null without parts (for recording its
   /// queries: RayTracer::Record).

@@ -57,6 +57,12 @@ struct ScheduledBeam {
                                                          std::size_t first, std::size_t last,
                                                          Labels labels = Labels::kDrop);
 
+/// SimulateBeams into `beams` (resized to last - first), their memory reused: a caller that
+/// keeps `beams` from sweep to sweep allocates once.
+void SimulateBeamsInto(const Scene& scene, const BeamSynthesizer& synthesizer, std::uint64_t seed,
+                       int threads, std::size_t first, std::size_t last, Labels labels,
+                       std::vector<SynthesizedBeam>& beams);
+
 /// The beams alone, as the mapper takes them.
 [[nodiscard]] std::vector<mapping::Beam> BeamsOf(std::span<const SynthesizedBeam> synthesized);
 
