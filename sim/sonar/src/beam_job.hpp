@@ -125,7 +125,8 @@ struct OneWayPattern {
 
 // One scene mesh's main-lobe direct returns in a beam, for the labels: their power per bin,
 // and per start bin (the bin the return's range falls in) the strongest's power after the range
-// loss and its point relative to the sonar (world frame, m). Emptied by the beam's labels.
+// loss and its point relative to the sonar (world frame, m). Reset when a beam gives it a slot
+// (LabelScratch::NewSlot); the spreader emptied by LabelScenePaths.
 struct MeshDirect {
   PulseSpreader spreader;
   std::vector<double> power;
