@@ -6,10 +6,12 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <span>
 #include <sstream>
 
 #include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/mapping/detection.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/app/map_log.hpp"
 #include "sonarbench/sim/app/simulated_scene.hpp"
@@ -73,6 +75,42 @@ MapMetrics MapAndScore(const mapping::MapperConfig& base, const Detection& detec
     first += size;
   }
   return ScoreMap(mapper.tree(), truth, observable, {}, {}, &direct);
+}
+
+// The echoes `detection` finds in `batches` (the simulated scene's, `kept` their beams' indices
+// in `bin_energy`) by the path with the most power over each echo's first three bins.
+EchoPathCounts CountEchoPaths(
+    const Detection& detection, const mapping::SensorGeometry& sensor, const Batches& batches,
+    const std::vector<std::size_t>& kept,
+    const std::vector<std::vector<std::array<float, kEchoPaths>>>& bin_energy) {
+  constexpr std::size_t kEchoBins = 3;
+  EchoPathCounts counts;
+  const std::span<const mapping::Beam> all(batches.beams);
+  std::size_t first = 0;
+  for (const std::size_t size : batches.sizes) {
+    const auto echoes = mapping::DetectObstacles(all.subspan(first, size), sensor, detection);
+    for (std::size_t b = 0; b < size; ++b) {
+      const auto& bins = bin_energy[kept[first + b]];
+      for (std::size_t e = 0; e < echoes[b].size(); ++e) {
+        std::array<double, kEchoPaths> power{};
+        const auto bin = static_cast<std::size_t>(echoes[b][e] / sensor.bin_size_m);
+        for (std::size_t k = bin; k < std::min(bins.size(), bin + kEchoBins); ++k) {
+          for (std::size_t p = 0; p < kEchoPaths; ++p) power[p] += bins[k][p];
+        }
+        const auto path =
+            static_cast<std::size_t>(std::max_element(power.begin(), power.end()) - power.begin());
+        ++(e == 0 ? counts.first : counts.later)[path];
+      }
+    }
+    first += size;
+  }
+  return counts;
+}
+
+json PathCountsJson(const std::array<std::size_t, kEchoPaths>& counts) {
+  json out = json::object();
+  for (std::size_t p = 0; p < kEchoPaths; ++p) out[std::string(kEchoPathNames[p])] = counts[p];
+  return out;
 }
 
 json MetricsJson(const MapMetrics& m) {
@@ -347,16 +385,19 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
   const RayTracer tracer(meshes);
   const SimulatedScene simulated = SimulateForScoring(
       scene, meshes, tracer, options.seed.value_or(scene.seed), options.threads, options.heads_deg);
+  std::vector<std::size_t> sim_kept;
   const Batches sim_beams =
       SelectBeams(simulated.beams, static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep()),
-                  options.heads_deg);
+                  options.heads_deg, [&](std::size_t b) { sim_kept.push_back(b); });
 
   std::vector<DetectorRow> rows;
   for (const DetectorItem& item : items) {
     DetectorRow row{item,
                     MapAndScore(base, item.detection, scene.sensor.geometry, sim_beams,
                                 simulated.truth, simulated.observable, simulated.direct),
-                    std::nullopt};
+                    std::nullopt,
+                    CountEchoPaths(item.detection, scene.sensor.geometry, sim_beams, sim_kept,
+                                   simulated.bin_energy)};
     if (log) {
       row.log = MapAndScore(base, item.detection, log->sensor, log_beams, log_score->truth,
                             log_score->observable, log_score->direct);
@@ -382,7 +423,10 @@ void WriteDetectorStudy(const std::string& dir, const Scene& scene,
                  {"threshold", d.threshold},
                  {"max_obstacles", d.max_obstacles},
                  {"later_echoes", io::LaterEchoesName(d.later_echoes)},
-                 {"scene", MetricsJson(row.scene)}};
+                 {"scene", MetricsJson(row.scene)},
+                 {"scene_echo_paths",
+                  {{"first", PathCountsJson(row.scene_paths.first)},
+                   {"later", PathCountsJson(row.scene_paths.later)}}}};
     if (row.log) item["log"] = MetricsJson(*row.log);
     items.push_back(item);
   }

@@ -8,7 +8,14 @@ SimulatedScene SimulateForScoring(const Scene& scene, const std::vector<Triangle
                                   const RayTracer& tracer, std::uint64_t seed, int threads,
                                   const std::optional<std::pair<double, double>>& heads_deg) {
   SimulatedScene s;
-  s.synthesized = SimulateScene(scene, tracer, seed, threads);
+  s.synthesized =
+      SimulateScene(scene, tracer, seed, threads, {}, [&](std::span<const SynthesizedBeam> sweep) {
+        for (const SynthesizedBeam& beam : sweep) {
+          auto& bins = s.bin_energy.emplace_back();
+          bins.reserve(beam.labels.size());
+          for (const BinLabel& label : beam.labels) bins.push_back(label.energy);
+        }
+      });
   s.beams = BeamsOf(s.synthesized);
   const octomap::OcTree key_space(scene.mapping.resolution_m);
   s.truth = VoxelizeMeshes(meshes, key_space);

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <numeric>
 #include <set>
 
 #include "sonarbench/sim/app/dataset_writer.hpp"
@@ -66,6 +67,25 @@ TEST(DetectorStudy, ADatasetOfTheSceneScoresAsTheScene) {
   // What `supported` drops are the detector's ghosts, not the arc's.
   EXPECT_LT(*rows[1].scene.ghost_echo_share, *rows[0].scene.ghost_echo_share);
   EXPECT_LT(rows[1].scene.occupied_cells, rows[0].scene.occupied_cells);
+  // By the simulator's truth: the rules differ in later echoes only; the tank's later echoes
+  // are mostly mirror paths behind its walls, and `supported` drops a larger share of those
+  // than of the direct ones.
+  const auto count = [](const DetectorRow& row, bool later, EchoPath path) {
+    return static_cast<double>(
+        (later ? row.scene_paths.later : row.scene_paths.first)[static_cast<std::size_t>(path)]);
+  };
+  EXPECT_EQ(rows[0].scene_paths.first, rows[1].scene_paths.first);
+  const std::size_t firsts = std::accumulate(rows[0].scene_paths.first.begin(),
+                                             rows[0].scene_paths.first.end(), std::size_t{0});
+  EXPECT_GT(firsts, 0u);
+  EXPECT_LE(firsts, 2u * 200u);  // one first echo a beam at most
+  const double multipath = count(rows[0], true, EchoPath::kMultipath);
+  const double direct = count(rows[0], true, EchoPath::kDirect);
+  EXPECT_GT(multipath, direct);
+  const double multipath_dropped = 1.0 - count(rows[1], true, EchoPath::kMultipath) / multipath;
+  const double direct_dropped =
+      1.0 - count(rows[1], true, EchoPath::kDirect) / std::max(direct, 1.0);
+  EXPECT_GT(multipath_dropped, direct_dropped);
 
   const auto out = dir.path() / "study";
   std::filesystem::create_directories(out);
@@ -85,6 +105,7 @@ TEST(DetectorStudy, ADatasetOfTheSceneScoresAsTheScene) {
   EXPECT_EQ(study["items"][1]["later_echoes"], "supported");
   EXPECT_DOUBLE_EQ(study["items"][1]["scene"]["ghost_share"].get<double>(),
                    rows[1].scene.ghost_share);
+  EXPECT_EQ(study["items"][0]["scene_echo_paths"]["later"]["multipath"].get<double>(), multipath);
 }
 
 // Spearman's rank correlation against cases worked by hand: the same order 1, the reverse -1,

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -10,6 +11,7 @@
 
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/eval/score.hpp"
+#include "sonarbench/sim/sonar/bin_labels.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 
 namespace sonarbench::sim {
@@ -43,12 +45,22 @@ struct DetectorStudyOptions {
 /// Whether `head_angle_rad` lies in [heads.first, heads.second) degrees, taken modulo 360.
 [[nodiscard]] bool InHeads(double head_angle_rad, const std::pair<double, double>& heads_deg);
 
+/// A setting's echoes on the simulated scene by the path that made them (the simulator's truth):
+/// the first echo of each beam and the later ones apart, each echo counted under the path with
+/// the most power over its bin and the two after it (BinLabel::energy), indexed by io::EchoPath.
+struct EchoPathCounts {
+  std::array<std::size_t, kEchoPaths> first{};
+  std::array<std::size_t, kEchoPaths> later{};
+};
+
 /// One row of the study: a setting's map of the simulated scene and, if given, of the log, each
-/// scored against the scene's surfaces (ScoreMap) as `report.json`'s metrics.
+/// scored against the scene's surfaces (ScoreMap) as `report.json`'s metrics, and the simulated
+/// scene's echoes by path.
 struct DetectorRow {
   DetectorItem item;
   MapMetrics scene;
   std::optional<MapMetrics> log;
+  EchoPathCounts scene_paths;
 };
 
 /// Maps the scene, simulated once (the scene's seed unless `seed`), and the log, read once, with

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <utility>
@@ -18,6 +19,8 @@ namespace sonarbench::sim {
 struct SimulatedScene {
   std::vector<SynthesizedBeam> synthesized;
   std::vector<mapping::Beam> beams;
+  /// Per beam, each bin's power by path (BinLabel::energy), as the labels give it.
+  std::vector<std::vector<std::array<float, kEchoPaths>>> bin_energy;
   mapping::KeySet truth;
   mapping::KeySet observable;
   DirectEchoes direct;
