@@ -78,11 +78,10 @@ MapMetrics MapAndScore(const mapping::MapperConfig& base, const Detection& detec
 }
 
 // The echoes `detection` finds in `batches` (the simulated scene's, `kept` their beams' indices
-// in `bin_energy`) by the path with the most power over each echo's first three bins.
-EchoPathCounts CountEchoPaths(
-    const Detection& detection, const mapping::SensorGeometry& sensor, const Batches& batches,
-    const std::vector<std::size_t>& kept,
-    const std::vector<std::vector<std::array<float, kEchoPaths>>>& bin_energy) {
+// in `bin_paths`), each counted under the path most of its first three bins have.
+EchoPathCounts CountEchoPaths(const Detection& detection, const mapping::SensorGeometry& sensor,
+                              const Batches& batches, const std::vector<std::size_t>& kept,
+                              const std::vector<std::vector<std::uint8_t>>& bin_paths) {
   constexpr std::size_t kEchoBins = 3;
   EchoPathCounts counts;
   const std::span<const mapping::Beam> all(batches.beams);
@@ -90,15 +89,17 @@ EchoPathCounts CountEchoPaths(
   for (const std::size_t size : batches.sizes) {
     const auto echoes = mapping::DetectObstacles(all.subspan(first, size), sensor, detection);
     for (std::size_t b = 0; b < size; ++b) {
-      const auto& bins = bin_energy[kept[first + b]];
+      const std::vector<std::uint8_t>& paths = bin_paths[kept[first + b]];
       for (std::size_t e = 0; e < echoes[b].size(); ++e) {
-        std::array<double, kEchoPaths> power{};
         const auto bin = static_cast<std::size_t>(echoes[b][e] / sensor.bin_size_m);
-        for (std::size_t k = bin; k < std::min(bins.size(), bin + kEchoBins); ++k) {
-          for (std::size_t p = 0; p < kEchoPaths; ++p) power[p] += bins[k][p];
+        if (bin >= paths.size()) continue;
+        std::array<int, kEchoPaths> votes{};
+        for (std::size_t k = bin; k < std::min(paths.size(), bin + kEchoBins); ++k)
+          ++votes[paths[k]];
+        std::size_t path = paths[bin];
+        for (std::size_t p = 0; p < kEchoPaths; ++p) {
+          if (votes[p] > votes[path]) path = p;
         }
-        const auto path =
-            static_cast<std::size_t>(std::max_element(power.begin(), power.end()) - power.begin());
         ++(e == 0 ? counts.first : counts.later)[path];
       }
     }
@@ -397,7 +398,7 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
                                 simulated.truth, simulated.observable, simulated.direct),
                     std::nullopt,
                     CountEchoPaths(item.detection, scene.sensor.geometry, sim_beams, sim_kept,
-                                   simulated.bin_energy)};
+                                   simulated.bin_paths)};
     if (log) {
       row.log = MapAndScore(base, item.detection, log->sensor, log_beams, log_score->truth,
                             log_score->observable, log_score->direct);

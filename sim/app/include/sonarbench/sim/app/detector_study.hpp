@@ -46,8 +46,9 @@ struct DetectorStudyOptions {
 [[nodiscard]] bool InHeads(double head_angle_rad, const std::pair<double, double>& heads_deg);
 
 /// A setting's echoes on the simulated scene by the path that made them (the simulator's truth):
-/// the first echo of each beam and the later ones apart, each echo counted under the path with
-/// the most power over its bin and the two after it (BinLabel::energy), indexed by io::EchoPath.
+/// the first echo of each beam and the later ones apart, indexed by io::EchoPath. Each echo counts
+/// under the path that has the most power in most of its first three bins (the first bin's on a
+/// tie).
 struct EchoPathCounts {
   std::array<std::size_t, kEchoPaths> first{};
   std::array<std::size_t, kEchoPaths> later{};

@@ -1,6 +1,5 @@
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <optional>
 #include <utility>
@@ -19,8 +18,8 @@ namespace sonarbench::sim {
 struct SimulatedScene {
   std::vector<SynthesizedBeam> synthesized;
   std::vector<mapping::Beam> beams;
-  /// Per beam, each bin's power by path (BinLabel::energy), as the labels give it.
-  std::vector<std::vector<std::array<float, kEchoPaths>>> bin_energy;
+  /// Per beam, each bin's path with the most power (io::EchoPath), as the labels give it.
+  std::vector<std::vector<std::uint8_t>> bin_paths;
   mapping::KeySet truth;
   mapping::KeySet observable;
   DirectEchoes direct;
