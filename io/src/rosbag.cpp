@@ -65,9 +65,7 @@ ros2::ProjectedSonarImage ImageMessage(const Beam& beam, const RosbagContent& ba
 Beam PathBeam(const Beam& beam, const BeamLabels& labels) {
   Beam path = beam;
   for (std::size_t k = 0; k < path.intensities.size() && k < labels.shares.size(); ++k) {
-    const auto& shares = labels.shares[k];
-    path.intensities[k] =
-        static_cast<std::uint8_t>(std::max_element(shares.begin(), shares.end()) - shares.begin());
+    path.intensities[k] = static_cast<std::uint8_t>(DominantPath(labels.shares[k]));
   }
   return path;
 }

@@ -77,12 +77,24 @@ MapMetrics MapAndScore(const mapping::MapperConfig& base, const Detection& detec
   return ScoreMap(mapper.tree(), truth, observable, {}, {}, &direct);
 }
 
+// The path an echo starting at `bin` came by: the one most of its first three bins have (the
+// first bin's among equals), from each bin's dominant path.
+std::size_t PathOfEcho(const std::vector<std::uint8_t>& paths, std::size_t bin) {
+  constexpr std::size_t kEchoBins = 3;
+  std::array<int, kEchoPaths> votes{};
+  for (std::size_t k = bin; k < std::min(paths.size(), bin + kEchoBins); ++k) ++votes[paths[k]];
+  std::size_t path = paths[bin];
+  for (std::size_t p = 0; p < kEchoPaths; ++p) {
+    if (votes[p] > votes[path]) path = p;
+  }
+  return path;
+}
+
 // The echoes `detection` finds in `batches` (the simulated scene's, `kept` their beams' indices
-// in `bin_paths`), each counted under the path most of its first three bins have.
+// in `bin_paths`) by the path they came by (PathOfEcho).
 EchoPathCounts CountEchoPaths(const Detection& detection, const mapping::SensorGeometry& sensor,
                               const Batches& batches, const std::vector<std::size_t>& kept,
                               const std::vector<std::vector<std::uint8_t>>& bin_paths) {
-  constexpr std::size_t kEchoBins = 3;
   EchoPathCounts counts;
   const std::span<const mapping::Beam> all(batches.beams);
   std::size_t first = 0;
@@ -92,15 +104,7 @@ EchoPathCounts CountEchoPaths(const Detection& detection, const mapping::SensorG
       const std::vector<std::uint8_t>& paths = bin_paths[kept[first + b]];
       for (std::size_t e = 0; e < echoes[b].size(); ++e) {
         const auto bin = static_cast<std::size_t>(echoes[b][e] / sensor.bin_size_m);
-        if (bin >= paths.size()) continue;
-        std::array<int, kEchoPaths> votes{};
-        for (std::size_t k = bin; k < std::min(paths.size(), bin + kEchoBins); ++k)
-          ++votes[paths[k]];
-        std::size_t path = paths[bin];
-        for (std::size_t p = 0; p < kEchoPaths; ++p) {
-          if (votes[p] > votes[path]) path = p;
-        }
-        ++(e == 0 ? counts.first : counts.later)[path];
+        if (bin < paths.size()) ++(e == 0 ? counts.first : counts.later)[PathOfEcho(paths, bin)];
       }
     }
     first += size;

@@ -1,19 +1,16 @@
 #include "sonarbench/sim/app/simulated_scene.hpp"
 
-#include <algorithm>
-
 #include "sonarbench/sim/app/detector_study.hpp"
 
 namespace sonarbench::sim {
 namespace {
 
-// Each bin's path with the most power; noise where the bin holds none.
+// Each bin's path with the most power (io::DominantPath).
 std::vector<std::uint8_t> DominantPaths(const SynthesizedBeam& beam) {
-  std::vector<std::uint8_t> paths(beam.labels.size(), static_cast<std::uint8_t>(EchoPath::kNoise));
-  for (std::size_t k = 0; k < paths.size(); ++k) {
-    const auto& energy = beam.labels[k].energy;
-    const auto most = std::max_element(energy.begin(), energy.end());
-    if (*most > 0.0F) paths[k] = static_cast<std::uint8_t>(most - energy.begin());
+  std::vector<std::uint8_t> paths;
+  paths.reserve(beam.labels.size());
+  for (const BinLabel& label : beam.labels) {
+    paths.push_back(static_cast<std::uint8_t>(io::DominantPath(label.energy)));
   }
   return paths;
 }

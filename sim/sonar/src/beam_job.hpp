@@ -144,7 +144,6 @@ struct LabelScratch {
   std::vector<std::uint32_t> mesh_of_slot;
   std::array<std::vector<double>, kEchoPaths> power;
   std::vector<double> before;
-  std::size_t bins = 0;
 
   // A main-lobe direct return: `echo`, its power after the range loss, per bin over [start,
   // end) bins, from mesh `mesh` at `point` relative to the sonar (world frame, m).

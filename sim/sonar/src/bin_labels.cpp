@@ -24,7 +24,6 @@ void BeamSynthesizer::BeamJob::StartLabels() {
     if (spreader.Bins() != bins_) spreader.Reset(bins_);
   }
   for (std::vector<double>& power : l.power) power.assign(bins_, 0.0);
-  l.bins = bins_;
   l.slot_of_mesh.assign(s_.vehicle_first_mesh_, -1);
   l.mesh_of_slot.clear();
 }
@@ -34,6 +33,7 @@ std::int32_t LabelScratch::NewSlot(std::uint32_t mesh) {
   mesh_of_slot.push_back(mesh);
   if (meshes.size() == slot) meshes.emplace_back();
   MeshDirect& m = meshes[slot];
+  const std::size_t bins = spreaders[0].Bins();  // the beam's (StartLabels)
   if (m.spreader.Bins() != bins) m.spreader.Reset(bins);
   m.strongest.assign(bins, 0.0);
   m.point.resize(bins);

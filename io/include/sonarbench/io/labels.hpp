@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -40,6 +41,14 @@ struct BeamLabels {
   std::vector<std::uint16_t> mesh;
   std::vector<Eigen::Vector3f> point_sonar_m;
 };
+
+/// The path with the most of a bin's power or shares (the first among equals); noise where the
+/// bin holds none.
+template <typename T>
+[[nodiscard]] EchoPath DominantPath(const std::array<T, kEchoPaths>& power) {
+  const auto most = std::max_element(power.begin(), power.end());
+  return *most > T{0} ? static_cast<EchoPath>(most - power.begin()) : EchoPath::kNoise;
+}
 
 /// Sweep `sweep`'s label file in a dataset: "truth/labels_0012.bin".
 [[nodiscard]] std::string LabelFile(std::size_t sweep);
