@@ -91,9 +91,12 @@ std::string DetectionLine(const mapping::MapperConfig& config) {
   const nlohmann::json& detection = mapping["detection"];
   std::string line = detection.value("method", "?");
   if (line == "threshold") line += " " + detection["threshold"].dump();
-  return line + ", at most " + detection["max_obstacles"].dump() +
-         " echoes a beam (later echoes: " + detection.value("later_echoes", "?") + "), " +
-         mapping.value("occupancy", "?") + " at " + mapping["resolution_m"].dump() + " m";
+  line += detection["max_obstacles"] == 1
+              ? ", the first echo a beam"
+              : ", at most " + detection["max_obstacles"].dump() +
+                    " echoes a beam (later echoes: " + detection.value("later_echoes", "?") + ")";
+  return line + ", " + mapping.value("occupancy", "?") + " at " + mapping["resolution_m"].dump() +
+         " m";
 }
 
 void PrintVerdict(const std::string& name, const sonarbench::sim::Verdict& v) {

@@ -27,17 +27,25 @@ struct MapArgs {
 
 int Map(const MapArgs& args) {
   sonarbench::CheckOutputDirectory(args.out);
+  // The sensor and the mapper's defaults: the scene's, else the --sensor model's, else the
+  // shipped Micron's; --mapping's keys over them.
+  std::string defaults =
+      args.sensor.empty() ? sonarbench::sim::ShippedSensorModelPath() : args.sensor;
   sonarbench::mapping::SensorGeometry sensor;
   sonarbench::mapping::MapperConfig config;
   if (!args.scene.empty()) {
     const sonarbench::sim::Scene scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
     sensor = scene.sensor.geometry;
     config = scene.mapping;
+    defaults = args.scene;
+  } else {
+    const sonarbench::sim::SensorModel model = sonarbench::sim::LoadSensorModel(defaults);
+    sensor = model.geometry;
+    config = model.mapping;
   }
-  if (!args.sensor.empty()) sensor = sonarbench::sim::LoadSensorModel(args.sensor).geometry;
   if (!args.mapping.empty()) {
     sonarbench::YamlReader reader = sonarbench::YamlReader::FromFile(args.mapping);
-    config = sonarbench::io::ReadMapperConfig(reader);
+    config = sonarbench::io::ReadMapperConfig(reader, config);
     reader.ThrowIfErrors();
   }
   config.threads = args.threads;
@@ -67,10 +75,8 @@ int Map(const MapArgs& args) {
   std::cout << result.beams << " beams (" << result.truncated_beams << " truncated) in "
             << Count(result.sweeps, "sweep") << "; " << t.beams_with_obstacle
             << " with an obstacle\n"
-            << "detection: " << DetectionLine(config)
-            << (args.scene.empty() && args.mapping.empty()
-                    ? " (the mapper's defaults; --scene or --mapping sets them)\n"
-                    : "\n");
+            << "detection: " << DetectionLine(config) << " (from " << defaults
+            << (args.mapping.empty() ? "" : " and " + args.mapping) << ")\n";
   for (const std::string& warning : result.warnings) std::cout << "warning: " << warning << "\n";
   if (result.score)
     std::cout << "against " << args.scene << ": " << MetricsLine(result.score->metrics) << "\n";
@@ -95,8 +101,9 @@ CLI::App* AddOptions(CLI::App& app, MapArgs& args) {
       "from above), polar.png and fan.png (the first sweep), report.html and report.json into "
       "--out; with --score also junit.xml, map_side.png, and certainty.png and .csv (the "
       "occupied cells' probability after each sweep), the map images then against the truth. "
-      "The sensor is the SHAD Micron and the mapper uses its defaults unless --scene, --sensor "
-      "or --mapping say otherwise.");
+      "The sensor and the mapper's settings are the shipped SHAD Micron model's "
+      "(sensor-models/shad-micron.yaml, its mapping section) unless --scene, --sensor or "
+      "--mapping say otherwise.");
   command
       ->add_option("input", args.input,
                    "A dataset directory, a .mat log, or a folder holding one .mat log")

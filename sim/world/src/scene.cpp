@@ -348,8 +348,10 @@ std::optional<YamlReader> ReadSections(YamlReader& root, bool has_base, Scene& s
     ReadAcoustics(*acoustics, checked);
     acoustics->RejectUnknownKeys();
   }
+  // Checked here, applied over the sensor model's mapping defaults once the model is read.
   if (auto mapping = root.OptionalChild("mapping")) {
-    scene.mapping = io::ReadMapperConfig(*mapping, scene.mapping);
+    [[maybe_unused]] const mapping::MapperConfig checked =
+        io::ReadMapperConfig(*mapping, scene.mapping);
   }
   if (auto criteria = root.OptionalChild("criteria")) {
     std::vector<std::string> mesh_names;
@@ -387,6 +389,7 @@ Scene LoadSceneIn(const std::string& path, const Budgets& budgets,
     scene.sensor_model_file = Resolve(root, scene.sensor_model_file);
     try {
       scene.sensor = LoadSensorModel(scene.sensor_model_file);
+      scene.mapping = scene.sensor.mapping;
     } catch (const InputError& e) {
       errors.push_back(root.WhereOf("sensor_model") + ": sensor_model: " + e.what() +
                        WhereLooked(scene.sensor_model_file));
@@ -396,6 +399,10 @@ Scene LoadSceneIn(const std::string& path, const Budgets& budgets,
     std::string all = errors.front();
     for (std::size_t i = 1; i < errors.size(); ++i) all += "\n" + errors[i];
     throw InputError(all);
+  }
+  if (auto mapping = root.OptionalChild("mapping")) {
+    scene.mapping = io::ReadMapperConfig(*mapping, scene.mapping);
+    root.ThrowIfErrors();
   }
   if (T_vehicle_sonar) scene.sensor.geometry.T_vehicle_sonar = *T_vehicle_sonar;
   if (acoustics) {

@@ -1,5 +1,6 @@
 #include "sonarbench/sim/world/sensor_model.hpp"
 
+#include <filesystem>
 #include <sstream>
 
 #include "sonarbench/io/mapping_yaml.hpp"
@@ -140,8 +141,13 @@ SensorModel ReadSensorModel(YamlReader& root) {
   ReadAcoustics(node, model.acoustics);
   CheckAcoustics(node, model.acoustics, model.geometry);
   node.RejectUnknownKeys();
+  if (auto mapping = root.OptionalChild("mapping")) model.mapping = io::ReadMapperConfig(*mapping);
   root.RejectUnknownKeys();
   return model;
+}
+
+std::string ShippedSensorModelPath() {
+  return (std::filesystem::path(SONARBENCH_DATA_DIR) / kShippedSensorModel).string();
 }
 
 SensorModel LoadSensorModel(const std::string& path) {

@@ -340,5 +340,48 @@ TEST(SensorModelFile, NoiseBeforeTheGainIsTheTanksAndChecked) {
                               {"'sonar_acoustics.noise_before_tvg_db'", "'200'"});
 }
 
+// The model's `mapping` section gives the mapper's defaults with that sonar: the shipped Micron's
+// detector is the threshold at 110 on first echoes; a model without one keeps MapperConfig's.
+// A scene's `mapping` refines them key by key; a bad key in the model's is named with its file.
+TEST(SensorModelFile, MappingDefaultsAreTheModelsAndTheSceneRefinesThem) {
+  const sim::SensorModel micron =
+      sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
+  EXPECT_EQ(micron.mapping.detection.threshold, 110);
+  EXPECT_EQ(micron.mapping.detection.max_obstacles, 1);
+  EXPECT_EQ(micron.mapping.detection.smoothing_bins, 5);
+  EXPECT_EQ(micron.mapping.detection.min_run_bins, 3);
+  EXPECT_EQ(micron.mapping.resolution_m, mapping::MapperConfig{}.resolution_m);
+
+  test::TempDir dir;
+  std::ifstream in(test::SourcePath("sensor-models/shad-micron.yaml"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bare = text.substr(0, text.find("\nmapping:"));
+  const std::string bare_path = (dir.path() / "bare.yaml").string();
+  std::ofstream(bare_path) << bare;
+  EXPECT_EQ(sim::LoadSensorModel(bare_path).mapping.detection, mapping::DetectionConfig{});
+  const std::string bad_path = (dir.path() / "bad_model.yaml").string();
+  std::ofstream(bad_path) << bare << "\nmapping: {detection: {threshold: 300}}\n";
+  EXPECT_TRUE(ThrowsInputErrorWith([&] { (void)sim::LoadSensorModel(bad_path); },
+                                   {"bad_model.yaml:", "'mapping.detection.threshold'", "'300'"}));
+
+  const auto scene_with = [&](const std::string& mapping_section) {
+    const std::string path = (dir.path() / "scene.yaml").string();
+    std::ofstream(path)
+        << "name: x\nsensor_model: " << test::SourcePath("sensor-models/shad-micron.yaml")
+        << "\nsweeps: 1\nmaterials:\n  - {name: rock, reflectivity: 0.5}\n"
+        << "meshes:\n  - {name: m, type: plane, size_m: [1, 1, 0], material: rock}\n"
+        << "trajectory: {type: static, position_m: [0, 0, 0]}\n"
+        << mapping_section;
+    return sim::LoadScene(path);
+  };
+  EXPECT_EQ(scene_with("").mapping.detection, micron.mapping.detection);
+  const sim::Scene refined = scene_with("mapping: {detection: {max_obstacles: 2}}\n");
+  EXPECT_EQ(refined.mapping.detection.max_obstacles, 2);
+  EXPECT_EQ(refined.mapping.detection.threshold, 110);
+  EXPECT_TRUE(
+      ThrowsInputErrorWith([&] { (void)scene_with("mapping: {detection: {threshold: 0}}\n"); },
+                           {"scene.yaml:9:", "'mapping.detection.threshold'", "'0'"}));
+}
+
 }  // namespace
 }  // namespace sonarbench

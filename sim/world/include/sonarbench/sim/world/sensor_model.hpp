@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "sonarbench/io/yaml_reader.hpp"
+#include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
 namespace sonarbench::sim {
@@ -100,15 +101,23 @@ struct Acoustics {
   bool operator==(const Acoustics&) const = default;
 };
 
-/// A sensor model file: `geometry` for the mapper, `acoustics` for the simulator.
+/// A sensor model file: `geometry` for the mapper, `acoustics` for the simulator, and `mapping`,
+/// the mapper's defaults with this sensor (its optional section over MapperConfig's own), which a
+/// scene's `mapping` section or `map --mapping` refines.
 struct SensorModel {
   std::string name;
   mapping::SensorGeometry geometry;
   Acoustics acoustics;
+  mapping::MapperConfig mapping;
 };
 
 /// Loads a sensor model YAML file; throws InputError naming the file and key on bad input.
 [[nodiscard]] SensorModel LoadSensorModel(const std::string& path);
+
+/// The shipped model of the SHAD's Micron (kShippedSensorModel under the source tree), what
+/// `map` uses unless told otherwise.
+inline constexpr const char* kShippedSensorModel = "sensor-models/shad-micron.yaml";
+[[nodiscard]] std::string ShippedSensorModelPath();
 /// Primary rays per beam: the main lobe's rays_horizontal × rays_vertical and, with sidelobes,
 /// their 2 × sidelobe_rays_horizontal × sidelobe_rays_vertical.
 [[nodiscard]] std::size_t MainLobeRays(const Acoustics& a);
