@@ -89,8 +89,11 @@ class EchoDeposit {
   // Inlined, with the range loss from its table (RangeLossFromTable): a call per ray cost more
   // than the work (synthesis_bench).
   [[gnu::always_inline]] void operator()(double range, double strength) {
+    AddPower(range, strength * receiver_.RangeLossFromTable(range));
+  }
+  // The same for an echo whose range loss is already in `power`.
+  [[gnu::always_inline]] void AddPower(double range, double power) {
     const double start = range * bins_per_m_;
-    const double power = strength * receiver_.RangeLossFromTable(range);
     spreader_.Add(start, start + pulse_bins_, power);
     // The second trip's impulse response: the echo over [start, start + 1) bins, shared by the
     // two bins it covers (the last bin's share past it dropped).
@@ -146,9 +149,9 @@ struct LabelScratch {
   std::vector<double> before;
 
   // A main-lobe direct return: `echo`, its power after the range loss, per bin over [start,
-  // end) bins, from mesh `mesh` at `point` relative to the sonar (world frame, m).
+  // end) bins, from mesh `mesh` at `range` [m] along the unit `direction` (world frame).
   [[gnu::always_inline]] void AddDirect(double start, double end, double echo, std::uint32_t mesh,
-                                        const Eigen::Vector3f& point) {
+                                        float range, const Eigen::Vector3f& direction) {
     std::int32_t slot = slot_of_mesh[mesh];
     if (slot < 0) slot = NewSlot(mesh);
     MeshDirect& m = meshes[static_cast<std::size_t>(slot)];
@@ -157,7 +160,7 @@ struct LabelScratch {
     const auto k = static_cast<std::size_t>(start);
     if (echo > m.strongest[k]) {
       m.strongest[k] = echo;
-      m.point[k] = point;
+      m.point[k] = range * direction;
     }
   }
   std::int32_t NewSlot(std::uint32_t mesh);

@@ -140,18 +140,19 @@ void BeamSynthesizer::BeamJob::TracePrimaries() {
     const double diffuse =
         pattern * material.reflectivity * CosPower(cos_incidence, material.backscatter_exponent);
     const double glint = pattern * Glint(material, 2.0 * cos_incidence * cos_incidence - 1.0);
+    // The range loss once for every deposit of this return (each echo's power after it).
+    const double loss = s_.receiver_.RangeLossFromTable(range);
     if (on_vehicle) {
-      vehicle_deposit(range, diffuse + glint);
+      vehicle_deposit.AddPower(range, (diffuse + glint) * loss);
     } else {
-      deposit(range, diffuse);
-      if (glint > 0.0) glint_deposit(range, glint);
+      deposit.AddPower(range, diffuse * loss);
+      if (glint > 0.0) glint_deposit.AddPower(range, glint * loss);
       if (labels_ && r < main_lobe_rays) {
         const double start = range * bins_per_m;
-        scratch_.labels.AddDirect(start, start + pulse_bins,
-                                  (diffuse + glint) * s_.receiver_.RangeLossFromTable(range),
-                                  hit->mesh, static_cast<float>(range) * direction);
+        scratch_.labels.AddDirect(start, start + pulse_bins, (diffuse + glint) * loss, hit->mesh,
+                                  static_cast<float>(range), direction);
       } else if (labels_) {
-        sidelobe_deposit(range, diffuse + glint);
+        sidelobe_deposit.AddPower(range, (diffuse + glint) * loss);
       }
     }
     if (a_.max_bounces > 0 && material.specular > 0.0 && !on_vehicle) {
@@ -284,7 +285,8 @@ void BeamSynthesizer::SynthesizeInto(double time_s, double head_angle_rad,
   out = SynthesizedBeam{};
   intensities.clear();
   power.clear();
-  bin_labels.clear();
+  // Kept at their size with labels: FinishLabels writes every field of every bin's.
+  if (labels != Labels::kKeep) bin_labels.clear();
   out.beam.intensities = std::move(intensities);
   out.echo_power = std::move(power);
   out.labels = std::move(bin_labels);

@@ -61,10 +61,17 @@ TEST(PulseSpreader, SpreadsEachBoxOverTheBinsItCovers) {
     }
   }
   EXPECT_EQ(spread[kBins - 1], 0.0);
-  // Emptied: a second read-out adds nothing.
-  std::vector<double> again(kBins, 0.0);
+  // Emptied: a second read-out adds nothing to what the bins hold; a box added after is read
+  // out alone.
+  std::vector<double> again(kBins, -1.5);
   spreader.AddTo(again);
-  EXPECT_EQ(again, std::vector<double>(kBins, 0.0));
+  EXPECT_EQ(again, std::vector<double>(kBins, -1.5));
+  spreader.Add(10.0, 12.0, 2.0);
+  std::vector<double> alone(kBins, 0.0);
+  spreader.AddTo(alone);
+  std::vector<double> expected(kBins, 0.0);
+  expected[10] = expected[11] = 2.0;
+  EXPECT_EQ(alone, expected);
 }
 
 }  // namespace

@@ -21,7 +21,10 @@ class PulseSpreader {
   explicit PulseSpreader(std::size_t bins = 0) { Reset(bins); }
 
   /// Empties the spreader and sizes it for `bins` bins.
-  void Reset(std::size_t bins) { edges_.assign(bins, Edges{}); }
+  void Reset(std::size_t bins) {
+    edges_.assign(bins, Edges{});
+    empty_ = true;
+  }
 
   [[nodiscard]] std::size_t Bins() const { return edges_.size(); }
 
@@ -29,12 +32,15 @@ class PulseSpreader {
   /// before bin 0, are dropped).
   // Inlined: the synthesis calls it for every echo of every ray.
   [[gnu::always_inline]] void Add(double start, double end, double power) {
+    empty_ = false;
     Edge(start, power, 1);
     Edge(end, -power, -1);
   }
 
   /// Adds every bin's sum to `out` (one value per bin) and empties the spreader.
   void AddTo(std::span<double> out) {
+    if (empty_) return;
+    empty_ = true;
     double running = 0.0;
     int open = 0;
     for (std::size_t k = 0; k < out.size() && k < edges_.size(); ++k) {
@@ -66,6 +72,7 @@ class PulseSpreader {
     int count = 0;
   };
   std::vector<Edges> edges_;
+  bool empty_ = true;  // no box added since the last AddTo or Reset
 };
 
 }  // namespace sonarbench::sim
