@@ -147,7 +147,7 @@ SensorModel ReadSensorModel(YamlReader& root) {
 }
 
 std::string ShippedSensorModelPath() {
-  return (std::filesystem::path(SONARBENCH_DATA_DIR) / kShippedSensorModel).string();
+  return (std::filesystem::path(SONARBENCH_DATA_DIR) / "sensor-models/shad-micron.yaml").string();
 }
 
 SensorModel LoadSensorModel(const std::string& path) {

@@ -7,6 +7,7 @@
 #include <tuple>
 #include <vector>
 
+#include "cli_util.hpp"
 #include "sim_fixtures.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/mapping/error.hpp"
@@ -353,8 +354,7 @@ TEST(SensorModelFile, MappingDefaultsAreTheModelsAndTheSceneRefinesThem) {
   EXPECT_EQ(micron.mapping.resolution_m, mapping::MapperConfig{}.resolution_m);
 
   test::TempDir dir;
-  std::ifstream in(test::SourcePath("sensor-models/shad-micron.yaml"));
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = test::ReadFile(test::SourcePath("sensor-models/shad-micron.yaml"));
   const std::string bare = text.substr(0, text.find("\nmapping:"));
   const std::string bare_path = (dir.path() / "bare.yaml").string();
   std::ofstream(bare_path) << bare;

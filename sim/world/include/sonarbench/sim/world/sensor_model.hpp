@@ -114,10 +114,10 @@ struct SensorModel {
 /// Loads a sensor model YAML file; throws InputError naming the file and key on bad input.
 [[nodiscard]] SensorModel LoadSensorModel(const std::string& path);
 
-/// The shipped model of the SHAD's Micron (kShippedSensorModel under the source tree), what
-/// `map` uses unless told otherwise.
-inline constexpr const char* kShippedSensorModel = "sensor-models/shad-micron.yaml";
+/// The shipped model of the SHAD's Micron (sensor-models/shad-micron.yaml under the source
+/// tree), what `map` uses unless told otherwise.
 [[nodiscard]] std::string ShippedSensorModelPath();
+
 /// Primary rays per beam: the main lobe's rays_horizontal × rays_vertical and, with sidelobes,
 /// their 2 × sidelobe_rays_horizontal × sidelobe_rays_vertical.
 [[nodiscard]] std::size_t MainLobeRays(const Acoustics& a);
