@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <numeric>
 
 #include "sonarbench/mapping/atomic_file.hpp"
@@ -21,15 +22,10 @@ static_assert(std::endian::native == std::endian::little,
 
 constexpr char kLabelMagic[8] = {'S', 'B', 'L', 'A', 'B', 'E', 'L', '1'};
 constexpr unsigned long long kMaxLabelBytes = 1ULL << 30;
-constexpr int kZstdLevel = 9;
+constexpr int kZstdLevel = 1;  // 9: files 2-5% smaller, 6-7 times slower (docs/benchmarks.md)
 // The paths stored, noise last and left out: 255 less the others.
 constexpr std::size_t kStoredPaths = kEchoPaths - 1;
 static_assert(static_cast<std::size_t>(EchoPath::kNoise) == kStoredPaths);
-
-template <typename T>
-void Put(std::string& out, T value) {
-  out.append(reinterpret_cast<const char*>(&value), sizeof value);
-}
 
 // Reads the decompressed payload front to back, refusing to read past its end.
 class Payload {
@@ -62,34 +58,103 @@ class Payload {
   std::size_t at_ = 0;
 };
 
-std::string Encode(std::span<const BeamLabels> beams) {
-  std::string raw(kLabelMagic, sizeof kLabelMagic);
-  Put<std::uint32_t>(raw, static_cast<std::uint32_t>(beams.size()));
-  Put<std::uint32_t>(raw, static_cast<std::uint32_t>(kEchoPaths));
+// A label file's bytes: put, then compressed a beam at a time (not the sweep's bytes at once)
+// into one frame whose header holds the whole size, as the reader expects.
+class FrameWriter {
+ public:
+  explicit FrameWriter(std::size_t total)
+      : cctx_(ZSTD_createCCtx(), ZSTD_freeCCtx), chunk_(ZSTD_CStreamOutSize(), '\0') {
+    Check(ZSTD_CCtx_setParameter(cctx_.get(), ZSTD_c_compressionLevel, kZstdLevel));
+    Check(ZSTD_CCtx_setPledgedSrcSize(cctx_.get(), total));
+  }
+  // Room for `size` more bytes, filled by the Put calls that follow.
+  void Reserve(std::size_t size) {
+    const std::size_t before = raw_.size();
+    raw_.resize(before + size);
+    at_ = raw_.data() + before;
+  }
+  void Put(const void* bytes, std::size_t size) {
+    std::memcpy(at_, bytes, size);
+    at_ += size;
+  }
+  void PutU32(std::size_t value) {
+    const auto v = static_cast<std::uint32_t>(value);
+    Put(&v, sizeof v);
+  }
+  void PutByte(std::uint8_t value) { *at_++ = static_cast<char>(value); }
+  // Compresses what was put; `end` closes the frame.
+  void Flush(bool end) {
+    const ZSTD_EndDirective mode = end ? ZSTD_e_end : ZSTD_e_continue;
+    ZSTD_inBuffer in{raw_.data(), raw_.size(), 0};
+    std::size_t left = 0;
+    do {
+      ZSTD_outBuffer out{chunk_.data(), chunk_.size(), 0};
+      left = Check(ZSTD_compressStream2(cctx_.get(), &out, &in, mode));
+      frame_.append(chunk_.data(), out.pos);
+    } while (end ? left != 0 : in.pos < in.size);
+    raw_.clear();
+  }
+  [[nodiscard]] std::string& Frame() { return frame_; }
+
+ private:
+  static std::size_t Check(std::size_t code) {
+    if (ZSTD_isError(code))
+      throw std::runtime_error(std::string("zstd: ") + ZSTD_getErrorName(code));
+    return code;
+  }
+  std::unique_ptr<ZSTD_CCtx, decltype(&ZSTD_freeCCtx)> cctx_;
+  std::string chunk_, raw_, frame_;
+  char* at_ = nullptr;
+};
+
+// The bins of `beam` with a mesh, hence a point.
+void PointBins(const BeamLabels& beam, std::vector<std::uint32_t>& bins) {
+  bins.clear();
+  for (std::size_t k = 0; k < beam.mesh.size(); ++k) {
+    if (beam.mesh[k] != kNoLabelMesh) bins.push_back(static_cast<std::uint32_t>(k));
+  }
+}
+
+// A beam's bytes in the file.
+std::size_t BeamBytes(std::size_t bins, std::size_t points) {
+  return 8 + bins * (kStoredPaths + 2) + points * 16;
+}
+
+}  // namespace
+
+std::string EncodeLabelFile(std::span<const BeamLabels> beams) {
+  std::vector<std::uint32_t> points;
+  std::size_t total = sizeof kLabelMagic + 8;
+  for (const BeamLabels& beam : beams) {
+    PointBins(beam, points);
+    total += BeamBytes(beam.shares.size(), points.size());
+  }
+  FrameWriter out(total);
+  out.Reserve(sizeof kLabelMagic + 8);
+  out.Put(kLabelMagic, sizeof kLabelMagic);
+  out.PutU32(beams.size());
+  out.PutU32(kEchoPaths);
   for (const BeamLabels& beam : beams) {
     const std::size_t bins = beam.shares.size();
-    Put<std::uint32_t>(raw, static_cast<std::uint32_t>(bins));
+    PointBins(beam, points);
+    out.Reserve(BeamBytes(bins, points.size()));
+    out.PutU32(bins);
     for (std::size_t p = 0; p < kStoredPaths; ++p) {
-      for (std::size_t k = 0; k < bins; ++k) raw.push_back(static_cast<char>(beam.shares[k][p]));
+      for (std::size_t k = 0; k < bins; ++k) out.PutByte(beam.shares[k][p]);
     }
-    for (std::size_t k = 0; k < bins; ++k) Put<std::uint16_t>(raw, beam.mesh[k]);
-    std::vector<std::uint32_t> points;
-    for (std::size_t k = 0; k < bins; ++k) {
-      if (beam.mesh[k] != kNoLabelMesh) points.push_back(static_cast<std::uint32_t>(k));
-    }
-    Put<std::uint32_t>(raw, static_cast<std::uint32_t>(points.size()));
-    for (const std::uint32_t k : points) Put<std::uint32_t>(raw, k);
+    out.Put(beam.mesh.data(), bins * sizeof(std::uint16_t));
+    out.PutU32(points.size());
+    out.Put(points.data(), points.size() * sizeof(std::uint32_t));
     for (int i = 0; i < 3; ++i) {
-      for (const std::uint32_t k : points) Put<float>(raw, beam.point_sonar_m[k][i]);
+      for (const std::uint32_t k : points) out.Put(&beam.point_sonar_m[k][i], sizeof(float));
     }
+    out.Flush(false);
   }
-  std::string frame(ZSTD_compressBound(raw.size()), '\0');
-  const std::size_t n =
-      ZSTD_compress(frame.data(), frame.size(), raw.data(), raw.size(), kZstdLevel);
-  if (ZSTD_isError(n)) throw std::runtime_error(std::string("zstd: ") + ZSTD_getErrorName(n));
-  frame.resize(n);
-  return frame;
+  out.Flush(true);
+  return std::move(out.Frame());
 }
+
+namespace {
 
 std::string Decompress(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -155,33 +220,8 @@ std::string LabelFile(std::size_t sweep) {
   return "truth/labels_" + digits + ".bin";
 }
 
-std::array<std::uint8_t, kEchoPaths> ShareOf(std::span<const float, kEchoPaths> energy) {
-  std::array<std::uint8_t, kEchoPaths> shares{};
-  double total = 0.0;
-  for (const float e : energy) total += std::max<double>(e, 0.0);
-  if (!(total > 0.0)) {
-    shares[static_cast<std::size_t>(EchoPath::kNoise)] = 255;
-    return shares;
-  }
-  std::array<double, kEchoPaths> rest{};
-  int given = 0;
-  for (std::size_t p = 0; p < kEchoPaths; ++p) {
-    const double exact = 255.0 * std::max<double>(energy[p], 0.0) / total;
-    shares[p] = static_cast<std::uint8_t>(std::min(255.0, std::floor(exact)));
-    rest[p] = exact - shares[p];
-    given += shares[p];
-  }
-  // The largest remainders (the earlier path on a tie) take what rounding down left.
-  std::array<std::size_t, kEchoPaths> order{};
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return rest[a] > rest[b]; });
-  for (std::size_t i = 0; given < 255; ++i, ++given) ++shares[order[i % kEchoPaths]];
-  return shares;
-}
-
 void WriteLabelFile(const std::string& path, std::span<const BeamLabels> beams) {
-  const std::string frame = Encode(beams);
+  const std::string frame = EncodeLabelFile(beams);
   WriteFileAtomically(path, [&](std::ostream& out) {
     out.write(frame.data(), static_cast<std::streamsize>(frame.size()));
   });

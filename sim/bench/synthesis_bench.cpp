@@ -29,6 +29,8 @@
 #include <string>
 #include <vector>
 
+#include "sonarbench/io/labels.hpp"
+#include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/sonar/beam_synthesizer.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
@@ -285,6 +287,22 @@ void BM_SynthesisLabels(benchmark::State& state, const std::string& file, Labels
       PrimaryRaysPerSweep(bench.scene) * state.iterations(), benchmark::Counter::kIsRate);
 }
 
+// The same with labels, and the sweep's label file formed as `simulate` writes it (each bin's
+// shares, the zstd frame; not the disk): what a dataset's labels cost in all.
+void BM_SynthesisLabelFile(benchmark::State& state, const std::string& file) {
+  const BenchScene& bench = TheSetup(file).bench;
+  const BeamSynthesizer synthesizer = SceneSynthesizer(bench.scene, bench.tracer, kSeed);
+  std::vector<SynthesizedBeam> beams;
+  for (auto _ : state) {
+    SimulateBeamsInto(bench.scene, synthesizer, kSeed, 1, 0, ScenarioBeamCount(bench.scene),
+                      Labels::kKeep, beams);
+    const std::string frame = io::EncodeLabelFile(LabelFileBeams(beams, 1));
+    benchmark::DoNotOptimize(frame.data());
+  }
+  state.counters["rays/s"] = benchmark::Counter(
+      PrimaryRaysPerSweep(bench.scene) * state.iterations(), benchmark::Counter::kIsRate);
+}
+
 // The same without multipath: one ray per primary, the raw benchmark's rays exactly.
 void BM_SynthesisNoMultipath(benchmark::State& state, const std::string& file) {
   const BenchScene& bench = TheSetup(file).bench;
@@ -325,6 +343,9 @@ BENCHMARK_CAPTURE(BM_SynthesisLabels, tank_unlabelled, kTank, Labels::kDrop)
 BENCHMARK_CAPTURE(BM_SynthesisLabels, tank_labelled, kTank, Labels::kKeep)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK_CAPTURE(BM_SynthesisLabelFile, tank_labelled_file, kTank)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_RawEmbree, seabed, kSeabed)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RawEmbreeBundle, seabed, kSeabed)
     ->Unit(benchmark::kMillisecond)
@@ -341,6 +362,9 @@ BENCHMARK_CAPTURE(BM_SynthesisLabels, seabed_unlabelled, kSeabed, Labels::kDrop)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_SynthesisLabels, seabed_labelled, kSeabed, Labels::kKeep)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_SynthesisLabelFile, seabed_labelled_file, kSeabed)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <numeric>
+#include <random>
 #include <string>
 
 #include "sonarbench/io/labels.hpp"
@@ -25,6 +26,44 @@ TEST(Labels, SharesRoundToTwoHundredFiftyFifths) {
   EXPECT_EQ(shares[2], 0);
   const std::array<float, kEchoPaths> nothing{};
   EXPECT_EQ(ShareOf(nothing)[static_cast<std::size_t>(EchoPath::kNoise)], 255);
+}
+
+// What rounding down leaves goes to the largest remainders, the earlier path on a tie.
+TEST(Labels, SharesLeftByRoundingGoToTheEarlierPathOnATie) {
+  using Shares = std::array<std::uint8_t, kEchoPaths>;
+  EXPECT_EQ(ShareOf(std::array<float, kEchoPaths>{1, 1, 0, 0, 0, 0, 0}),
+            (Shares{128, 127, 0, 0, 0, 0, 0}));
+  EXPECT_EQ(ShareOf(std::array<float, kEchoPaths>{0, 0, 0, 1, 1, 1, 1}),
+            (Shares{0, 0, 0, 64, 64, 64, 63}));
+}
+
+// Over random energies of one to seven paths: each share is its exact value rounded down or up,
+// and a path rounded up has a larger remainder than any rounded down (or an equal one, earlier).
+TEST(Labels, SharesAreTheLargestRemainderRounding) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> size(0.0F, 1.0F);
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::array<float, kEchoPaths> energy{};
+    for (float& e : energy) e = rng() % 3 == 0 ? 0.0F : std::pow(size(rng), 4.0F);
+    const auto shares = ShareOf(energy);
+    const double total = std::accumulate(energy.begin(), energy.end(), 0.0);
+    if (total == 0.0) continue;
+    ASSERT_EQ(std::accumulate(shares.begin(), shares.end(), 0U), 255U) << trial;
+    std::array<double, kEchoPaths> rest{};
+    std::array<bool, kEchoPaths> up{};
+    for (std::size_t p = 0; p < kEchoPaths; ++p) {
+      const double exact = 255.0 * energy[p] / total;
+      rest[p] = exact - std::floor(exact);
+      ASSERT_LE(std::abs(shares[p] - exact), 1.0) << trial;
+      up[p] = shares[p] > exact;
+    }
+    for (std::size_t i = 0; i < kEchoPaths; ++i) {
+      for (std::size_t j = 0; j < kEchoPaths; ++j) {
+        if (!up[i] || up[j] || energy[j] == 0.0F) continue;
+        ASSERT_TRUE(rest[i] > rest[j] || (rest[i] == rest[j] && i < j)) << trial;
+      }
+    }
+  }
 }
 
 BeamLabels TwoBins() {

@@ -1,6 +1,7 @@
 #include "sonarbench/sim/app/dataset_writer.hpp"
 
 #include <octomap/OcTree.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cctype>
@@ -180,27 +181,6 @@ std::string TruthCsv(std::span<const SynthesizedBeam> beams, std::size_t first_i
   return csv;
 }
 
-// A sweep's labels as the label file holds them: each bin's shares, mesh and point.
-std::vector<io::BeamLabels> LabelsOf(std::span<const SynthesizedBeam> beams) {
-  std::vector<io::BeamLabels> out(beams.size());
-  for (std::size_t b = 0; b < beams.size(); ++b) {
-    const std::vector<BinLabel>& bins = beams[b].labels;
-    io::BeamLabels& labels = out[b];
-    labels.shares.reserve(bins.size());
-    for (const BinLabel& bin : bins) {
-      if (bin.mesh != kNoMesh && bin.mesh >= io::kNoLabelMesh) {
-        throw InputError("the label files number meshes in 16 bits: a scene of at most " +
-                         std::to_string(io::kNoLabelMesh) + " meshes");
-      }
-      labels.shares.push_back(io::ShareOf(bin.energy));
-      labels.mesh.push_back(bin.mesh == kNoMesh ? io::kNoLabelMesh
-                                                : static_cast<std::uint16_t>(bin.mesh));
-      labels.point_sonar_m.push_back(bin.point_sonar_m);
-    }
-  }
-  return out;
-}
-
 void WriteTruthOccupancy(const fs::path& path, const std::vector<TriangleMesh>& meshes,
                          double resolution) {
   octomap::OcTree tree(resolution);
@@ -216,6 +196,35 @@ void WriteTruthOccupancy(const fs::path& path, const std::vector<TriangleMesh>& 
 }
 
 }  // namespace
+
+std::vector<io::BeamLabels> LabelFileBeams(std::span<const SynthesizedBeam> beams, int threads) {
+  for (const SynthesizedBeam& beam : beams) {
+    for (const BinLabel& bin : beam.labels) {
+      if (bin.mesh != kNoMesh && bin.mesh >= io::kNoLabelMesh) {
+        throw InputError("the label files number meshes in 16 bits: a scene of at most " +
+                         std::to_string(io::kNoLabelMesh) + " meshes");
+      }
+    }
+  }
+  std::vector<io::BeamLabels> out(beams.size());
+  const int n_threads = threads > 0 ? threads : omp_get_max_threads();
+#pragma omp parallel for num_threads(n_threads) schedule(static)
+  for (std::int64_t b = 0; b < static_cast<std::int64_t>(beams.size()); ++b) {
+    const std::vector<BinLabel>& bins = beams[static_cast<std::size_t>(b)].labels;
+    io::BeamLabels& labels = out[static_cast<std::size_t>(b)];
+    labels.shares.resize(bins.size());
+    labels.mesh.resize(bins.size());
+    labels.point_sonar_m.resize(bins.size());
+    for (std::size_t k = 0; k < bins.size(); ++k) {
+      const BinLabel& bin = bins[k];
+      io::ShareInto(bin.energy, labels.shares[k]);
+      labels.mesh[k] =
+          bin.mesh == kNoMesh ? io::kNoLabelMesh : static_cast<std::uint16_t>(bin.mesh);
+      labels.point_sonar_m[k] = bin.point_sonar_m;
+    }
+  }
+  return out;
+}
 
 std::string SceneConfigHash(const Scene& scene, std::uint64_t seed) {
   json inputs = {{"tool", ReportHeader()["tool"]},
@@ -398,7 +407,8 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
       const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
       WriteBeams(root / io::SweepFile("beams", s, "bin"), beams);
       WriteText(root / io::SweepFile("truth", s, "csv"), TruthCsv(synthesized, first, scene));
-      io::WriteLabelFile((root / io::LabelFile(s)).string(), LabelsOf(synthesized));
+      io::WriteLabelFile((root / io::LabelFile(s)).string(),
+                         LabelFileBeams(synthesized, options.threads));
       WritePolarImage((root / io::SweepFile("images", s, "png")).string(), beams,
                       scene.name + ", seed " + std::to_string(seed) + ": sweep " +
                           std::to_string(s) + ", polar");

@@ -167,6 +167,35 @@ TEST_F(TankDataset, ReadsBackTheSimulatedBeamsAndPoses) {
   EXPECT_GT(direct_bins, 10u);
 }
 
+// The label file's records are the same on any number of threads; a mesh the file's 16 bits
+// cannot number is refused with what the file can hold.
+TEST(LabelFileBeams, AreTheSameOnAnyThreadsAndRefuseMeshesPastSixteenBits) {
+  std::vector<sim::SynthesizedBeam> beams(5);
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    beams[b].labels.resize(40);
+    for (std::size_t k = 0; k < 40; ++k) {
+      sim::BinLabel& bin = beams[b].labels[k];
+      bin.energy = {static_cast<float>(k % 3), 0.5F, 0, 0, 0, 0, static_cast<float>(b + 1)};
+      if (k % 4 == 0) {
+        bin.mesh = static_cast<std::uint32_t>(b);
+        bin.point_sonar_m = Eigen::Vector3f(1.0F, static_cast<float>(k), 0.0F);
+      }
+    }
+  }
+  const std::vector<io::BeamLabels> one = sim::LabelFileBeams(beams, 1);
+  const std::vector<io::BeamLabels> two = sim::LabelFileBeams(beams, 2);
+  ASSERT_EQ(one.size(), 5u);
+  EXPECT_EQ(io::EncodeLabelFile(one), io::EncodeLabelFile(two));
+  EXPECT_EQ(one[3].mesh[8], 3);
+  EXPECT_EQ(one[3].mesh[9], io::kNoLabelMesh);
+  EXPECT_EQ(one[3].shares[2], io::ShareOf(beams[3].labels[2].energy));
+  beams[4].labels[7].mesh = 70000;
+  EXPECT_NE(test::InputErrorOf([&] {
+              (void)sim::LabelFileBeams(beams, 2);
+            }).find("a scene of at most 65535 meshes"),
+            std::string::npos);
+}
+
 TEST_F(TankDataset, ShardsAndResumedRunsGiveTheSameBytesAsOneRun) {
   test::TempDir dir;
   const auto whole = dir.path() / "whole";

@@ -53,13 +53,59 @@ template <typename T>
 /// Sweep `sweep`'s label file in a dataset: "truth/labels_0012.bin".
 [[nodiscard]] std::string LabelFile(std::size_t sweep);
 
-/// Each path's share of `energy` in 255ths, rounded so that they sum to 255 (largest
-/// remainders); all noise when `energy` sums to nothing.
-[[nodiscard]] std::array<std::uint8_t, kEchoPaths> ShareOf(
-    std::span<const float, kEchoPaths> energy);
+/// Each path's share of `energy` in 255ths into `shares`, rounded so that they sum to 255
+/// (largest remainders); all noise when `energy` sums to nothing. Inline, writing in place: the
+/// dataset writer calls it for every bin, and a 7-byte array returned is shuffled through memory.
+inline void ShareInto(std::span<const float, kEchoPaths> energy,
+                      std::span<std::uint8_t, kEchoPaths> shares) {
+  double total = 0.0;
+  std::size_t paths = 0;
+  std::size_t last = static_cast<std::size_t>(EchoPath::kNoise);
+  for (std::size_t p = 0; p < kEchoPaths; ++p) {
+    if (!(energy[p] > 0.0F)) continue;
+    total += energy[p];
+    ++paths;
+    last = p;
+  }
+  std::array<int, kEchoPaths> whole{};
+  if (paths < 2 || !(total > 0.0)) {  // one path, or none (all noise)
+    whole[last] = 255;
+  } else {
+    std::array<double, kEchoPaths> rest{};
+    int given = 0;
+    for (std::size_t p = 0; p < kEchoPaths; ++p) {
+      if (!(energy[p] > 0.0F)) continue;  // share and remainder 0
+      const double exact = std::min(255.0, 255.0 * static_cast<double>(energy[p]) / total);
+      whole[p] = static_cast<int>(exact);  // exact ≥ 0: truncation is the floor
+      rest[p] = exact - whole[p];
+      given += whole[p];
+    }
+    // The largest remainders take what rounding down left, one each (fewer than kEchoPaths, as
+    // each path lost less than one), the earlier path on a tie.
+    for (; given < 255; ++given) {
+      std::size_t most = 0;
+      for (std::size_t p = 1; p < kEchoPaths; ++p) {
+        if (rest[p] > rest[most]) most = p;
+      }
+      ++whole[most];
+      rest[most] = -1.0;
+    }
+  }
+  for (std::size_t p = 0; p < kEchoPaths; ++p) shares[p] = static_cast<std::uint8_t>(whole[p]);
+}
 
-/// Writes one sweep's labels: a zstd frame of the little-endian layout of
+/// ShareInto's shares, returned.
+[[nodiscard]] inline std::array<std::uint8_t, kEchoPaths> ShareOf(
+    std::span<const float, kEchoPaths> energy) {
+  std::array<std::uint8_t, kEchoPaths> shares{};
+  ShareInto(energy, shares);
+  return shares;
+}
+
+/// One sweep's label file as bytes: a zstd frame of the little-endian layout of
 /// docs/dataset-format.md ("SBLABEL1", beam count, path count, then per beam its bins).
+[[nodiscard]] std::string EncodeLabelFile(std::span<const BeamLabels> beams);
+/// Writes one sweep's labels (EncodeLabelFile) atomically.
 void WriteLabelFile(const std::string& path, std::span<const BeamLabels> beams);
 /// A dataset's labels, beam by beam (every sweep's label file in turn), when its manifest lists
 /// them (a simulated dataset); none otherwise. Throws InputError as ReadLabelFile does, or when

@@ -3,11 +3,14 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/labels.hpp"
 #include "sonarbench/io/mat_log.hpp"
+#include "sonarbench/sim/sonar/beam_synthesizer.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 
 namespace sonarbench::sim {
@@ -55,6 +58,12 @@ struct DatasetSummary {
   bool already_complete = false;
   std::string config_sha256;
 };
+
+/// A sweep's labels as its label file holds them (io::EncodeLabelFile): each bin's shares,
+/// mesh and point, beams on `threads` threads (0: all cores). Throws InputError for a scene of
+/// more meshes than the file numbers.
+[[nodiscard]] std::vector<io::BeamLabels> LabelFileBeams(std::span<const SynthesizedBeam> beams,
+                                                         int threads);
 
 /// Simulates a scene into a dataset directory (io::ReadDataset's format). Every file is
 /// written atomically; a sweep is complete when its beam, truth and image files all exist, and
