@@ -98,8 +98,9 @@ class FrameWriter {
 
  private:
   static std::size_t Check(std::size_t code) {
-    if (ZSTD_isError(code))
+    if (ZSTD_isError(code)) {
       throw std::runtime_error(std::string("zstd: ") + ZSTD_getErrorName(code));
+    }
     return code;
   }
   std::unique_ptr<ZSTD_CCtx, decltype(&ZSTD_freeCCtx)> cctx_;
