@@ -74,6 +74,7 @@ class FrameWriter {
     at_ = raw_.data() + before;
   }
   void Put(const void* bytes, std::size_t size) {
+    if (size == 0) return;  // an empty beam's data() may be null, which memcpy must not see
     std::memcpy(at_, bytes, size);
     at_ += size;
   }
