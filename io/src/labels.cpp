@@ -58,14 +58,23 @@ class Payload {
   std::size_t at_ = 0;
 };
 
+// A thread's zstd context and buffers, kept from one label file to the next: made afresh, their
+// memory is mapped and zeroed for every file.
+struct Compressor {
+  std::unique_ptr<ZSTD_CCtx, decltype(&ZSTD_freeCCtx)> cctx{ZSTD_createCCtx(), ZSTD_freeCCtx};
+  std::string chunk = std::string(ZSTD_CStreamOutSize(), '\0');
+  std::string raw;
+};
+
 // A label file's bytes: put, then compressed a beam at a time (not the sweep's bytes at once)
 // into one frame whose header holds the whole size, as the reader expects.
 class FrameWriter {
  public:
-  explicit FrameWriter(std::size_t total)
-      : cctx_(ZSTD_createCCtx(), ZSTD_freeCCtx), chunk_(ZSTD_CStreamOutSize(), '\0') {
-    Check(ZSTD_CCtx_setParameter(cctx_.get(), ZSTD_c_compressionLevel, kZstdLevel));
-    Check(ZSTD_CCtx_setPledgedSrcSize(cctx_.get(), total));
+  explicit FrameWriter(std::size_t total) : c_(ThreadCompressor()) {
+    Check(ZSTD_CCtx_reset(c_.cctx.get(), ZSTD_reset_session_and_parameters));
+    Check(ZSTD_CCtx_setParameter(c_.cctx.get(), ZSTD_c_compressionLevel, kZstdLevel));
+    Check(ZSTD_CCtx_setPledgedSrcSize(c_.cctx.get(), total));
+    c_.raw.clear();
   }
   // Room for `size` more bytes, filled by the Put calls that follow.
   void Reserve(std::size_t size) {
@@ -82,16 +91,21 @@ class FrameWriter {
     const auto v = static_cast<std::uint32_t>(value);
     Put(&v, sizeof v);
   }
-  void PutByte(std::uint8_t value) { *at_++ = static_cast<char>(value); }
+  // The next `size` bytes of the room reserved, to fill in place.
+  std::uint8_t* Claim(std::size_t size) {
+    auto* bytes = reinterpret_cast<std::uint8_t*>(at_);
+    at_ += size;
+    return bytes;
+  }
   // Compresses what was put; `end` closes the frame.
   void Flush(bool end) {
     const ZSTD_EndDirective mode = end ? ZSTD_e_end : ZSTD_e_continue;
     ZSTD_inBuffer in{raw_.data(), raw_.size(), 0};
     std::size_t left = 0;
     do {
-      ZSTD_outBuffer out{chunk_.data(), chunk_.size(), 0};
-      left = Check(ZSTD_compressStream2(cctx_.get(), &out, &in, mode));
-      frame_.append(chunk_.data(), out.pos);
+      ZSTD_outBuffer out{c_.chunk.data(), c_.chunk.size(), 0};
+      left = Check(ZSTD_compressStream2(c_.cctx.get(), &out, &in, mode));
+      frame_.append(c_.chunk.data(), out.pos);
     } while (end ? left != 0 : in.pos < in.size);
     raw_.clear();
   }
@@ -104,8 +118,13 @@ class FrameWriter {
     }
     return code;
   }
-  std::unique_ptr<ZSTD_CCtx, decltype(&ZSTD_freeCCtx)> cctx_;
-  std::string chunk_, raw_, frame_;
+  static Compressor& ThreadCompressor() {
+    thread_local Compressor compressor;
+    return compressor;
+  }
+  Compressor& c_;
+  std::string& raw_ = c_.raw;
+  std::string frame_;
   char* at_ = nullptr;
 };
 
@@ -128,8 +147,9 @@ std::string EncodeLabelFile(std::span<const BeamLabels> beams) {
   std::vector<std::uint32_t> points;
   std::size_t total = sizeof kLabelMagic + 8;
   for (const BeamLabels& beam : beams) {
-    PointBins(beam, points);
-    total += BeamBytes(beam.shares.size(), points.size());
+    const auto with_mesh = std::count_if(beam.mesh.begin(), beam.mesh.end(),
+                                         [](std::uint16_t m) { return m != kNoLabelMesh; });
+    total += BeamBytes(beam.shares.size(), static_cast<std::size_t>(with_mesh));
   }
   FrameWriter out(total);
   out.Reserve(sizeof kLabelMagic + 8);
@@ -141,14 +161,21 @@ std::string EncodeLabelFile(std::span<const BeamLabels> beams) {
     PointBins(beam, points);
     out.Reserve(BeamBytes(bins, points.size()));
     out.PutU32(bins);
+    std::uint8_t* const planes = out.Claim(kStoredPaths * bins);
+    const std::array<std::uint8_t, kEchoPaths>* const shares = beam.shares.data();
     for (std::size_t p = 0; p < kStoredPaths; ++p) {
-      for (std::size_t k = 0; k < bins; ++k) out.PutByte(beam.shares[k][p]);
+      for (std::size_t k = 0; k < bins; ++k) planes[p * bins + k] = shares[k][p];
     }
     out.Put(beam.mesh.data(), bins * sizeof(std::uint16_t));
     out.PutU32(points.size());
     out.Put(points.data(), points.size() * sizeof(std::uint32_t));
-    for (int i = 0; i < 3; ++i) {
-      for (const std::uint32_t k : points) out.Put(&beam.point_sonar_m[k][i], sizeof(float));
+    std::uint8_t* const coordinates = out.Claim(3 * sizeof(float) * points.size());
+    const Eigen::Vector3f* const point = beam.point_sonar_m.data();
+    for (std::size_t i = 0; i < 3; ++i) {
+      for (std::size_t j = 0; j < points.size(); ++j) {
+        std::memcpy(coordinates + (i * points.size() + j) * sizeof(float), &point[points[j]][i],
+                    sizeof(float));
+      }
     }
     out.Flush(false);
   }

@@ -16,13 +16,20 @@
 //                       mirrored and occlusion rays), recorded from one sweep and replayed
 //                       through Embree alone: /*_queries as the queries it made, /*_per_ray one
 //                       query per ray (the whole synthesis's comparison: traced_rays/s)
-// Per-run set-up is outside every timing, as a run does it once: the BVH (the raw rows' too) and
-// the synthesizer's tables (SceneSynthesizer); everything done per beam is inside.
-// Counters: primary rays per second (compare BM_SynthesisNoMultipath with the faster raw one),
-// all rays traced per second (compare BM_Synthesis/1 with the replays) and, for the synthesis,
-// the real-time factor: the real sonar's time for the sweep over ours.
+//   BM_SynthesisLabels  one sweep on one thread with and without the bins' labels;
+//                       BM_SynthesisLabelFile the same with the label file formed
+//   BM_SimulateDataset  `simulate` whole on one thread, every sweep of the scene (its own count):
+//                       meshes, BVH, synthesis, the beam, truth, image and (/*_labels) label
+//                       files, the truth occupancy, into a temporary directory replaced each time
+// Per-run set-up is outside every timing but BM_SimulateDataset's, as a run does it once: the BVH
+// (the raw rows' too) and the synthesizer's tables (SceneSynthesizer); everything done per beam is
+// inside. Counters: primary rays per second (compare BM_SynthesisNoMultipath with the faster raw
+// one), all rays traced per second (compare BM_Synthesis/1 with the replays) and, for the
+// synthesis, the real-time factor: the real sonar's time for the sweep over ours.
 #include <benchmark/benchmark.h>
+#include <unistd.h>
 
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
@@ -293,14 +300,33 @@ void BM_SynthesisLabelFile(benchmark::State& state, const std::string& file) {
   const BenchScene& bench = TheSetup(file).bench;
   const BeamSynthesizer synthesizer = SceneSynthesizer(bench.scene, bench.tracer, kSeed);
   std::vector<SynthesizedBeam> beams;
+  std::vector<io::BeamLabels> labels;
   for (auto _ : state) {
     SimulateBeamsInto(bench.scene, synthesizer, kSeed, 1, 0, ScenarioBeamCount(bench.scene),
                       Labels::kKeep, beams);
-    const std::string frame = io::EncodeLabelFile(LabelFileBeams(beams, 1));
+    LabelFileBeams(beams, 1, labels);
+    const std::string frame = io::EncodeLabelFile(labels);
     benchmark::DoNotOptimize(frame.data());
   }
   state.counters["rays/s"] = benchmark::Counter(
       PrimaryRaysPerSweep(bench.scene) * state.iterations(), benchmark::Counter::kIsRate);
+}
+
+// `simulate` as a user runs it, with and without the label files: their whole cost is the ratio.
+void BM_SimulateDataset(benchmark::State& state, const std::string& file, bool labels) {
+  const Scene scene = LoadScene(std::string(SONARBENCH_SOURCE_DIR "/scenes/") + file);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("sonarbench-bench-" + std::to_string(::getpid()));
+  DatasetOptions options;
+  options.threads = 1;
+  options.force = true;
+  options.labels = labels;
+  for (auto _ : state) {
+    const DatasetSummary summary = SimulateDataset(scene, dir.string(), options);
+    benchmark::DoNotOptimize(summary.sweeps_written);
+  }
+  std::filesystem::remove_all(dir);
+  state.counters["sweeps"] = static_cast<double>(scene.sweeps);
 }
 
 // The same without multipath: one ray per primary, the raw benchmark's rays exactly.
@@ -346,6 +372,12 @@ BENCHMARK_CAPTURE(BM_SynthesisLabels, tank_labelled, kTank, Labels::kKeep)
 BENCHMARK_CAPTURE(BM_SynthesisLabelFile, tank_labelled_file, kTank)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK_CAPTURE(BM_SimulateDataset, tank_labels, kTank, true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_SimulateDataset, tank_no_labels, kTank, false)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_RawEmbree, seabed, kSeabed)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_RawEmbreeBundle, seabed, kSeabed)
     ->Unit(benchmark::kMillisecond)
@@ -365,6 +397,12 @@ BENCHMARK_CAPTURE(BM_SynthesisLabels, seabed_labelled, kSeabed, Labels::kKeep)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_SynthesisLabelFile, seabed_labelled_file, kSeabed)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_SimulateDataset, seabed_labels, kSeabed, true)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_SimulateDataset, seabed_no_labels, kSeabed, false)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

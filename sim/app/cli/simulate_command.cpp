@@ -18,6 +18,7 @@ struct SimulateArgs {
   bool force = false;
   std::string shard;
   bool no_progress = false;
+  bool no_labels = false;
 };
 
 int Simulate(const SimulateArgs& args) {
@@ -27,6 +28,7 @@ int Simulate(const SimulateArgs& args) {
   options.seed = args.seed;
   options.threads = args.threads;
   options.force = args.force;
+  options.labels = !args.no_labels;
   options.shard = ResolveShard(args.shard);
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   options.progress = [&](std::size_t done, std::size_t total) {
@@ -58,8 +60,9 @@ CLI::App* AddOptions(CLI::App& app, SimulateArgs& args) {
   CLI::App* command = app.add_subcommand(
       "simulate",
       "Simulate SCENE into a dataset directory (format: docs/dataset-format.md): beams of every "
-      "sweep in binary, a polar PNG per sweep, per-beam ground truth, sonar and vehicle poses "
-      "(TUM), the truth occupancy (.bt) and manifest.json with the sha256 of every file. Writes "
+      "sweep in binary, a polar PNG per sweep, per-beam ground truth, per-bin labels of where "
+      "each echo came from, sonar and vehicle poses (TUM), the truth occupancy (.bt) and "
+      "manifest.json with the sha256 of every file. Writes "
       "are atomic; a rerun resumes where a killed one stopped; an existing dataset is replaced "
       "only with --force. `sonarbench map DIR` maps it.");
   command->add_option("scene", args.scene, "Scene YAML file")->required()->check(CLI::ExistingFile);
@@ -74,6 +77,9 @@ CLI::App* AddOptions(CLI::App& app, SimulateArgs& args) {
       "K/N: write only sweeps s with s mod N = K-1 (cluster array jobs; default from "
       "SLURM_ARRAY_TASK_ID/_MIN/_COUNT). Beams are seeded by hashing their index, so shards "
       "give the same bytes as one run");
+  command->add_flag("--no-labels", args.no_labels,
+                    "Write no per-bin label files (truth/labels_NNNN.bin, 3-4 times the size of "
+                    "the beam files); the beams are the same bytes either way");
   command->add_flag("--no-progress", args.no_progress, "Never show the progress line");
   return command;
 }

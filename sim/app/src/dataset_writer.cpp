@@ -58,10 +58,10 @@ std::optional<std::string> StoredConfig(const fs::path& file) {
   }
 }
 
-// Every file a dataset of `sweeps` sweeps holds (with truth when simulated), and the partial
-// marker: what its output directory claims.
+// Every file a dataset of `sweeps` sweeps holds (with truth when simulated, label files when
+// `labels`), and the partial marker: what its output directory claims.
 OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sweeps,
-                         bool simulated, bool force) {
+                         bool simulated, bool labels, bool force) {
   OutputClaim claim;
   claim.command = std::move(command);
   claim.config_sha256 = std::move(config);
@@ -75,7 +75,7 @@ OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sw
     claim.files.push_back(io::SweepFile("beams", s, "bin"));
     claim.files.push_back(io::SweepFile("images", s, "png"));
     if (simulated) claim.files.push_back(io::SweepFile("truth", s, "csv"));
-    if (simulated) claim.files.push_back(io::LabelFile(s));
+    if (labels) claim.files.push_back(io::LabelFile(s));
   }
   claim.record = "manifest.json";
   claim.force = force;
@@ -154,11 +154,11 @@ void WriteBeams(const fs::path& path, std::span<const mapping::Beam> beams) {
   WriteFileAtomically(path.string(), [&](std::ostream& out) { io::WriteBeamFile(out, beams); });
 }
 
-bool SweepComplete(const fs::path& root, std::size_t sweep, bool with_truth) {
+bool SweepComplete(const fs::path& root, std::size_t sweep, bool with_truth, bool with_labels) {
   return fs::is_regular_file(root / io::SweepFile("beams", sweep, "bin")) &&
          fs::is_regular_file(root / io::SweepFile("images", sweep, "png")) &&
-         (!with_truth || (fs::is_regular_file(root / io::SweepFile("truth", sweep, "csv")) &&
-                          fs::is_regular_file(root / io::LabelFile(sweep))));
+         (!with_truth || fs::is_regular_file(root / io::SweepFile("truth", sweep, "csv"))) &&
+         (!with_labels || fs::is_regular_file(root / io::LabelFile(sweep)));
 }
 
 std::string TruthCsv(std::span<const SynthesizedBeam> beams, std::size_t first_index,
@@ -197,18 +197,12 @@ void WriteTruthOccupancy(const fs::path& path, const std::vector<TriangleMesh>& 
 
 }  // namespace
 
-std::vector<io::BeamLabels> LabelFileBeams(std::span<const SynthesizedBeam> beams, int threads) {
-  for (const SynthesizedBeam& beam : beams) {
-    for (const BinLabel& bin : beam.labels) {
-      if (bin.mesh != kNoMesh && bin.mesh >= io::kNoLabelMesh) {
-        throw InputError("the label files number meshes in 16 bits: a scene of at most " +
-                         std::to_string(io::kNoLabelMesh) + " meshes");
-      }
-    }
-  }
-  std::vector<io::BeamLabels> out(beams.size());
+void LabelFileBeams(std::span<const SynthesizedBeam> beams, int threads,
+                    std::vector<io::BeamLabels>& out) {
+  out.resize(beams.size());
   const int n_threads = threads > 0 ? threads : omp_get_max_threads();
-#pragma omp parallel for num_threads(n_threads) schedule(static)
+  bool unnumbered = false;  // a mesh past the file's 16 bits (an exception cannot leave the loop)
+#pragma omp parallel for num_threads(n_threads) schedule(static) reduction(|| : unnumbered)
   for (std::int64_t b = 0; b < static_cast<std::int64_t>(beams.size()); ++b) {
     const std::vector<BinLabel>& bins = beams[static_cast<std::size_t>(b)].labels;
     io::BeamLabels& labels = out[static_cast<std::size_t>(b)];
@@ -218,12 +212,16 @@ std::vector<io::BeamLabels> LabelFileBeams(std::span<const SynthesizedBeam> beam
     for (std::size_t k = 0; k < bins.size(); ++k) {
       const BinLabel& bin = bins[k];
       io::ShareInto(bin.energy, labels.shares[k]);
+      unnumbered = unnumbered || (bin.mesh != kNoMesh && bin.mesh >= io::kNoLabelMesh);
       labels.mesh[k] =
           bin.mesh == kNoMesh ? io::kNoLabelMesh : static_cast<std::uint16_t>(bin.mesh);
       labels.point_sonar_m[k] = bin.point_sonar_m;
     }
   }
-  return out;
+  if (unnumbered) {
+    throw InputError("the label files number meshes in 16 bits: a scene of at most " +
+                     std::to_string(io::kNoLabelMesh) + " meshes");
+  }
 }
 
 std::string SceneConfigHash(const Scene& scene, std::uint64_t seed) {
@@ -254,6 +252,11 @@ std::string SceneConfigHash(const Scene& scene, std::uint64_t seed) {
     inputs["extends_sha256"] = bases;
   }
   return io::Sha256(inputs.dump());
+}
+
+std::string DatasetConfigHash(const Scene& scene, std::uint64_t seed, bool labels) {
+  const std::string scene_config = SceneConfigHash(scene, seed);
+  return labels ? scene_config : io::Sha256(scene_config + "/without label files");
 }
 
 std::vector<std::string> SceneInputFiles(const Scene& scene) {
@@ -337,7 +340,7 @@ void WritePosesAndTruth(const fs::path& root, const Scene& scene, std::uint64_t 
 
 // A simulated dataset's manifest.json.
 json SimulatedManifest(const Scene& scene, const DatasetSummary& summary, std::uint64_t seed,
-                       std::size_t beam_count) {
+                       std::size_t beam_count, bool labels) {
   json manifest =
       ManifestBase(scene.sensor.geometry, summary.sweeps_total, beam_count, summary.config_sha256);
   manifest["source"] = "simulate";
@@ -353,12 +356,14 @@ json SimulatedManifest(const Scene& scene, const DatasetSummary& summary, std::u
        "truth/sweep_NNNN.csv: beam, time_s, head_angle_rad, first_hit_range_m "
        "(nearest surface any ray of the beam's main lobe hit), first_hit_mesh, "
        "axis_hit_range_m; empty when nothing within range"},
-      {"labels",
-       "truth/labels_NNNN.bin: per bin, each echo path's share of its power, the mesh that "
-       "answers it directly and that mesh's strongest return's point (docs/dataset-format.md)"},
-      {"paths", kEchoPathNames},
       {"occupancy", "truth/occupancy.bt: every cell a mesh surface crosses, at resolution_m"},
       {"resolution_m", scene.mapping.resolution_m}};
+  if (labels) {
+    manifest["truth"]["labels"] =
+        "truth/labels_NNNN.bin: per bin, each echo path's share of its power, the mesh that "
+        "answers it directly and that mesh's strongest return's point (docs/dataset-format.md)";
+    manifest["truth"]["paths"] = kEchoPathNames;
+  }
   json mesh_names = json::array();
   for (const MeshSpec& mesh : scene.meshes) mesh_names.push_back(mesh.name);
   manifest["meshes"] = mesh_names;
@@ -372,15 +377,20 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   const std::uint64_t seed = options.seed.value_or(scene.seed);
   DatasetSummary summary;
   summary.sweeps_total = static_cast<std::size_t>(scene.sweeps);
-  summary.config_sha256 = SceneConfigHash(scene, seed);
+  summary.config_sha256 = DatasetConfigHash(scene, seed, options.labels);
+  if (options.labels && scene.meshes.size() >= io::kNoLabelMesh) {
+    throw InputError(scene.file + ": " + std::to_string(scene.meshes.size()) +
+                     " meshes; the label files number meshes in 16 bits, at most " +
+                     std::to_string(io::kNoLabelMesh) + " (--no-labels writes none)");
+  }
   // The output directory checked, then the meshes' preflight, before the directory is made: bad
   // input leaves none.
   CheckOutputDirectory(dir);
   const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
   const RayTracer tracer(meshes);
   const BeamSynthesizer synthesizer = SceneSynthesizer(scene, tracer, seed);
-  OutputClaim claim =
-      DatasetClaim("simulate", summary.config_sha256, summary.sweeps_total, true, options.force);
+  OutputClaim claim = DatasetClaim("simulate", summary.config_sha256, summary.sweeps_total, true,
+                                   options.labels, options.force);
   claim.inputs = SceneInputFiles(scene);
   const OutputDirectory out(dir, claim);
   if (PrepareDirectory(out, summary.config_sha256, true)) {
@@ -397,18 +407,22 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
                                : 0;
   std::size_t handled = 0;
   std::vector<SynthesizedBeam> synthesized;  // a sweep's, its memory kept for the next
+  std::vector<io::BeamLabels> label_beams;   // the same
   for (std::size_t s = first_sweep; s < summary.sweeps_total; s += stride) {
-    if (SweepComplete(root, s, true)) {
+    if (SweepComplete(root, s, true, options.labels)) {
       ++summary.sweeps_skipped;
     } else {
       const std::size_t first = s * per_sweep;
       SimulateBeamsInto(scene, synthesizer, seed, options.threads, first,
-                        std::min(beam_count, first + per_sweep), Labels::kKeep, synthesized);
+                        std::min(beam_count, first + per_sweep),
+                        options.labels ? Labels::kKeep : Labels::kDrop, synthesized);
       const std::vector<mapping::Beam> beams = BeamsOf(synthesized);
       WriteBeams(root / io::SweepFile("beams", s, "bin"), beams);
       WriteText(root / io::SweepFile("truth", s, "csv"), TruthCsv(synthesized, first, scene));
-      io::WriteLabelFile((root / io::LabelFile(s)).string(),
-                         LabelFileBeams(synthesized, options.threads));
+      if (options.labels) {
+        LabelFileBeams(synthesized, options.threads, label_beams);
+        io::WriteLabelFile((root / io::LabelFile(s)).string(), label_beams);
+      }
       WritePolarImage((root / io::SweepFile("images", s, "png")).string(), beams,
                       scene.name + ", seed " + std::to_string(seed) + ": sweep " +
                           std::to_string(s) + ", polar");
@@ -418,10 +432,11 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   }
 
   for (std::size_t s = 0; s < summary.sweeps_total; ++s) {
-    if (!SweepComplete(root, s, true)) return summary;  // other shards' sweeps are still due
+    // Other shards' sweeps are still due.
+    if (!SweepComplete(root, s, true, options.labels)) return summary;
   }
   WritePosesAndTruth(root, scene, seed, beam_count, meshes);
-  const json manifest = SimulatedManifest(scene, summary, seed, beam_count);
+  const json manifest = SimulatedManifest(scene, summary, seed, beam_count, options.labels);
   Finalize(out, claim.files, manifest);
   summary.complete = true;
   return summary;
@@ -444,7 +459,7 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& 
   summary.config_sha256 = io::Sha256(inputs.dump());
   CheckOutputDirectory(dir);
   OutputClaim claim =
-      DatasetClaim("import", summary.config_sha256, summary.sweeps_total, false, force);
+      DatasetClaim("import", summary.config_sha256, summary.sweeps_total, false, false, force);
   claim.inputs = {log_path};
   const OutputDirectory out(dir, claim);
   if (PrepareDirectory(out, summary.config_sha256, false)) {
@@ -456,7 +471,7 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& 
   std::string poses;
   for (std::size_t s = 0; s < summary.sweeps_total; ++s) {
     const auto sweep = all.subspan(s * per_sweep, std::min(per_sweep, all.size() - s * per_sweep));
-    if (SweepComplete(root, s, false)) {
+    if (SweepComplete(root, s, false, false)) {
       ++summary.sweeps_skipped;
     } else {
       WriteBeams(root / io::SweepFile("beams", s, "bin"), sweep);

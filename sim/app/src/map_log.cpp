@@ -76,8 +76,10 @@ std::optional<Eigen::Isometry3d> DatasetPlacement(const io::Dataset& dataset,
                      scene.file + "): score it against the scene it was simulated from");
   }
   const nlohmann::json seed = m.value("seed", nlohmann::json());
+  const nlohmann::json truth = m.value("truth", nlohmann::json::object());
+  const bool labels = truth.is_object() && truth.contains("labels");
   if (seed.is_number_unsigned() &&
-      SceneConfigHash(scene, seed.get<std::uint64_t>()) != m.value("config_sha256", "")) {
+      DatasetConfigHash(scene, seed.get<std::uint64_t>(), labels) != m.value("config_sha256", "")) {
     warnings.push_back(dir + " was simulated from other files than " + scene.file +
                        " and its meshes and sensor model now hold (config_sha256 differs): the "
                        "truth is the scene's as it is now");

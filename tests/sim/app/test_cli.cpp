@@ -181,6 +181,16 @@ TEST(Cli, MessagesNameWhatToDoNext) {
   const auto ds = dir.path() / "ds";
   ASSERT_EQ(RunCli("simulate " + scene.string() + " --out " + ds.string(), &output), 0) << output;
   EXPECT_NE(output.find("wrote 1 sweep, skipped 0"), std::string::npos) << output;
+  const auto bare = dir.path() / "bare";
+  ASSERT_EQ(RunCli("simulate " + scene.string() + " --no-labels --out " + bare.string(), &output),
+            0)
+      << output;
+  EXPECT_TRUE(fs::exists(ds / "truth/labels_0000.bin"));
+  EXPECT_FALSE(fs::exists(bare / "truth/labels_0000.bin"));
+  EXPECT_EQ(test::ReadFile(bare / "beams/sweep_0000.bin"),
+            test::ReadFile(ds / "beams/sweep_0000.bin"));
+  EXPECT_EQ(RunCli("simulate " + scene.string() + " --out " + bare.string(), &output), 2);
+  EXPECT_NE(output.find("another configuration"), std::string::npos) << output;
   const auto mine = dir.path() / "mine.mcap";
   std::ofstream(mine) << "my notes";
   EXPECT_EQ(RunCli("export " + ds.string() + " --out " + mine.string(), &output), 2);

@@ -9,6 +9,7 @@
 #include "sonarbench/io/labels.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
+#include "sonarbench/sim/app/map_log.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
 #include "sonarbench/sim/world/ray_tracer.hpp"
@@ -167,8 +168,8 @@ TEST_F(TankDataset, ReadsBackTheSimulatedBeamsAndPoses) {
   EXPECT_GT(direct_bins, 10u);
 }
 
-// The label file's records are the same on any number of threads; a mesh the file's 16 bits
-// cannot number is refused with what the file can hold.
+// The label file's records are the same on any number of threads and into reused memory; a mesh the
+// file's 16 bits cannot number is refused with what the file can hold.
 TEST(LabelFileBeams, AreTheSameOnAnyThreadsAndRefuseMeshesPastSixteenBits) {
   std::vector<sim::SynthesizedBeam> beams(5);
   for (std::size_t b = 0; b < beams.size(); ++b) {
@@ -182,8 +183,15 @@ TEST(LabelFileBeams, AreTheSameOnAnyThreadsAndRefuseMeshesPastSixteenBits) {
       }
     }
   }
-  const std::vector<io::BeamLabels> one = sim::LabelFileBeams(beams, 1);
-  const std::vector<io::BeamLabels> two = sim::LabelFileBeams(beams, 2);
+  std::vector<io::BeamLabels> one;
+  sim::LabelFileBeams(beams, 1, one);
+  // Into the memory of a sweep of more beams and bins: the same as into none.
+  std::vector<sim::SynthesizedBeam> longer = beams;
+  longer.push_back(beams[1]);
+  for (sim::SynthesizedBeam& beam : longer) beam.labels.resize(60, beams[2].labels[0]);
+  std::vector<io::BeamLabels> two;
+  sim::LabelFileBeams(longer, 2, two);
+  sim::LabelFileBeams(beams, 2, two);
   ASSERT_EQ(one.size(), 5u);
   EXPECT_EQ(io::EncodeLabelFile(one), io::EncodeLabelFile(two));
   EXPECT_EQ(one[3].mesh[8], 3);
@@ -191,7 +199,7 @@ TEST(LabelFileBeams, AreTheSameOnAnyThreadsAndRefuseMeshesPastSixteenBits) {
   EXPECT_EQ(one[3].shares[2], io::ShareOf(beams[3].labels[2].energy));
   beams[4].labels[7].mesh = 70000;
   EXPECT_NE(test::InputErrorOf([&] {
-              (void)sim::LabelFileBeams(beams, 2);
+              sim::LabelFileBeams(beams, 2, two);
             }).find("a scene of at most 65535 meshes"),
             std::string::npos);
 }
@@ -224,6 +232,61 @@ TEST_F(TankDataset, ShardsAndResumedRunsGiveTheSameBytesAsOneRun) {
 
   const auto again = sim::SimulateDataset(*scene_, split.string(), {});
   EXPECT_TRUE(again.already_complete);
+}
+
+// Without label files: the same beams, images, poses and truth, no label file listed or written, a
+// configuration of its own (a rerun never mixes the two), and mapped against its scene without a
+// warning.
+TEST_F(TankDataset, WithoutLabelFilesTheOtherFilesAreTheSameBytes) {
+  test::TempDir dir;
+  const auto whole = dir.path() / "whole";
+  const auto bare = dir.path() / "bare";
+  (void)sim::SimulateDataset(*scene_, whole.string(), {});
+  sim::DatasetOptions no_labels;
+  no_labels.labels = false;
+  no_labels.threads = 1;
+  EXPECT_TRUE(sim::SimulateDataset(*scene_, bare.string(), no_labels).complete);
+
+  const auto with = Tree(whole);
+  const auto without = Tree(bare);
+  std::size_t compared = 0;
+  for (const auto& [path, bytes] : with) {
+    if (path.starts_with("truth/labels_")) {
+      EXPECT_EQ(without.count(path), 0u) << path;
+    } else if (path != "manifest.json" && !path.starts_with(".sonarbench")) {
+      EXPECT_EQ(without.at(path), bytes) << path;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 3u * 3u + 3u + 1u);
+  EXPECT_EQ(without.size(), with.size() - 3u);
+  const io::Dataset dataset = io::ReadDataset(bare.string());
+  EXPECT_EQ(dataset.manifest["files"].size(), 3u * 3u + 3u + 1u);
+  EXPECT_FALSE(dataset.manifest["truth"].contains("labels"));
+  EXPECT_TRUE(io::ReadDatasetLabels(bare.string(), dataset).empty());
+  EXPECT_NE(dataset.manifest["config_sha256"],
+            io::ReadDataset(whole.string()).manifest["config_sha256"]);
+  EXPECT_TRUE(sim::MapLog(bare.string(), scene_->sensor.geometry, scene_->mapping, scene_)
+                  .warnings.empty());
+
+  EXPECT_NE(test::InputErrorOf([&] {
+              (void)sim::SimulateDataset(*scene_, bare.string(), {});
+            }).find("another configuration"),
+            std::string::npos);
+  sim::DatasetOptions labels_again;
+  labels_again.force = true;
+  EXPECT_TRUE(sim::SimulateDataset(*scene_, bare.string(), labels_again).complete);
+  EXPECT_EQ(Tree(bare), with);
+
+  // A scene of more meshes than the label files number: refused before anything is made.
+  sim::Scene crowded = *scene_;
+  crowded.meshes.resize(io::kNoLabelMesh, crowded.meshes.front());
+  const auto none = dir.path() / "none";
+  EXPECT_NE(test::InputErrorOf([&] {
+              (void)sim::SimulateDataset(crowded, none.string(), {});
+            }).find("65535 meshes; the label files number meshes in 16 bits, at most 65535"),
+            std::string::npos);
+  EXPECT_FALSE(fs::exists(none));
 }
 
 TEST_F(TankDataset, NeverOverwritesWithoutForceAndNeverDeletesStrangers) {

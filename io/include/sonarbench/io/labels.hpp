@@ -58,38 +58,40 @@ template <typename T>
 /// dataset writer calls it for every bin, and a 7-byte array returned is shuffled through memory.
 inline void ShareInto(std::span<const float, kEchoPaths> energy,
                       std::span<std::uint8_t, kEchoPaths> shares) {
+  // A path without power (zero, negative or NaN) counts as 0: share and remainder 0. Branchless
+  // over the paths, so the compiler forms them side by side.
+  std::array<double, kEchoPaths> power{};
   double total = 0.0;
   std::size_t paths = 0;
-  std::size_t last = static_cast<std::size_t>(EchoPath::kNoise);
   for (std::size_t p = 0; p < kEchoPaths; ++p) {
-    if (!(energy[p] > 0.0F)) continue;
-    total += energy[p];
-    ++paths;
-    last = p;
+    power[p] = energy[p] > 0.0F ? static_cast<double>(energy[p]) : 0.0;
+    total += power[p];
+    paths += power[p] > 0.0 ? 1 : 0;
+  }
+  if (paths < 2 || !(total > 0.0)) {  // one path, or none (all noise): written at once
+    std::size_t last = static_cast<std::size_t>(EchoPath::kNoise);
+    for (std::size_t p = 0; p < kEchoPaths; ++p) last = power[p] > 0.0 ? p : last;
+    for (std::size_t p = 0; p < kEchoPaths; ++p) shares[p] = p == last ? 255 : 0;
+    return;
   }
   std::array<int, kEchoPaths> whole{};
-  if (paths < 2 || !(total > 0.0)) {  // one path, or none (all noise)
-    whole[last] = 255;
-  } else {
-    std::array<double, kEchoPaths> rest{};
-    int given = 0;
-    for (std::size_t p = 0; p < kEchoPaths; ++p) {
-      if (!(energy[p] > 0.0F)) continue;  // share and remainder 0
-      const double exact = std::min(255.0, 255.0 * static_cast<double>(energy[p]) / total);
-      whole[p] = static_cast<int>(exact);  // exact ≥ 0: truncation is the floor
-      rest[p] = exact - whole[p];
-      given += whole[p];
+  std::array<double, kEchoPaths> rest{};
+  int given = 0;
+  for (std::size_t p = 0; p < kEchoPaths; ++p) {
+    const double exact = std::min(255.0, 255.0 * power[p] / total);
+    whole[p] = static_cast<int>(exact);  // exact ≥ 0: truncation is the floor
+    rest[p] = exact - whole[p];
+    given += whole[p];
+  }
+  // The largest remainders take what rounding down left, one each (fewer than kEchoPaths, as
+  // each path lost less than one), the earlier path on a tie.
+  for (; given < 255; ++given) {
+    std::size_t most = 0;
+    for (std::size_t p = 1; p < kEchoPaths; ++p) {
+      if (rest[p] > rest[most]) most = p;
     }
-    // The largest remainders take what rounding down left, one each (fewer than kEchoPaths, as
-    // each path lost less than one), the earlier path on a tie.
-    for (; given < 255; ++given) {
-      std::size_t most = 0;
-      for (std::size_t p = 1; p < kEchoPaths; ++p) {
-        if (rest[p] > rest[most]) most = p;
-      }
-      ++whole[most];
-      rest[most] = -1.0;
-    }
+    ++whole[most];
+    rest[most] = -1.0;
   }
   for (std::size_t p = 0; p < kEchoPaths; ++p) shares[p] = static_cast<std::uint8_t>(whole[p]);
 }

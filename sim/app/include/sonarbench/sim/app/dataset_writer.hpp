@@ -36,6 +36,9 @@ struct Shard {
 /// SHA-256 of what determines a scene's outputs: the tool and schema versions, the seed, and the
 /// SHA-256 of the scene file, the sensor model file and every mesh file.
 [[nodiscard]] std::string SceneConfigHash(const Scene& scene, std::uint64_t seed);
+/// The configuration a simulated dataset records: SceneConfigHash with label files, another
+/// hash without them (a rerun never mixes the two).
+[[nodiscard]] std::string DatasetConfigHash(const Scene& scene, std::uint64_t seed, bool labels);
 
 struct DatasetOptions {
   std::optional<std::uint64_t> seed;
@@ -43,6 +46,9 @@ struct DatasetOptions {
   /// Replace an existing dataset (or a partial one of another configuration).
   bool force = false;
   Shard shard;
+  /// Write the per-bin label files (truth/labels_NNNN.bin); the beams are the same bytes either
+  /// way.
+  bool labels = true;
   /// Called after each sweep this process handles: sweeps handled and the shard's total.
   std::function<void(std::size_t done, std::size_t total)> progress;
 };
@@ -59,11 +65,11 @@ struct DatasetSummary {
   std::string config_sha256;
 };
 
-/// A sweep's labels as its label file holds them (io::EncodeLabelFile): each bin's shares,
-/// mesh and point, beams on `threads` threads (0: all cores). Throws InputError for a scene of
-/// more meshes than the file numbers.
-[[nodiscard]] std::vector<io::BeamLabels> LabelFileBeams(std::span<const SynthesizedBeam> beams,
-                                                         int threads);
+/// A sweep's labels as its label file holds them (io::EncodeLabelFile) into `out`, a beam each
+/// (its memory reused): each bin's shares, mesh and point, beams on `threads` threads (0: all
+/// cores). Throws InputError for a scene of more meshes than the file numbers.
+void LabelFileBeams(std::span<const SynthesizedBeam> beams, int threads,
+                    std::vector<io::BeamLabels>& out);
 
 /// Simulates a scene into a dataset directory (io::ReadDataset's format). Every file is
 /// written atomically; a sweep is complete when its beam, truth and image files all exist, and
