@@ -16,8 +16,8 @@
 //                       mirrored and occlusion rays), recorded from one sweep and replayed
 //                       through Embree alone: /*_queries as the queries it made, /*_per_ray one
 //                       query per ray (the whole synthesis's comparison: traced_rays/s)
-//   BM_SynthesisLabels  one sweep on one thread with and without the bins' labels;
-//                       BM_SynthesisLabelFile the same with the label file formed
+//   BM_SynthesisLabels  one sweep on one thread without labels, with the bins' labels, and with
+//                       the sweep's label file formed too
 //   BM_SimulateDataset  `simulate` whole on one thread, every sweep of the scene (its own count):
 //                       meshes, BVH, synthesis, the beam, truth, image and (/*_labels) label
 //                       files, the truth occupancy, into a temporary directory replaced each time
@@ -279,34 +279,26 @@ void BM_Synthesis(benchmark::State& state, const std::string& file) {
       g.BeamsPerSweep() / g.beams_per_second * state.iterations(), benchmark::Counter::kIsRate);
 }
 
-// The same on one thread, with and without the bins' labels (a dataset's): their cost is the
-// ratio of the two. Each sweep into the last one's memory, as `simulate` writes a dataset.
-void BM_SynthesisLabels(benchmark::State& state, const std::string& file, Labels labels) {
-  const BenchScene& bench = TheSetup(file).bench;
-  const BeamSynthesizer synthesizer = SceneSynthesizer(bench.scene, bench.tracer, kSeed);
-  std::vector<SynthesizedBeam> beams;
-  for (auto _ : state) {
-    SimulateBeamsInto(bench.scene, synthesizer, kSeed, 1, 0, ScenarioBeamCount(bench.scene), labels,
-                      beams);
-    benchmark::DoNotOptimize(beams.data());
-  }
-  state.counters["rays/s"] = benchmark::Counter(
-      PrimaryRaysPerSweep(bench.scene) * state.iterations(), benchmark::Counter::kIsRate);
-}
+// What the labels of a dataset cost: none, the bins' labels, or those and the sweep's label file
+// formed as `simulate` writes it (each bin's shares, the zstd frame; not the disk).
+enum class Labelled { kNone, kBins, kFile };
 
-// The same with labels, and the sweep's label file formed as `simulate` writes it (each bin's
-// shares, the zstd frame; not the disk): what a dataset's labels cost in all.
-void BM_SynthesisLabelFile(benchmark::State& state, const std::string& file) {
+// The same on one thread, labelled as asked: the labels' cost is the ratio to kNone. Each sweep
+// into the last one's memory, as `simulate` writes a dataset.
+void BM_SynthesisLabels(benchmark::State& state, const std::string& file, Labelled labelled) {
   const BenchScene& bench = TheSetup(file).bench;
   const BeamSynthesizer synthesizer = SceneSynthesizer(bench.scene, bench.tracer, kSeed);
   std::vector<SynthesizedBeam> beams;
   std::vector<io::BeamLabels> labels;
   for (auto _ : state) {
     SimulateBeamsInto(bench.scene, synthesizer, kSeed, 1, 0, ScenarioBeamCount(bench.scene),
-                      Labels::kKeep, beams);
-    LabelFileBeams(beams, 1, labels);
-    const std::string frame = io::EncodeLabelFile(labels);
-    benchmark::DoNotOptimize(frame.data());
+                      labelled == Labelled::kNone ? Labels::kDrop : Labels::kKeep, beams);
+    benchmark::DoNotOptimize(beams.data());
+    if (labelled == Labelled::kFile) {
+      LabelFileBeams(beams, 1, labels);
+      const std::string frame = io::EncodeLabelFile(labels);
+      benchmark::DoNotOptimize(frame.data());
+    }
   }
   state.counters["rays/s"] = benchmark::Counter(
       PrimaryRaysPerSweep(bench.scene) * state.iterations(), benchmark::Counter::kIsRate);
@@ -363,13 +355,13 @@ BENCHMARK_CAPTURE(BM_Synthesis, tank, kTank)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_SynthesisLabels, tank_unlabelled, kTank, Labels::kDrop)
+BENCHMARK_CAPTURE(BM_SynthesisLabels, tank_unlabelled, kTank, Labelled::kNone)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_SynthesisLabels, tank_labelled, kTank, Labels::kKeep)
+BENCHMARK_CAPTURE(BM_SynthesisLabels, tank_labelled, kTank, Labelled::kBins)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_SynthesisLabelFile, tank_labelled_file, kTank)
+BENCHMARK_CAPTURE(BM_SynthesisLabels, tank_labelled_file, kTank, Labelled::kFile)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_SimulateDataset, tank_labels, kTank, true)
@@ -390,13 +382,13 @@ BENCHMARK_CAPTURE(BM_Synthesis, seabed, kSeabed)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_SynthesisLabels, seabed_unlabelled, kSeabed, Labels::kDrop)
+BENCHMARK_CAPTURE(BM_SynthesisLabels, seabed_unlabelled, kSeabed, Labelled::kNone)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_SynthesisLabels, seabed_labelled, kSeabed, Labels::kKeep)
+BENCHMARK_CAPTURE(BM_SynthesisLabels, seabed_labelled, kSeabed, Labelled::kBins)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_SynthesisLabelFile, seabed_labelled_file, kSeabed)
+BENCHMARK_CAPTURE(BM_SynthesisLabels, seabed_labelled_file, kSeabed, Labelled::kFile)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_SimulateDataset, seabed_labels, kSeabed, true)
