@@ -25,6 +25,10 @@ const char* LaterEchoesName(DetectionConfig::LaterEchoes rule) {
   return rule == DetectionConfig::LaterEchoes::kSupported ? "supported" : "strongest";
 }
 
+const char* BehindWallsName(DetectionConfig::BehindWalls rule) {
+  return rule == DetectionConfig::BehindWalls::kRefuse ? "refuse" : "keep";
+}
+
 const char* OccupancyName(Occupancy occupancy) {
   return occupancy == Occupancy::kArcEvidence ? "arc_evidence" : "arc_marking";
 }
@@ -64,6 +68,10 @@ MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
     detection->Optional("later_echoes", later, OneOf({"strongest", "supported"}));
     d.later_echoes = later == "supported" ? DetectionConfig::LaterEchoes::kSupported
                                           : DetectionConfig::LaterEchoes::kStrongest;
+    std::string walls = BehindWallsName(d.behind_walls);
+    detection->Optional("behind_walls", walls, OneOf({"keep", "refuse"}));
+    d.behind_walls = walls == "refuse" ? DetectionConfig::BehindWalls::kRefuse
+                                       : DetectionConfig::BehindWalls::kKeep;
     detection->Optional("support_window_deg", d.support_window_deg, InRange(0.0, 180.0));
     detection->Optional("support_range_m", d.support_range_m, InRange(0.0, 100.0));
     detection->Optional("canny_low", d.canny_low, InRange(0.0, 2000.0));

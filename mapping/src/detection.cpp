@@ -6,6 +6,8 @@
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 
+#include "walls.hpp"
+
 namespace sonarbench::mapping {
 namespace {
 
@@ -127,6 +129,53 @@ std::vector<std::vector<Echo>> CannyEchoes(std::span<const Beam> beams,
   return candidates;
 }
 
+// The beams of a batch in order of head angle in [0, 2π) (their order on a tie).
+std::vector<std::size_t> HeadAngleOrder(std::span<const Beam> beams) {
+  std::vector<std::size_t> order(beams.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  auto angle = [&](std::size_t b) {
+    const double a = std::fmod(beams[b].head_angle_rad, 2.0 * std::numbers::pi);
+    return a < 0.0 ? a + 2.0 * std::numbers::pi : a;
+  };
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return angle(a) < angle(b); });
+  return order;
+}
+
+// Drops every echo heard more than a margin behind the walls that the batch's first echoes
+// outline (FitWalls, top-down in the world frame), along the beam's bearing. The margin is what
+// the wall's own echoes can reach past its line: the slant range of its top or foot at the beam's
+// vertical edge, d (1 / cos(β/2) - 1), plus the line's band and a bin. Marks the beams that lose
+// every echo so.
+void DropEchoesBehindWalls(std::vector<std::vector<Echo>>& candidates, std::span<const Beam> beams,
+                           const SensorGeometry& sensor, std::vector<bool>& heard_through) {
+  auto top_down = [&](const Beam& beam) {
+    const Eigen::Vector3d axis =
+        beam.T_world_sonar.linear() * SonarRayDirection(beam.head_angle_rad, 0.0);
+    return std::pair<Eigen::Vector2d, Eigen::Vector2d>{beam.T_world_sonar.translation().head<2>(),
+                                                       axis.head<2>().normalized()};
+  };
+  std::vector<FirstEcho> firsts;
+  for (const std::size_t b : HeadAngleOrder(beams)) {
+    if (candidates[b].empty()) continue;
+    const auto [origin, bearing] = top_down(beams[b]);
+    const double range = beams[b].BinCentreRange(static_cast<std::size_t>(candidates[b][0].bin));
+    firsts.push_back({origin, origin + range * bearing});
+  }
+  const std::vector<WallLine> walls = FitWalls(firsts);
+  const double slant = 1.0 / std::cos(sensor.beam_width_vertical_rad / 2.0) - 1.0;
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    const auto [origin, bearing] = top_down(beams[b]);
+    const std::optional<double> wall = WallAhead(origin, bearing, walls);
+    if (!wall || candidates[b].empty()) continue;
+    const double limit = *wall * (1.0 + slant) + kWallBand + beams[b].bin_size_m;
+    std::erase_if(candidates[b], [&](const Echo& e) {
+      return beams[b].BinCentreRange(static_cast<std::size_t>(e.bin)) > limit;
+    });
+    heard_through[b] = candidates[b].empty();
+  }
+}
+
 // Removes each beam's later echoes (all but its first) that no other beam within
 // `support_window_deg` of head angle hears first within `support_range_m` of their range.
 void DropUnsupportedLaterEchoes(std::vector<std::vector<Echo>>& candidates,
@@ -139,14 +188,7 @@ void DropUnsupportedLaterEchoes(std::vector<std::vector<Echo>>& candidates,
   }
   // Beams in order of head angle, so that each one's neighbours are a contiguous (circular) run.
   const std::size_t n = beams.size();
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  auto angle = [&](std::size_t b) {
-    const double a = std::fmod(beams[b].head_angle_rad, 2.0 * std::numbers::pi);
-    return a < 0.0 ? a + 2.0 * std::numbers::pi : a;
-  };
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return angle(a) < angle(b); });
+  const std::vector<std::size_t> order = HeadAngleOrder(beams);
   auto supported = [&](std::size_t at, double range) {
     const std::size_t b = order[at];
     for (std::size_t step = 1; step <= n / 2; ++step) {
@@ -180,7 +222,13 @@ void DropUnsupportedLaterEchoes(std::vector<std::vector<Echo>>& candidates,
 // The ranges a batch's beams report, from their candidate echoes.
 std::vector<std::vector<double>> ChooseAll(std::vector<std::vector<Echo>> candidates,
                                            std::span<const Beam> beams,
-                                           const DetectionConfig& config) {
+                                           const SensorGeometry& sensor,
+                                           const DetectionConfig& config,
+                                           std::vector<bool>* heard_through_walls) {
+  std::vector<bool> through(beams.size(), false);
+  if (config.behind_walls == DetectionConfig::BehindWalls::kRefuse)
+    DropEchoesBehindWalls(candidates, beams, sensor, through);
+  if (heard_through_walls != nullptr) *heard_through_walls = std::move(through);
   if (config.later_echoes == DetectionConfig::LaterEchoes::kSupported)
     DropUnsupportedLaterEchoes(candidates, beams, config);
   std::vector<std::vector<double>> ranges(beams.size());
@@ -199,18 +247,21 @@ std::vector<double> DetectThreshold(const Beam& beam, const SensorGeometry& sens
 std::vector<std::vector<double>> DetectCanny(std::span<const Beam> beams,
                                              const SensorGeometry& sensor,
                                              const DetectionConfig& config) {
-  return ChooseAll(CannyEchoes(beams, sensor, config), beams, config);
+  return ChooseAll(CannyEchoes(beams, sensor, config), beams, sensor, config, nullptr);
 }
 
 std::vector<std::vector<double>> DetectObstacles(std::span<const Beam> beams,
                                                  const SensorGeometry& sensor,
-                                                 const DetectionConfig& config) {
-  if (config.method != DetectionConfig::Method::kThreshold)
-    return DetectCanny(beams, sensor, config);
+                                                 const DetectionConfig& config,
+                                                 std::vector<bool>* heard_through_walls) {
   std::vector<std::vector<Echo>> candidates(beams.size());
-  for (std::size_t b = 0; b < beams.size(); ++b)
-    candidates[b] = ThresholdEchoes(beams[b], sensor, config);
-  return ChooseAll(std::move(candidates), beams, config);
+  if (config.method != DetectionConfig::Method::kThreshold) {
+    candidates = CannyEchoes(beams, sensor, config);
+  } else {
+    for (std::size_t b = 0; b < beams.size(); ++b)
+      candidates[b] = ThresholdEchoes(beams[b], sensor, config);
+  }
+  return ChooseAll(std::move(candidates), beams, sensor, config, heard_through_walls);
 }
 
 }  // namespace sonarbench::mapping

@@ -102,8 +102,22 @@ const octomap::OcTree& Mapper::tree() const {
 }
 
 BatchStats Mapper::Integrate(std::span<const Beam> beams) {
-  const auto obstacles = DetectObstacles(beams, sensor_, config_.detection);
-  return Integrate(beams, obstacles);
+  std::vector<bool> heard_through_walls;
+  auto obstacles = DetectObstacles(beams, sensor_, config_.detection, &heard_through_walls);
+  if (std::none_of(heard_through_walls.begin(), heard_through_walls.end(),
+                   [](bool b) { return b; })) {
+    return Integrate(beams, obstacles);
+  }
+  // A beam that heard only through a wall places nothing: neither its echoes nor, without one,
+  // the water out to the free range (through the wall).
+  std::vector<Beam> kept;
+  std::vector<std::vector<double>> kept_obstacles;
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    if (heard_through_walls[b]) continue;
+    kept.push_back(beams[b]);
+    kept_obstacles.push_back(std::move(obstacles[b]));
+  }
+  return Integrate(kept, kept_obstacles);
 }
 
 BatchStats Mapper::IntegrateSweeps(

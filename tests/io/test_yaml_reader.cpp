@@ -43,6 +43,16 @@ TEST(YamlReader, IntegrationIsExactUnlessRaysAreAskedFor) {
                            {"scene.yaml:1:14", "'integration'", "rays", "exact", "got 'dense'"}));
 }
 
+TEST(YamlReader, EchoesBehindWallsAreKeptUnlessRefused) {
+  using BehindWalls = mapping::DetectionConfig::BehindWalls;
+  EXPECT_EQ(ReadMapping("resolution_m: 0.1\n").detection.behind_walls, BehindWalls::kKeep);
+  EXPECT_EQ(ReadMapping("detection:\n  behind_walls: refuse\n").detection.behind_walls,
+            BehindWalls::kRefuse);
+  EXPECT_TRUE(ThrowsInputErrorWith(
+      [] { (void)ReadMapping("detection:\n  behind_walls: drop\n"); },
+      {"scene.yaml:2:17", "'detection.behind_walls'", "keep", "refuse", "got 'drop'"}));
+}
+
 TEST(YamlReader, LaterEchoesAreTheStrongestUnlessSupportIsAskedFor) {
   using LaterEchoes = mapping::DetectionConfig::LaterEchoes;
   EXPECT_EQ(ReadMapping("resolution_m: 0.1\n").detection.later_echoes, LaterEchoes::kStrongest);

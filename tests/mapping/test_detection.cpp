@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "sonarbench/mapping/detection.hpp"
+#include "sonarbench/mapping/mapper.hpp"
 
 namespace sonarbench::mapping {
 namespace {
@@ -366,6 +367,107 @@ TEST(DetectObstacles, SupportComesFromWithinTheWindowAndTolerance) {
       EXPECT_EQ(DetectObstacles(sweep, sensor, config)[beam_at].size(), 1u) << beam_at << steps;
     }
   }
+}
+
+// A sonar at the origin in a rectangle of walls at x = -1, x = 3, y = ±1.5 [m]: where bearing θ
+// meets them.
+double TankWallRange(double theta) {
+  const double c = std::cos(theta), s = std::sin(theta);
+  double range = 1e9;
+  if (c > 1e-12) range = std::min(range, 3.0 / c);
+  if (c < -1e-12) range = std::min(range, -1.0 / c);
+  if (s > 1e-12) range = std::min(range, 1.5 / s);
+  if (s < -1e-12) range = std::min(range, -1.5 / s);
+  return range;
+}
+
+// Every beam hears its wall and, 0.6 m behind it, a mirror path; the beams at 10.8° to 16.2° hear
+// the mirror path only (the wall too weak there). Beam `inside` hears a second echo `by` [m]
+// within the wall's margin, beam `inside` + 1 the same beyond it.
+std::vector<Beam> TankSweep(const SensorGeometry& sensor, std::size_t inside, double by) {
+  std::vector<Beam> sweep;
+  const double margin_per_m = 1.0 / std::cos(sensor.beam_width_vertical_rad / 2.0) - 1.0;
+  for (int b = 0; b < sensor.BeamsPerSweep(); ++b) {
+    Beam beam = MakeBeam(sensor);
+    beam.head_angle_rad = b * sensor.step_angle_rad;
+    const double wall = TankWallRange(beam.head_angle_rad);
+    const auto bin = [&](double range) { return static_cast<int>(range / sensor.bin_size_m); };
+    if (b < 6 || b > 9) Fill(beam, bin(wall), bin(wall) + 5, 150);
+    Fill(beam, bin(wall + 0.6), bin(wall + 0.6) + 5, 200);
+    const double limit = wall * (1.0 + margin_per_m) + 0.05 + sensor.bin_size_m;
+    if (static_cast<std::size_t>(b) == inside)
+      Fill(beam, bin(limit - by), bin(limit - by) + 5, 220);
+    if (static_cast<std::size_t>(b) == inside + 1)
+      Fill(beam, bin(limit + by), bin(limit + by) + 5, 220);
+    sweep.push_back(beam);
+  }
+  return sweep;
+}
+
+// Nothing heard through a wall: the walls the first echoes outline refuse every echo beyond the
+// margin their own echoes can reach, and a beam that heard only through one is marked; echoes
+// within the margin stay. Two bins either side of the margin (the fitted wall lies within one).
+TEST(DetectObstacles, EchoesBehindTheWallsAreRefused) {
+  const SensorGeometry sensor;
+  const double two_bins = 2.0 * sensor.bin_size_m;
+  const std::vector<Beam> sweep = TankSweep(sensor, 50, two_bins);
+  DetectionConfig config;
+  config.smoothing_bins = 1;
+  config.threshold = 100;
+  config.max_obstacles = 3;
+  std::vector<bool> through;
+  const auto kept = DetectObstacles(sweep, sensor, config, &through);
+  EXPECT_EQ(kept[0].size(), 2u);  // the wall and its mirror path
+  EXPECT_EQ(kept[8].size(), 1u);  // the mirror path
+  EXPECT_EQ(std::count(through.begin(), through.end(), true), 0);
+
+  config.behind_walls = DetectionConfig::BehindWalls::kRefuse;
+  const auto refused = DetectObstacles(sweep, sensor, config, &through);
+  ASSERT_EQ(through.size(), sweep.size());
+  for (std::size_t b = 0; b < sweep.size(); ++b) {
+    const bool gap = b >= 6 && b <= 9;
+    EXPECT_EQ(through[b], gap) << b;
+    const std::size_t expected = gap ? 0u : b == 50 ? 2u : 1u;
+    ASSERT_EQ(refused[b].size(), expected) << b;
+    if (!gap) {
+      EXPECT_NEAR(refused[b][0], TankWallRange(sweep[b].head_angle_rad), sensor.bin_size_m) << b;
+    }
+  }
+  config.max_obstacles = 1;  // the first echo alone is refused as well
+  EXPECT_TRUE(DetectObstacles(sweep, sensor, config)[8].empty());
+}
+
+// The mapper sets aside a beam that heard only through a wall: it neither marks the echo behind
+// the wall nor, left without one, clears the water through the wall to the free range. Cells are
+// 5 cm; at 12.6° the gap's beam is 2° (7 cm at 3.7 m) from its neighbours' edges.
+TEST(DetectObstacles, TheMapperSetsAsideABeamHeardOnlyThroughAWall) {
+  const SensorGeometry sensor;
+  const std::vector<Beam> sweep = TankSweep(sensor, 50, 0.0);
+  MapperConfig config;
+  config.resolution_m = 0.05;
+  config.threads = 1;
+  config.detection.smoothing_bins = 1;
+  config.detection.threshold = 100;
+  config.detection.max_obstacles = 2;
+  const double theta = sweep[7].head_angle_rad;
+  const Eigen::Vector3d bearing(std::cos(theta), std::sin(theta), 0.0);
+  const Eigen::Vector3d ghost = (TankWallRange(theta) + 0.62) * bearing;
+  const Eigen::Vector3d water = 1.5 * bearing;
+  auto node = [](const Mapper& m, const Eigen::Vector3d& p) {
+    return m.tree().search(p.x(), p.y(), p.z());
+  };
+  Mapper keep(config, sensor);
+  keep.Integrate(sweep);
+  ASSERT_NE(node(keep, ghost), nullptr);
+  EXPECT_TRUE(keep.tree().isNodeOccupied(node(keep, ghost)));
+  config.detection.behind_walls = DetectionConfig::BehindWalls::kRefuse;
+  Mapper refuse(config, sensor);
+  refuse.Integrate(sweep);
+  EXPECT_EQ(node(refuse, ghost), nullptr);
+  EXPECT_EQ(node(refuse, ghost + 0.3 * bearing), nullptr);
+  EXPECT_EQ(node(refuse, water), nullptr);
+  ASSERT_NE(node(refuse, Eigen::Vector3d(3.02, 0.0, 0.0)), nullptr);  // the wall, heard
+  EXPECT_TRUE(refuse.tree().isNodeOccupied(node(refuse, Eigen::Vector3d(3.02, 0.0, 0.0))));
 }
 
 }  // namespace

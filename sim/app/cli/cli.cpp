@@ -95,6 +95,7 @@ std::string DetectionLine(const mapping::MapperConfig& config) {
               ? ", the first echo a beam"
               : ", at most " + detection["max_obstacles"].dump() +
                     " echoes a beam (later echoes: " + detection.value("later_echoes", "?") + ")";
+  if (detection.value("behind_walls", "keep") == "refuse") line += ", none behind a wall";
   return line + ", " + mapping.value("occupancy", "?") + " at " + mapping["resolution_m"].dump() +
          " m";
 }

@@ -38,6 +38,7 @@ nlohmann::json MapperConfigJson(const mapping::MapperConfig& c) {
             {"min_run_bins", c.detection.min_run_bins},
             {"max_obstacles", c.detection.max_obstacles},
             {"later_echoes", io::LaterEchoesName(c.detection.later_echoes)},
+            {"behind_walls", io::BehindWallsName(c.detection.behind_walls)},
             {"support_window_deg", c.detection.support_window_deg},
             {"support_range_m", c.detection.support_range_m},
             {"canny_low", c.detection.canny_low},

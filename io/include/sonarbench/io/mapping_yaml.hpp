@@ -18,11 +18,12 @@ using mapping::SensorGeometry;
 /// the struct's defaults).
 [[nodiscard]] MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base = {});
 
-/// The names `integration`, `detection.method`, `detection.later_echoes`, `occupancy` and
-/// `key_set` take in YAML (and reports).
+/// The names `integration`, `detection.method`, `detection.later_echoes`,
+/// `detection.behind_walls`, `occupancy` and `key_set` take in YAML (and reports).
 [[nodiscard]] const char* IntegrationName(Integration integration);
 [[nodiscard]] const char* DetectionMethodName(DetectionConfig::Method method);
 [[nodiscard]] const char* LaterEchoesName(DetectionConfig::LaterEchoes rule);
+[[nodiscard]] const char* BehindWallsName(DetectionConfig::BehindWalls rule);
 [[nodiscard]] const char* OccupancyName(Occupancy occupancy);
 [[nodiscard]] const char* KeySetName(KeySetKind kind);
 

@@ -29,10 +29,12 @@ namespace sonarbench::mapping {
                                                            const DetectionConfig& config);
 
 /// The obstacle ranges [m] of every beam of a batch, by the configured method. With
-/// `later_echoes` kSupported a later echo is kept only if another beam of the batch within
-/// `support_window_deg` of head angle has its first echo within `support_range_m` of it.
-[[nodiscard]] std::vector<std::vector<double>> DetectObstacles(std::span<const Beam> beams,
-                                                               const SensorGeometry& sensor,
-                                                               const DetectionConfig& config);
+/// `behind_walls` kRefuse, echoes behind the walls the batch's first echoes outline are dropped
+/// (docs/mapper.md); `heard_through_walls`, when given, is set to whether each beam lost every
+/// echo so. With `later_echoes` kSupported a later echo is kept only if another beam of the batch
+/// within `support_window_deg` of head angle has its first echo within `support_range_m` of it.
+[[nodiscard]] std::vector<std::vector<double>> DetectObstacles(
+    std::span<const Beam> beams, const SensorGeometry& sensor, const DetectionConfig& config,
+    std::vector<bool>* heard_through_walls = nullptr);
 
 }  // namespace sonarbench::mapping

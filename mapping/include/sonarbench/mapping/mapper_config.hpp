@@ -30,6 +30,11 @@ struct DetectionConfig {
                  ///< within `support_range_m`: a surface seen directly around a nearer object
   };
   LaterEchoes later_echoes = LaterEchoes::kStrongest;
+  /// Whether echoes heard behind a wall are kept: kRefuse drops every echo more than a margin
+  /// behind the walls (vertical, seen from above) that the batch's first echoes outline along
+  /// the beam's bearing, and sets aside a beam that loses all (docs/mapper.md).
+  enum class BehindWalls { kKeep, kRefuse };
+  BehindWalls behind_walls = BehindWalls::kKeep;
   /// kSupported: head-angle distance [deg] within which a beam supports another's later echo.
   double support_window_deg = 9.0;
   /// kSupported: how close [m] the supporting beam's first echo must be to the later echo.
