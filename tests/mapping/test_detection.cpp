@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <numbers>
 
+#include "rectangle_tank.hpp"
 #include "sonarbench/mapping/detection.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 
@@ -369,28 +370,16 @@ TEST(DetectObstacles, SupportComesFromWithinTheWindowAndTolerance) {
   }
 }
 
-// A sonar at the origin in a rectangle of walls at x = -1, x = 3, y = ±1.5 [m]: where bearing θ
-// meets them.
-double TankWallRange(double theta) {
-  const double c = std::cos(theta), s = std::sin(theta);
-  double range = 1e9;
-  if (c > 1e-12) range = std::min(range, 3.0 / c);
-  if (c < -1e-12) range = std::min(range, -1.0 / c);
-  if (s > 1e-12) range = std::min(range, 1.5 / s);
-  if (s < -1e-12) range = std::min(range, -1.5 / s);
-  return range;
-}
-
-// Every beam hears its wall and, 0.6 m behind it, a mirror path; the beams at 10.8° to 16.2° hear
-// the mirror path only (the wall too weak there). Beam `inside` hears a second echo `by` [m]
-// within the wall's margin, beam `inside` + 1 the same beyond it.
+// In test::RectangleWallRange's tank every beam hears its wall and, 0.6 m behind it, a mirror path;
+// the beams at 10.8° to 16.2° hear the mirror path only (the wall too weak there). Beam `inside`
+// hears a second echo `by` [m] within the wall's margin, beam `inside` + 1 the same beyond it.
 std::vector<Beam> TankSweep(const SensorGeometry& sensor, std::size_t inside, double by) {
   std::vector<Beam> sweep;
   const double margin_per_m = 1.0 / std::cos(sensor.beam_width_vertical_rad / 2.0) - 1.0;
   for (int b = 0; b < sensor.BeamsPerSweep(); ++b) {
     Beam beam = MakeBeam(sensor);
     beam.head_angle_rad = b * sensor.step_angle_rad;
-    const double wall = TankWallRange(beam.head_angle_rad);
+    const double wall = test::RectangleWallRange(beam.head_angle_rad);
     const auto bin = [&](double range) { return static_cast<int>(range / sensor.bin_size_m); };
     if (b < 6 || b > 9) Fill(beam, bin(wall), bin(wall) + 5, 150);
     Fill(beam, bin(wall + 0.6), bin(wall + 0.6) + 5, 200);
@@ -430,7 +419,9 @@ TEST(DetectObstacles, EchoesBehindTheWallsAreRefused) {
     const std::size_t expected = gap ? 0u : b == 50 ? 2u : 1u;
     ASSERT_EQ(refused[b].size(), expected) << b;
     if (!gap) {
-      EXPECT_NEAR(refused[b][0], TankWallRange(sweep[b].head_angle_rad), sensor.bin_size_m) << b;
+      EXPECT_NEAR(refused[b][0], test::RectangleWallRange(sweep[b].head_angle_rad),
+                  sensor.bin_size_m)
+          << b;
     }
   }
   config.max_obstacles = 1;  // the first echo alone is refused as well
@@ -451,7 +442,7 @@ TEST(DetectObstacles, TheMapperSetsAsideABeamHeardOnlyThroughAWall) {
   config.detection.max_obstacles = 2;
   const double theta = sweep[7].head_angle_rad;
   const Eigen::Vector3d bearing(std::cos(theta), std::sin(theta), 0.0);
-  const Eigen::Vector3d ghost = (TankWallRange(theta) + 0.62) * bearing;
+  const Eigen::Vector3d ghost = (test::RectangleWallRange(theta) + 0.62) * bearing;
   const Eigen::Vector3d water = 1.5 * bearing;
   auto node = [](const Mapper& m, const Eigen::Vector3d& p) {
     return m.tree().search(p.x(), p.y(), p.z());

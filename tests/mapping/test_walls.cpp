@@ -4,22 +4,11 @@
 #include <numbers>
 #include <vector>
 
+#include "rectangle_tank.hpp"
 #include "walls.hpp"
 
 namespace sonarbench::mapping {
 namespace {
-
-// Where a bearing θ from the origin meets a rectangle of walls at x = -1, x = 3, y = -1.5 and
-// y = 1.5 [m] (a tank seen from a sonar off its centre).
-double RectangleRange(double theta) {
-  const double c = std::cos(theta), s = std::sin(theta);
-  double range = 1e9;
-  if (c > 1e-12) range = std::min(range, 3.0 / c);
-  if (c < -1e-12) range = std::min(range, -1.0 / c);
-  if (s > 1e-12) range = std::min(range, 1.5 / s);
-  if (s < -1e-12) range = std::min(range, -1.5 / s);
-  return range;
-}
 
 FirstEcho At(const Eigen::Vector2d& point) { return {Eigen::Vector2d::Zero(), point}; }
 
@@ -27,7 +16,8 @@ std::vector<FirstEcho> RectanglePoints() {
   std::vector<FirstEcho> points;
   for (int b = 0; b < 200; ++b) {
     const double theta = b * 1.8 * std::numbers::pi / 180.0;
-    points.push_back(At(RectangleRange(theta) * Eigen::Vector2d(std::cos(theta), std::sin(theta))));
+    points.push_back(
+        At(test::RectangleWallRange(theta) * Eigen::Vector2d(std::cos(theta), std::sin(theta))));
   }
   return points;
 }
@@ -57,7 +47,7 @@ TEST(FitWalls, ARectanglesEchoesGiveItsFourWalls) {
     const auto range = WallAhead(Eigen::Vector2d::Zero(),
                                  Eigen::Vector2d(std::cos(theta), std::sin(theta)), walls);
     ASSERT_TRUE(range.has_value()) << b;
-    EXPECT_NEAR(*range, RectangleRange(theta), kBin) << b;
+    EXPECT_NEAR(*range, test::RectangleWallRange(theta), kBin) << b;
   }
 }
 
@@ -75,7 +65,7 @@ TEST(FitWalls, AWallIsMetAcrossAGapInItsEchoesAndNoiseMakesNone) {
   const auto range =
       WallAhead(Eigen::Vector2d::Zero(), Eigen::Vector2d(std::cos(theta), std::sin(theta)), walls);
   ASSERT_TRUE(range.has_value());
-  EXPECT_NEAR(*range, RectangleRange(theta), kBin);
+  EXPECT_NEAR(*range, test::RectangleWallRange(theta), kBin);
   // Half a metre past its last echo (y = 3 tan 9°) the x = 3 wall ends: at 24° only y = 1.5 is met.
   const double past = 24.0 * std::numbers::pi / 180.0;
   const auto beyond =
@@ -118,7 +108,7 @@ TEST(FitWalls, AnObjectInFrontOfTheWallsIsNoWall) {
   const double north = 90.0 * std::numbers::pi / 180.0;
   const auto range = WallAhead(Eigen::Vector2d::Zero(), Eigen::Vector2d(0.0, 1.0), walls);
   ASSERT_TRUE(range.has_value());
-  EXPECT_NEAR(*range, RectangleRange(north), kBin);
+  EXPECT_NEAR(*range, test::RectangleWallRange(north), kBin);
 }
 
 }  // namespace
