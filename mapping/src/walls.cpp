@@ -26,23 +26,11 @@ constexpr double kExtend = 0.5;
 // A line within 15° and 0.4 m of a wall found is that wall again.
 const double kSameAngleCos = std::cos(15.0 * std::numbers::pi / 180.0);
 constexpr double kSameOffset = 0.4;
-// Whether most of the beams whose bearings cross `wall` hear it first rather than something
-// beyond its thick echoes.
-bool Bounds(std::span<const FirstEcho> echoes, const WallLine& wall) {
-  std::size_t crossing = 0;
-  std::size_t beyond = 0;
-  for (const FirstEcho& e : echoes) {
-    const Eigen::Vector2d ray = e.point - e.origin;
-    const auto at = WallAhead(e.origin, ray.normalized(), std::span(&wall, 1));
-    if (!at) continue;
-    ++crossing;
-    beyond += ray.norm() > *at + kClaimed;
-  }
-  return 2 * beyond <= crossing;
-}
-
-// Candidate lines join echoes this many places apart in head-angle order.
+// Candidate lines join echoes this many places apart in head-angle order, from at most 200 of
+// them (every one of a sweep's); a dozen rounds find a sweep's walls and what stands before them.
 constexpr std::array<std::size_t, 6> kStrides = {3, 5, 8, 12, 20, 30};
+constexpr std::size_t kMaxStarts = 200;
+constexpr std::size_t kMaxRounds = 12;
 
 struct Candidate {
   std::size_t count = 0;
@@ -54,8 +42,9 @@ struct Candidate {
 Candidate BestLine(std::span<const FirstEcho> points, const std::vector<std::size_t>& live) {
   Candidate best;
   const std::size_t n = live.size();
+  const std::size_t step = (n + kMaxStarts - 1) / kMaxStarts;
   for (const std::size_t stride : kStrides) {
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < n; i += step) {
       const Eigen::Vector2d& a = points[live[i]].point;
       const Eigen::Vector2d d = points[live[(i + stride) % n]].point - a;
       if (d.norm() < 0.2) continue;
@@ -92,13 +81,29 @@ bool SameWall(const WallLine& a, const WallLine& b) {
          std::abs((a.centre - b.centre).dot(normal)) < kSameOffset;
 }
 
+// Whether at least half the beams whose bearings cross `wall` hear it first rather than something
+// beyond its thick echoes.
+bool Bounds(std::span<const FirstEcho> echoes, const WallLine& wall) {
+  std::size_t crossing = 0;
+  std::size_t beyond = 0;
+  for (const FirstEcho& e : echoes) {
+    const Eigen::Vector2d ray = e.point - e.origin;
+    const auto at = WallAhead(e.origin, ray.normalized(), std::span(&wall, 1));
+    if (!at) continue;
+    ++crossing;
+    beyond += ray.norm() > *at + kClaimed;
+  }
+  return 2 * beyond <= crossing;
+}
+
 }  // namespace
 
 std::vector<WallLine> FitWalls(std::span<const FirstEcho> points) {
   std::vector<WallLine> walls;
   std::vector<std::size_t> live(points.size());
   for (std::size_t k = 0; k < live.size(); ++k) live[k] = k;
-  while (walls.size() < kMaxWalls && live.size() >= kMinPoints) {
+  for (std::size_t round = 0;
+       round < kMaxRounds && walls.size() < kMaxWalls && live.size() >= kMinPoints; ++round) {
     const Candidate best = BestLine(points, live);
     if (best.count < kMinPoints) break;
     std::vector<std::size_t> inliers;
