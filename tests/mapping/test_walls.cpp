@@ -42,6 +42,10 @@ TEST(FitWalls, ARectanglesEchoesGiveItsFourWalls) {
         << wall.centre.transpose() << " along " << wall.direction.transpose();
   }
   EXPECT_EQ(along_x, 2);
+  // A batch of ten sweeps (2000 echoes) is fitted from 200 starts: the same four walls.
+  std::vector<FirstEcho> ten;
+  for (int sweep = 0; sweep < 10; ++sweep) ten.insert(ten.end(), points.begin(), points.end());
+  EXPECT_EQ(FitWalls(ten).size(), 4u);
   for (int b = 0; b < 200; ++b) {
     const double theta = b * 1.8 * std::numbers::pi / 180.0;
     const auto range = WallAhead(Eigen::Vector2d::Zero(),
