@@ -78,9 +78,9 @@ class FrameWriter {
   }
   // Room for `size` more bytes, filled by the Put calls that follow.
   void Reserve(std::size_t size) {
-    const std::size_t before = raw_.size();
-    raw_.resize(before + size);
-    at_ = raw_.data() + before;
+    const std::size_t before = c_.raw.size();
+    c_.raw.resize(before + size);
+    at_ = c_.raw.data() + before;
   }
   void Put(const void* bytes, std::size_t size) {
     if (size == 0) return;  // an empty beam's data() may be null, which memcpy must not see
@@ -100,14 +100,14 @@ class FrameWriter {
   // Compresses what was put; `end` closes the frame.
   void Flush(bool end) {
     const ZSTD_EndDirective mode = end ? ZSTD_e_end : ZSTD_e_continue;
-    ZSTD_inBuffer in{raw_.data(), raw_.size(), 0};
+    ZSTD_inBuffer in{c_.raw.data(), c_.raw.size(), 0};
     std::size_t left = 0;
     do {
       ZSTD_outBuffer out{c_.chunk.data(), c_.chunk.size(), 0};
       left = Check(ZSTD_compressStream2(c_.cctx.get(), &out, &in, mode));
       frame_.append(c_.chunk.data(), out.pos);
     } while (end ? left != 0 : in.pos < in.size);
-    raw_.clear();
+    c_.raw.clear();
   }
   [[nodiscard]] std::string& Frame() { return frame_; }
 
@@ -123,7 +123,6 @@ class FrameWriter {
     return compressor;
   }
   Compressor& c_;
-  std::string& raw_ = c_.raw;
   std::string frame_;
   char* at_ = nullptr;
 };

@@ -83,22 +83,16 @@ void BeamSynthesizer::BeamJob::FinishLabels(std::span<const double> self_reflect
   }
   constexpr auto kNoise = static_cast<std::size_t>(EchoPath::kNoise);
   constexpr auto kVehicle = static_cast<std::size_t>(EchoPath::kVehicle);
-  // The arrays' addresses held apart from the vectors: the loop's float stores would otherwise
-  // have them read again for every bin.
-  std::array<const double*, kEchoPaths> power{};
-  for (std::size_t p = 0; p < kEchoPaths; ++p) power[p] = l.power[p].data();
-  const double* const speckle = a_.speckle.on ? scratch_.speckle.data() : nullptr;
-  BinLabel* const out = labels.data();
   for (std::size_t k = 0; k < bins_; ++k) {
-    const double bin_speckle = speckle != nullptr ? speckle[k] : 1.0;
-    BinLabel& label = out[k];
+    const double speckle = a_.speckle.on ? scratch_.speckle[k] : 1.0;
+    BinLabel& label = labels[k];
     for (std::size_t p = 0; p < kEchoPaths; ++p) {
-      label.energy[p] = static_cast<float>(power[p][k] * scale[p] * bin_speckle);
+      label.energy[p] = static_cast<float>(l.power[p][k] * scale[p] * speckle);
     }
-    label.energy[kNoise] = static_cast<float>(power[kNoise][k]);
+    label.energy[kNoise] = static_cast<float>(l.power[kNoise][k]);
     if (k < self_reflection.size()) {
       label.energy[kVehicle] =
-          static_cast<float>(power[kVehicle][k] * gain * bin_speckle + self_reflection[k]);
+          static_cast<float>(l.power[kVehicle][k] * gain * speckle + self_reflection[k]);
     }
     label.mesh = kNoMesh;
     label.point_sonar_m = Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN());
