@@ -103,10 +103,11 @@ std::vector<Beam> ReadBeamFile(std::istream& in, const std::string& name) {
                        std::to_string(count));
     }
     if (!std::isfinite(beam.time_s) || !std::isfinite(beam.head_angle_rad) ||
-        !(beam.bin_size_m > 0) || bins > 1000000) {
+        !(beam.bin_size_m > 0) || !std::isfinite(beam.bin_size_m) || bins > kMaxBinsPerBeam) {
       throw InputError(name + ": beam " + std::to_string(b) +
                        ": expected a finite time and head angle, a positive bin size and at "
-                       "most 10^6 bins");
+                       "most " +
+                       std::to_string(kMaxBinsPerBeam) + " bins");
     }
     beam.intensities.resize(bins);
     if (!in.read(reinterpret_cast<char*>(beam.intensities.data()), bins)) {
@@ -153,7 +154,7 @@ std::vector<StampedPose> ReadTum(const std::string& path) {
     const Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     if (std::abs(q.norm() - 1.0) > 1e-6) {
       throw InputError(path + ":" + std::to_string(number) + ": the quaternion's norm is " +
-                       std::to_string(q.norm()) + ", expected 1");
+                       Number(q.norm()) + ", expected 1");
     }
     StampedPose p;
     p.time_s = v[0];
@@ -234,8 +235,7 @@ void ReadPoses(const std::filesystem::path& root, std::vector<Beam>& beams) {
   for (std::size_t b = 0; b < poses.size(); ++b) {
     if (std::abs(poses[b].time_s - beams[b].time_s) > 1e-6) {
       throw InputError(poses_path + ": pose " + std::to_string(b) + " is stamped " +
-                       std::to_string(poses[b].time_s) + " s, its beam " +
-                       std::to_string(beams[b].time_s) + " s");
+                       Number(poses[b].time_s) + " s, its beam " + Number(beams[b].time_s) + " s");
     }
     beams[b].T_world_sonar = poses[b].pose;
   }

@@ -1,6 +1,7 @@
 #include "sonarbench/io/files.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -9,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench {
@@ -71,6 +73,36 @@ void ClaimExportFile(const std::string& path, bool force, bool ours, const std::
   if (!parent.empty()) CreateOutputDirectory(parent.string());
 }
 
+void RemoveDeadTemporaries(const std::string& path,
+                           const std::function<bool(const std::string& head)>& ours) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path folder = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  const std::string prefix = target.filename().string() + ".tmp.";
+  std::error_code error;
+  for (fs::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+    const std::string name = it->path().filename().string();
+    if (!name.starts_with(prefix) || name.size() == prefix.size() ||
+        name.size() > prefix.size() + 9 ||
+        name.find_first_not_of("0123456789", prefix.size()) != std::string::npos) {
+      continue;
+    }
+    const auto pid = static_cast<pid_t>(std::stol(name.substr(prefix.size())));
+    std::error_code status_error;
+    if (pid <= 0 || !fs::is_regular_file(fs::symlink_status(it->path(), status_error)) ||
+        ::kill(pid, 0) == 0 || errno != ESRCH) {
+      continue;  // a writer still running (or a pid this process cannot tell of)
+    }
+    const int fd = ::open(it->path().c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
+    if (fd < 0) continue;
+    std::string head(512, '\0');
+    const ssize_t got = ::read(fd, head.data(), head.size());
+    ::close(fd);
+    head.resize(got > 0 ? static_cast<std::size_t>(got) : 0);
+    if (ours(head)) fs::remove(it->path(), status_error);
+  }
+}
+
 namespace {
 
 // What `mode` is, for a refusal: "a FIFO", "a directory".
@@ -81,6 +113,15 @@ const char* FileKind(mode_t mode) {
   if (S_ISBLK(mode)) return "a block device";
   if (S_ISSOCK(mode)) return "a socket";
   return "not a regular file";
+}
+
+// The reports and manifests name their inputs in JSON, which holds UTF-8 only.
+void RefuseNonUtf8Name(const std::string& path) {
+  if (!io::IsUtf8(path)) {
+    throw InputError(io::Quoted(path, 200) +
+                     ": the file's name is not UTF-8 (the reports name every input in UTF-8); "
+                     "rename it");
+  }
 }
 
 // Refuses what `info` describes unless a regular file of at most `max_bytes`.
@@ -112,6 +153,7 @@ std::string ByteCount(std::uint64_t bytes) {
 }
 
 std::uint64_t CheckInputFile(const std::string& path, std::uint64_t max_bytes) {
+  RefuseNonUtf8Name(path);
   struct stat info {};
   if (::stat(path.c_str(), &info) != 0) {
     throw InputError(path + ": cannot be read (" + std::strerror(errno) + ")");
@@ -121,6 +163,7 @@ std::uint64_t CheckInputFile(const std::string& path, std::uint64_t max_bytes) {
 }
 
 std::string ReadFileBytes(const std::string& path, std::uint64_t max_bytes) {
+  RefuseNonUtf8Name(path);
   // O_NONBLOCK: a FIFO opens at once (and is refused by its type) instead of waiting for a writer.
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
   if (fd < 0) throw InputError(path + ": cannot be read (" + std::strerror(errno) + ")");

@@ -11,6 +11,7 @@
 #include <memory>
 #include <numeric>
 
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 
@@ -184,17 +185,17 @@ std::string EncodeLabelFile(std::span<const BeamLabels> beams) {
 
 namespace {
 
-std::string Decompress(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open file");
-  const std::string frame((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+std::string Decompress(const std::string& path, std::uint64_t max_bytes) {
+  // A frame is at most a little larger than what it holds.
+  const std::string frame = ReadFileBytes(path, max_bytes + 4096);
   const unsigned long long size = ZSTD_getFrameContentSize(frame.data(), frame.size());
   if (size == ZSTD_CONTENTSIZE_ERROR || size == ZSTD_CONTENTSIZE_UNKNOWN) {
     throw InputError(path + ": not a label file (expected one zstd frame that states its size)");
   }
-  if (size > kMaxLabelBytes) {
-    throw InputError(path + ": its frame holds " + std::to_string(size) +
-                     " bytes; at most 1 GiB is read");
+  if (size > max_bytes) {
+    throw InputError(path + ": its frame states " + std::to_string(size) +
+                     " bytes uncompressed; expected at most " + std::to_string(max_bytes) +
+                     " for the beams it labels");
   }
   std::string raw(static_cast<std::size_t>(size), '\0');
   const std::size_t n = ZSTD_decompress(raw.data(), raw.size(), frame.data(), frame.size());
@@ -262,8 +263,15 @@ std::vector<BeamLabels> ReadDatasetLabels(const std::string& dir, const Dataset&
                    [](const nlohmann::json& f) { return f.value("path", "") == LabelFile(0); })) {
     return beams;
   }
+  const std::size_t per_sweep = static_cast<std::size_t>(dataset.sensor.BeamsPerSweep());
   for (std::size_t s = 0; s < dataset.sweeps; ++s) {
-    std::vector<BeamLabels> sweep = ReadLabelFile(dir + "/" + LabelFile(s));
+    // What the sweep's beams can take: a generous 64 bytes a bin (a bin stores at most 21).
+    std::uint64_t max_bytes = 4096;
+    for (std::size_t b = s * per_sweep; b < std::min(dataset.beams.size(), (s + 1) * per_sweep);
+         ++b) {
+      max_bytes += 64 + 64 * std::uint64_t{dataset.beams[b].intensities.size()};
+    }
+    std::vector<BeamLabels> sweep = ReadLabelFile(dir + "/" + LabelFile(s), max_bytes);
     std::move(sweep.begin(), sweep.end(), std::back_inserter(beams));
   }
   if (beams.size() != dataset.beams.size()) {
@@ -274,8 +282,8 @@ std::vector<BeamLabels> ReadDatasetLabels(const std::string& dir, const Dataset&
   return beams;
 }
 
-std::vector<BeamLabels> ReadLabelFile(const std::string& path) {
-  const std::string raw = Decompress(path);
+std::vector<BeamLabels> ReadLabelFile(const std::string& path, std::uint64_t max_bytes) {
+  const std::string raw = Decompress(path, std::min<std::uint64_t>(max_bytes, kMaxLabelBytes));
   Payload in(raw, path);
   char magic[8];
   for (char& c : magic) c = in.Get<char>("the magic");

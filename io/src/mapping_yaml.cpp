@@ -3,6 +3,8 @@
 #include <array>
 #include <string>
 
+#include "sonarbench/io/files.hpp"
+
 namespace sonarbench::io {
 
 const char* IntegrationName(Integration integration) {
@@ -112,7 +114,7 @@ SensorGeometry ReadSensorGeometry(YamlReader& node) {
   double step_deg = g.step_angle_rad / mapping::kDegToRad;
   node.Required("beam_width_horizontal_deg", width_h_deg, InRange(0.1, 90.0));
   node.Required("beam_width_vertical_deg", width_v_deg, InRange(0.1, 90.0));
-  node.Required("num_bins", g.num_bins, IntInRange(1, 100000));
+  node.Required("num_bins", g.num_bins, IntInRange(1, static_cast<int>(kMaxBinsPerBeam)));
   node.Required("bin_size_m", g.bin_size_m, Positive());
   node.Required("step_angle_deg", step_deg, InRange(0.01, 180.0));
   node.Required("beams_per_second", g.beams_per_second, Positive());

@@ -40,12 +40,15 @@ std::size_t ElementCount(const matvar_t* var) {
 mat_v5::ArrayView ViewOf(const matvar_t* var) {
   constexpr std::uint32_t kTypeOfClass[16] = {0, 0, 0, 0, 0, 0, 9, 7, 1, 2, 3, 4, 5, 6, 12, 13};
   const auto array_class = static_cast<std::uint32_t>(var->class_type);
+  int long_dims = 0;
+  for (int i = 0; i < var->rank; ++i) long_dims += var->dims[i] > 1;
   return {array_class,
           var->isComplex != 0,
           ElementCount(var),
           array_class < 16 ? kTypeOfClass[array_class] : 0,
           static_cast<const char*>(var->data),
-          var->nbytes};
+          var->nbytes,
+          long_dims};
 }
 
 // Throws unless the struct array's table of fields reads back whole. A corrupt file can leave it
@@ -71,6 +74,14 @@ std::vector<std::uint8_t> ReadIntensities(const std::string& path,
   if (!bins) throw InputError(where() + ": missing");
   const std::size_t n = bins->count;
   if (n == 0) throw InputError(where() + ": empty");
+  if (bins->long_dims > 1) {
+    throw InputError(where() + ": a matrix of " + std::to_string(n) +
+                     " values; expected one row or column of range bins");
+  }
+  if (n > kMaxBinsPerBeam) {
+    throw InputError(where() + ": " + std::to_string(n) + " range bins; expected at most " +
+                     std::to_string(kMaxBinsPerBeam));
+  }
   if (const std::string_view bytes = bins->StoredBytes(); bytes.size() == n) {
     return {bytes.begin(), bytes.end()};  // stored as uint8: each value already in 0..255
   }

@@ -138,6 +138,7 @@ class Walker {
       const auto dim = static_cast<std::int32_t>(U32(bytes, dims.data + d));
       if (dim < 0) throw fail_("an array of negative dimensions");
       array.view.count *= static_cast<std::size_t>(dim);
+      array.view.long_dims += dim > 1;
     }
     const Tag name = ReadTag(bytes, dims.end, end);
     array.name = std::string_view(bytes.data() + name.data, name.bytes);

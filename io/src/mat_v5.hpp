@@ -25,6 +25,8 @@ struct ArrayView {
   std::uint32_t data_type = 0;
   const char* data = nullptr;
   std::size_t data_bytes = 0;
+  /// Dimensions longer than 1: at most one for a vector (or a scalar).
+  int long_dims = 0;
 
   /// Element k of a real array of class double, single or (u)int8..32, as the class holds it;
   /// nullopt for other classes, complex arrays and k out of range.

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "ros2_messages.hpp"
+#include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/error.hpp"
@@ -170,11 +171,15 @@ class TransformTree {
   }
   [[nodiscard]] bool Has(const std::string& frame) const { return parent_.count(frame) != 0; }
   // T_root_frame at time `t` and the root's name; nullopt when a moving link has no transform
-  // at or around `t`.
-  std::optional<Eigen::Isometry3d> Lookup(std::string frame, double t, std::string& root) const {
+  // at or around `t`. A loop is refused naming `path`, the bag.
+  std::optional<Eigen::Isometry3d> Lookup(std::string frame, double t, std::string& root,
+                                          const std::string& path) const {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
     for (int depth = 0; parent_.count(frame); ++depth) {
-      if (depth == 64) throw InputError("the transforms from " + Quoted(frame) + " form a loop");
+      if (depth == 64) {
+        throw InputError(path + ": the transforms from " + Quoted(frame) +
+                         " form a loop (expected a tree of frames on /tf and /tf_static)");
+      }
       const auto s = static_.find(frame);
       std::optional<Eigen::Isometry3d> link;
       if (s != static_.end()) {
@@ -279,6 +284,10 @@ Beam ImageBeam(const ros2::ProjectedSonarImage& m, const RosbagReadOptions& opti
     throw InputError(where + "image.dtype is " + std::to_string(m.dtype) +
                      "; expected 0 (DTYPE_UINT8, 8-bit intensities)");
   }
+  if (m.ranges.size() > kMaxBinsPerBeam) {
+    throw InputError(where + "image holds " + std::to_string(m.ranges.size()) +
+                     " ranges; expected at most " + std::to_string(kMaxBinsPerBeam));
+  }
   if (m.data.size() != m.ranges.size()) {
     throw InputError(where + "image.data holds " + std::to_string(m.data.size()) + " bytes for " +
                      std::to_string(m.ranges.size()) + " ranges; expected one byte a range");
@@ -361,7 +370,7 @@ void PoseBeams(RosbagBeams& out, TransformTree& tree, const std::string& path) {
   std::vector<Beam> posed;
   for (Beam& beam : out.beams) {
     std::string root;
-    const auto pose = tree.Lookup(out.sonar_frame, beam.time_s, root);
+    const auto pose = tree.Lookup(out.sonar_frame, beam.time_s, root, path);
     if (!pose) continue;
     if (!out.world_frame.empty() && root != out.world_frame) {
       throw InputError(path + ": the transforms from " + Quoted(out.sonar_frame) + " reach " +

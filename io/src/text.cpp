@@ -1,5 +1,7 @@
 #include "sonarbench/io/text.hpp"
 
+#include <cstdio>
+
 namespace sonarbench::io {
 
 std::string Quoted(std::string_view text, std::size_t max) {
@@ -17,6 +19,12 @@ std::string Quoted(std::string_view text, std::size_t max) {
   }
   out += text.size() > max ? "'..." : "'";
   return out;
+}
+
+std::string Number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
 }
 
 bool IsUtf8(std::string_view text) {

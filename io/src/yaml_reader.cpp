@@ -1,5 +1,6 @@
 #include "sonarbench/io/yaml_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -7,6 +8,7 @@
 #include <sstream>
 
 #include "sonarbench/io/files.hpp"
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 
@@ -144,6 +146,19 @@ YamlReader YamlReader::FromFile(const std::string& path) {
 }
 
 YamlReader YamlReader::FromString(const std::string& text, const std::string& source_name) {
+  if (!io::IsUtf8(text)) {
+    // The first line that is not: names and paths go into UTF-8 JSON reports.
+    std::size_t line = 1;
+    for (std::size_t start = 0; start <= text.size(); ++line) {
+      const std::size_t end = std::min(text.find('\n', start), text.size());
+      const std::string_view part(text.data() + start, end - start);
+      if (!io::IsUtf8(part)) {
+        throw InputError(source_name + ":" + std::to_string(line) + ": " + io::Quoted(part) +
+                         " is not UTF-8 text (expected a YAML file in UTF-8)");
+      }
+      start = end + 1;
+    }
+  }
   YAML::Node root;
   try {
     root = YAML::Load(text);

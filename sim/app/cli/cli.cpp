@@ -3,9 +3,11 @@
 #include <omp.h>
 
 #include <cmath>
+#include <cstdlib>
 
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/files.hpp"
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
 
@@ -148,23 +150,44 @@ void AddSeedOption(CLI::App* command, std::optional<std::uint64_t>& seed,
           "UINT64"));
 }
 
+namespace {
+
+// A budget: a finite number above 0 (CLI11's PositiveNumber takes "nan" and "inf", and its range
+// message prints the double's whole range).
+CLI::Validator BudgetNumber() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (!text.empty() && end == text.c_str() + text.size() && std::isfinite(value) &&
+            value > 0.0 && value <= 1e15) {
+          return "";
+        }
+        return "expected a number above 0 and at most 1e15 (e.g. 2e8), got " +
+               sonarbench::io::Quoted(text);
+      },
+      "NUMBER > 0");
+}
+
+}  // namespace
+
 void AddBudgetOptions(CLI::App* command, sonarbench::sim::Budgets& budgets) {
   command
       ->add_option("--max-triangles", budgets.max_triangles,
                    "Refuse a scene whose meshes would make more triangles (estimated from the "
                    "scene before anything is built)")
-      ->check(CLI::PositiveNumber)
+      ->check(BudgetNumber())
       ->capture_default_str();
   command
       ->add_option("--max-cells", budgets.max_cells,
                    "Refuse a scene whose ground truth or map would hold more cells (estimated "
                    "from the scene, or the log's poses, before anything is built)")
-      ->check(CLI::PositiveNumber)
+      ->check(BudgetNumber())
       ->capture_default_str();
   command
       ->add_option("--max-beams", budgets.max_beams,
                    "Refuse a scene whose sweeps would make more beams (each held in memory)")
-      ->check(CLI::PositiveNumber)
+      ->check(BudgetNumber())
       ->capture_default_str();
 }
 
@@ -172,7 +195,14 @@ void AddThreadsOption(CLI::App* command, int& threads) {
   command
       ->add_option("-j,--threads", threads,
                    "Threads; 0 = all cores. Outputs are identical for any value.")
-      ->check(CLI::Range(0, 1024))
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            const std::optional<int> n = ParsedWhole<int>(text);
+            if (n && *n >= 0 && *n <= 1024) return "";
+            return "expected a whole number of threads from 0 (all cores) to 1024, got " +
+                   sonarbench::io::Quoted(text);
+          },
+          "0-1024"))
       ->capture_default_str();
   // Every parallel loop that names no thread count, the images' too, takes this one.
   command->parse_complete_callback([&threads] {

@@ -10,6 +10,7 @@
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/detector_study.hpp"
+#include "sonarbench/sim/app/map_log.hpp"
 
 namespace sonarbench::app {
 namespace {
@@ -43,8 +44,13 @@ int Detectors(const DetectorsArgs& args) {
     }
     options.heads_deg = std::pair{args.heads[0], args.heads[1]};
   }
-  sim::OutputDirectory out(
-      args.out, OneShotClaim("detectors", sim::kDetectorStudyFiles, {args.scene, args.log}));
+  std::vector<std::string> inputs = sim::SceneInputFiles(scene);
+  if (!args.log.empty()) {
+    const std::vector<std::string> log_files = sim::LogInputFiles(args.log);
+    inputs.insert(inputs.end(), log_files.begin(), log_files.end());
+  }
+  sim::OutputDirectory out(args.out,
+                           OneShotClaim("detectors", sim::kDetectorStudyFiles, std::move(inputs)));
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   options.progress = [&](std::size_t done, std::size_t total) {
     progress.Update("settings", done, total);

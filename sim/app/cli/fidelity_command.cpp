@@ -81,9 +81,12 @@ int Fidelity(const FidelityArgs& args) {
   }
   const auto map_settings = MapSettings(args.maps, scene.mapping.detection);
   const std::vector<sonarbench::mapping::Beam> log_beams = ReadLogBeams(args.log);
+  sim::CheckBeamsMapCells(log_beams, scene.sensor.geometry, scene.mapping.resolution_m,
+                          args.budgets, args.log);
   const auto meshes = sim::BuildSceneMeshes(scene);
   std::vector<std::string> inputs = sim::SceneInputFiles(scene);
-  inputs.push_back(args.log);
+  const std::vector<std::string> log_files = sim::LogInputFiles(args.log);
+  inputs.insert(inputs.end(), log_files.begin(), log_files.end());
   sim::OutputDirectory out(args.out, OneShotClaim("fidelity", sim::kFidelityOutputFiles, inputs));
   const sim::RayTracer tracer(meshes);
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));

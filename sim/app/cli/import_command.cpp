@@ -68,7 +68,7 @@ int Import(const ImportArgs& args) {
     log = sim::ImportedMatLog(io::ReadMatLog(args.log, args.max_input_mb << 20));
   }
   const sim::DatasetSummary summary =
-      sim::ImportLogDataset(args.log, log, sensor, args.out, args.force);
+      sim::ImportLogDataset(args.log, log, sensor, args.out, args.force, args.sensor);
   if (summary.already_complete) {
     std::cout << args.out << ": already holds this log's dataset; nothing to do\n";
     return 0;

@@ -33,12 +33,18 @@ int Map(const MapArgs& args) {
       args.sensor.empty() ? sonarbench::sim::ShippedSensorModelPath() : args.sensor;
   sonarbench::mapping::SensorGeometry sensor;
   sonarbench::mapping::MapperConfig config;
+  // Every file the command reads: none may be an output.
+  std::vector<std::string> inputs = sonarbench::sim::LogInputFiles(args.input);
+  inputs.insert(inputs.end(), {args.sensor, args.mapping});
   if (!args.scene.empty()) {
     const sonarbench::sim::Scene scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
     sensor = scene.sensor.geometry;
     config = scene.mapping;
     defaults = args.scene;
+    const std::vector<std::string> scene_files = sonarbench::sim::SceneInputFiles(scene);
+    inputs.insert(inputs.end(), scene_files.begin(), scene_files.end());
   } else {
+    inputs.push_back(defaults);
     const sonarbench::sim::SensorModel model = sonarbench::sim::LoadSensorModel(defaults);
     sensor = model.geometry;
     config = model.mapping;
@@ -57,8 +63,7 @@ int Map(const MapArgs& args) {
   }
   std::vector<std::string> files = sonarbench::sim::kLogMapOutputFiles;
   std::rotate(files.begin(), files.end() - 1, files.end());  // the record, report.json, first
-  sonarbench::sim::OutputDirectory out(
-      args.out, OneShotClaim("map", files, {args.input, args.scene, args.sensor, args.mapping}));
+  sonarbench::sim::OutputDirectory out(args.out, OneShotClaim("map", files, inputs));
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   auto result = sonarbench::sim::MapLog(
       args.input, sensor, config, scene ? &*scene : nullptr, args.budgets,

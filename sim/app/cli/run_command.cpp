@@ -1,6 +1,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "cli.hpp"
 #include "sonarbench/io/files.hpp"
@@ -69,10 +70,21 @@ int Run(const RunArgs& args) {
   std::vector<std::string> files = sim::kScenarioOutputFiles;
   std::erase(files, "report.json");
   files.insert(files.begin(), "report.json");
-  // Taken before any work: a run writes its junit.xml there even when the scene is refused.
-  sim::OutputDirectory out(args.out, OneShotClaim("run", files, {args.scene}));
+  // The scene is loaded first, so that every file it reads is known as an input; the directory
+  // is taken before any work, so a run writes its junit.xml there even when the scene is refused.
+  std::optional<sim::Scene> loaded;
+  std::exception_ptr refused;
   try {
-    const sim::Scene scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
+    loaded = sim::LoadScene(args.scene, args.budgets);
+  } catch (const sonarbench::InputError&) {
+    refused = std::current_exception();
+  }
+  sim::OutputDirectory out(
+      args.out,
+      OneShotClaim("run", files, loaded ? sim::SceneInputFiles(*loaded) : std::vector{args.scene}));
+  try {
+    if (refused) std::rethrow_exception(refused);
+    const sim::Scene& scene = *loaded;
     sim::RunOptions options;
     options.seed = args.seed;
     options.threads = args.threads;

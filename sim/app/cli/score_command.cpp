@@ -22,8 +22,10 @@ int Score(const ScoreArgs& args) {
   sonarbench::CheckOutputDirectory(args.out);
   const sim::Scene scene = sonarbench::sim::LoadScene(args.scene, args.budgets);
   sim::CheckBudgets(scene, args.budgets);
-  sim::OutputDirectory out(
-      args.out, OneShotClaim("score", sim::kMapFileScoreOutputFiles, {args.map, args.scene}));
+  std::vector<std::string> inputs = sim::SceneInputFiles(scene);
+  inputs.push_back(args.map);
+  sim::OutputDirectory out(args.out,
+                           OneShotClaim("score", sim::kMapFileScoreOutputFiles, std::move(inputs)));
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   const sim::MapFileScore file_score = sim::ScoreMapFile(
       args.map, scene, args.budgets,

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "dataset_resume.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/labels.hpp"
 #include "sonarbench/io/text.hpp"
@@ -46,18 +47,6 @@ std::string Number(double value) {
   return text;
 }
 
-// The config hash stored in a manifest; nullopt when it is absent or unreadable.
-std::optional<std::string> StoredConfig(const fs::path& file) {
-  if (!fs::is_regular_file(file)) return std::nullopt;
-  try {
-    return json::parse(ReadFileBytes(file.string(), kMaxJsonBytes))
-        .at("config_sha256")
-        .get<std::string>();
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-}
-
 // Every file a dataset of `sweeps` sweeps holds (with truth when simulated, label files when
 // `labels`), and the partial marker: what its output directory claims.
 OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sweeps,
@@ -72,10 +61,8 @@ OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sw
                        {"poses/sonar_true.tum", "poses/vehicle.tum", "truth/occupancy.bt"});
   }
   for (std::size_t s = 0; s < sweeps; ++s) {
-    claim.files.push_back(io::SweepFile("beams", s, "bin"));
-    claim.files.push_back(io::SweepFile("images", s, "png"));
-    if (simulated) claim.files.push_back(io::SweepFile("truth", s, "csv"));
-    if (labels) claim.files.push_back(io::LabelFile(s));
+    for (std::string& file : SweepFiles(s, simulated, labels)) claim.files.push_back(file);
+    claim.files.push_back(SweepRecordFile(s));
   }
   claim.record = "manifest.json";
   claim.force = force;
@@ -83,10 +70,12 @@ OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sw
 }
 
 // Readies an owned dataset directory for `config` (truth/ only when `simulated`). Returns true when
-// a complete dataset of that very configuration is already there (nothing to do).
-bool PrepareDirectory(const OutputDirectory& out, const std::string& config, bool simulated) {
+// a complete dataset of that very configuration is already there, every file the hash its
+// manifest gives (nothing to do).
+bool PrepareDirectory(const OutputDirectory& out, const std::string& config, bool simulated,
+                      ResumeRecords& records) {
   const fs::path& root = out.root();
-  if (StoredConfig(root / "manifest.json") == config) return true;
+  if (records.ManifestComplete()) return true;
   for (const char* sub : {"beams", "images", "poses"}) fs::create_directories(root / sub);
   if (simulated) fs::create_directories(root / "truth");
   if (!fs::exists(root / kPartialMarker)) {
@@ -96,13 +85,15 @@ bool PrepareDirectory(const OutputDirectory& out, const std::string& config, boo
   return false;
 }
 
-// Writes manifest.json over the claimed files present (sha256 and size), then drops the marker.
-void Finalize(const OutputDirectory& out, const std::vector<std::string>& claimed, json manifest) {
+// Writes manifest.json over the claimed files present (sha256 and size), then drops the marker
+// and the sweeps' records.
+void Finalize(const OutputDirectory& out, const std::vector<std::string>& claimed, json manifest,
+              const ResumeRecords& records) {
   const fs::path& root = out.root();
   std::vector<std::string> files;
   for (const std::string& relative : claimed) {
     if (relative != "manifest.json" && relative != kPartialMarker &&
-        fs::is_regular_file(root / relative)) {
+        !relative.starts_with(kSweepRecordFolder) && fs::is_regular_file(root / relative)) {
       files.push_back(relative);
     }
   }
@@ -115,6 +106,7 @@ void Finalize(const OutputDirectory& out, const std::vector<std::string>& claime
   }
   manifest["files"] = list;
   WriteText(root / "manifest.json", manifest.dump(2) + "\n");
+  records.RemoveAll(manifest.value("sweeps", std::size_t{0}));
   std::error_code ignored;
   fs::remove(root / kPartialMarker, ignored);
 }
@@ -152,13 +144,6 @@ json ManifestBase(const mapping::SensorGeometry& sensor, std::size_t sweeps, std
 
 void WriteBeams(const fs::path& path, std::span<const mapping::Beam> beams) {
   WriteFileAtomically(path.string(), [&](std::ostream& out) { io::WriteBeamFile(out, beams); });
-}
-
-bool SweepComplete(const fs::path& root, std::size_t sweep, bool with_truth, bool with_labels) {
-  return fs::is_regular_file(root / io::SweepFile("beams", sweep, "bin")) &&
-         fs::is_regular_file(root / io::SweepFile("images", sweep, "png")) &&
-         (!with_truth || fs::is_regular_file(root / io::SweepFile("truth", sweep, "csv"))) &&
-         (!with_labels || fs::is_regular_file(root / io::LabelFile(sweep)));
 }
 
 std::string TruthCsv(std::span<const SynthesizedBeam> beams, std::size_t first_index,
@@ -393,7 +378,8 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
                                    options.labels, options.force);
   claim.inputs = SceneInputFiles(scene);
   const OutputDirectory out(dir, claim);
-  if (PrepareDirectory(out, summary.config_sha256, true)) {
+  ResumeRecords records(out.root(), summary.config_sha256);
+  if (PrepareDirectory(out, summary.config_sha256, true, records)) {
     summary.complete = summary.already_complete = true;
     return summary;
   }
@@ -409,7 +395,8 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   std::vector<SynthesizedBeam> synthesized;  // a sweep's, its memory kept for the next
   std::vector<io::BeamLabels> label_beams;   // the same
   for (std::size_t s = first_sweep; s < summary.sweeps_total; s += stride) {
-    if (SweepComplete(root, s, true, options.labels)) {
+    const std::vector<std::string> sweep_files = SweepFiles(s, true, options.labels);
+    if (records.Vouched(s, sweep_files)) {
       ++summary.sweeps_skipped;
     } else {
       const std::size_t first = s * per_sweep;
@@ -426,6 +413,7 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
       WritePolarImage((root / io::SweepFile("images", s, "png")).string(), beams,
                       scene.name + ", seed " + std::to_string(seed) + ": sweep " +
                           std::to_string(s) + ", polar");
+      records.Record(s, sweep_files);
       ++summary.sweeps_written;
     }
     if (options.progress) options.progress(++handled, mine);
@@ -433,11 +421,11 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
 
   for (std::size_t s = 0; s < summary.sweeps_total; ++s) {
     // Other shards' sweeps are still due.
-    if (!SweepComplete(root, s, true, options.labels)) return summary;
+    if (!records.Vouched(s, SweepFiles(s, true, options.labels))) return summary;
   }
   WritePosesAndTruth(root, scene, seed, beam_count, meshes);
   const json manifest = SimulatedManifest(scene, summary, seed, beam_count, options.labels);
-  Finalize(out, claim.files, manifest);
+  Finalize(out, claim.files, manifest, records);
   summary.complete = true;
   return summary;
 }
@@ -448,7 +436,7 @@ ImportedLog ImportedMatLog(io::MatLog log) {
 
 DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& log,
                                 const mapping::SensorGeometry& sensor, const std::string& dir,
-                                bool force) {
+                                bool force, const std::string& sensor_file) {
   DatasetSummary summary;
   const auto per_sweep = static_cast<std::size_t>(sensor.BeamsPerSweep());
   summary.sweeps_total = (log.beams.size() + per_sweep - 1) / per_sweep;
@@ -461,8 +449,10 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& 
   OutputClaim claim =
       DatasetClaim("import", summary.config_sha256, summary.sweeps_total, false, false, force);
   claim.inputs = {log_path};
+  if (!sensor_file.empty()) claim.inputs.push_back(sensor_file);
   const OutputDirectory out(dir, claim);
-  if (PrepareDirectory(out, summary.config_sha256, false)) {
+  ResumeRecords records(out.root(), summary.config_sha256);
+  if (PrepareDirectory(out, summary.config_sha256, false, records)) {
     summary.complete = summary.already_complete = true;
     return summary;
   }
@@ -471,13 +461,15 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& 
   std::string poses;
   for (std::size_t s = 0; s < summary.sweeps_total; ++s) {
     const auto sweep = all.subspan(s * per_sweep, std::min(per_sweep, all.size() - s * per_sweep));
-    if (SweepComplete(root, s, false, false)) {
+    const std::vector<std::string> sweep_files = SweepFiles(s, false, false);
+    if (records.Vouched(s, sweep_files)) {
       ++summary.sweeps_skipped;
     } else {
       WriteBeams(root / io::SweepFile("beams", s, "bin"), sweep);
       WritePolarImage(
           (root / io::SweepFile("images", s, "png")).string(), sweep,
           fs::path(log_path).filename().string() + ": sweep " + std::to_string(s) + ", polar");
+      records.Record(s, sweep_files);
       ++summary.sweeps_written;
     }
   }
@@ -490,7 +482,7 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& 
   manifest["log"].update(log.info);
   manifest["seed"] = nullptr;
   manifest["truth"] = nullptr;
-  Finalize(out, claim.files, manifest);
+  Finalize(out, claim.files, manifest, records);
   summary.complete = true;
   return summary;
 }

@@ -47,6 +47,23 @@ std::string MatLogInDirectory(const std::string& input) {
                    " .mat logs; name the one to map:" + names);
 }
 
+std::vector<std::string> LogInputFiles(const std::string& input) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_directory(input, error)) return {input};
+  if (std::string log = MatLogInDirectory(input); !log.empty()) return {log};
+  // A dataset: its manifest and every file of its folders (what ReadDataset and the labels'
+  // readers open); the outputs a command writes beside them are not read.
+  std::vector<std::string> files = {(fs::path(input) / "manifest.json").string()};
+  for (const char* folder : {"beams", "images", "poses", "truth"}) {
+    for (fs::recursive_directory_iterator it(fs::path(input) / folder, error), end;
+         !error && it != end; it.increment(error)) {
+      if (!it->is_directory(error)) files.push_back(it->path().string());
+    }
+  }
+  return files;
+}
+
 namespace {
 
 // Where a dataset's beams are mapped to score them against `scene`: an imported log is static at
@@ -128,14 +145,7 @@ LogMapResult MapLog(const std::string& input, const mapping::SensorGeometry& sen
   result.import_s = std::chrono::duration<double>(now - start).count();
   result.beams = beams.size();
 
-  Eigen::Vector3d lo = Eigen::Vector3d::Zero();
-  Eigen::Vector3d hi = Eigen::Vector3d::Zero();
-  for (std::size_t b = 0; b < beams.size(); ++b) {
-    const Eigen::Vector3d p = beams[b].T_world_sonar.translation();
-    lo = b == 0 ? p : lo.cwiseMin(p);
-    hi = b == 0 ? p : hi.cwiseMax(p);
-  }
-  CheckMapCells(MapCellsEstimate(geometry, config.resolution_m, lo, hi), budgets, input);
+  CheckBeamsMapCells(beams, geometry, config.resolution_m, budgets, input);
 
   start = now;
   result.sensor = geometry;

@@ -73,6 +73,11 @@ void WriteNpzFromDataset(const std::string& dir, const std::string& path, bool f
   for (const mapping::Beam& beam : d.beams) bins = std::max(bins, beam.intensities.size());
   ClaimExportFile(path, force, io::NpzComment(path).value_or("").rfind("sonarbench", 0) == 0,
                   "an .npz file");
+  // A killed export's archive starts with the local header of its first array.
+  RemoveDeadTemporaries(path, [](const std::string& head) {
+    return head.starts_with("PK\x03\x04") && head.size() >= 45 &&
+           head.compare(30, 15, "intensities.npy") == 0;
+  });
   const std::size_t slots = d.sweeps * per_sweep;
   std::vector<std::uint8_t> intensities(slots * bins, 0);
   std::vector<std::uint8_t> valid(slots, 0);

@@ -56,6 +56,10 @@ io::RosbagContent RosbagFromDataset(const std::string& dir) {
 void WriteRosbagFile(const io::RosbagContent& bag, const std::string& path, bool force) {
   ClaimExportFile(path, force, io::McapLibrary(path).value_or("").rfind("sonarbench", 0) == 0,
                   "an MCAP file");
+  // A killed export's bag starts with the magic and a header naming sonarbench as its library.
+  RemoveDeadTemporaries(path, [](const std::string& head) {
+    return head.starts_with(io::kMcapMagic) && head.find("sonarbench") != std::string::npos;
+  });
   WriteFileAtomically(path, [&](std::ostream& out) { io::WriteRosbag(out, bag, LibraryName()); });
 }
 

@@ -156,6 +156,9 @@ cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m,
   for (const auto& beam : sweep) {
     max_range = std::max(max_range, beam.bin_size_m * static_cast<double>(beam.intensities.size()));
   }
+  // A longer reach takes larger pixels: at most kMaxFanHalf a side of the sonar (4097² pixels).
+  constexpr int kMaxFanHalf = 2048;
+  pixel_m = std::max(pixel_m, max_range / kMaxFanHalf);
   const int half = static_cast<int>(std::ceil(max_range / pixel_m));
   cv::Mat gray(2 * half + 1, 2 * half + 1, CV_8UC1, cv::Scalar(0));
   if (!sweep.empty()) {

@@ -112,6 +112,20 @@ std::vector<std::string> SortedUnion(std::vector<std::string> a,
   return a;
 }
 
+// Whether `output` and `input` name one file: the same path once links and ".." are resolved,
+// or the same inode (a hard link).
+bool SameFile(const fs::path& output, const fs::path& input) {
+  std::error_code out_error;
+  std::error_code in_error;
+  const fs::path out = fs::weakly_canonical(output, out_error);
+  const fs::path in = fs::weakly_canonical(input, in_error);
+  if (!out_error && !in_error && out == in) return true;
+  struct stat a {};
+  struct stat b {};
+  return ::stat(output.c_str(), &a) == 0 && ::stat(input.c_str(), &b) == 0 &&
+         a.st_dev == b.st_dev && a.st_ino == b.st_ino;
+}
+
 bool IsFolder(const fs::path& path) {
   std::error_code error;
   return fs::is_directory(fs::symlink_status(path, error));
@@ -395,12 +409,10 @@ void OutputDirectory::CheckInputsAndCollisions(const std::vector<std::string>& o
     throw InputError(name_ + ": holds files sonarbench did not write: " + Listed(foreign) +
                      "; sonarbench never replaces them (move them or choose another --out)");
   }
-  std::error_code error;
   for (const std::string& input : claim_.inputs) {
-    const fs::path in = fs::weakly_canonical(input, error);
     for (const auto* list : {&claim_.files, &owned}) {
       for (const std::string& file : *list) {
-        if (fs::weakly_canonical(root_ / file, error) == in) {
+        if (SameFile(root_ / file, input)) {
           throw InputError(name_ + "/" + file + " is the input " + input +
                            ": sonarbench never overwrites or removes its inputs (choose another "
                            "--out)");

@@ -119,16 +119,16 @@ SceneEstimate EstimateScene(const Scene& scene) {
   }
   if (scene.trajectory.waypoints.empty()) lo = hi = Eigen::Vector3d::Zero();
   const double mount = scene.sensor.geometry.T_vehicle_sonar.translation().norm();
-  e.map_cells =
-      MapCellsEstimate(scene.sensor.geometry, res, lo.array() - mount, hi.array() + mount);
+  e.map_cells = MapCellsEstimate(scene.sensor.geometry, scene.sensor.geometry.MaxRangeM(), res,
+                                 lo.array() - mount, hi.array() + mount);
   return e;
 }
 
-double MapCellsEstimate(const mapping::SensorGeometry& sensor, double resolution_m,
+double MapCellsEstimate(const mapping::SensorGeometry& sensor, double range_m, double resolution_m,
                         const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   // The zone of a sphere the beams sweep about the head's axis, stretched along each axis by the
   // box the sonar moves in.
-  const double r = sensor.MaxRangeM();
+  const double r = range_m;
   const double zone = 4.0 / 3.0 * std::numbers::pi * r * r * r *
                       std::sin(0.5 * std::min(sensor.beam_width_vertical_rad, std::numbers::pi));
   const Eigen::Vector3d stretch = Eigen::Vector3d::Ones() + (hi - lo) / (2.0 * r);
@@ -139,6 +139,31 @@ void CheckMapCells(double estimate, const Budgets& budgets, const std::string& w
   if (!(estimate <= budgets.max_cells)) {
     Refuse(what, "'mapping.resolution_m' and the sonar's range give a map of", estimate, "cells",
            budgets.max_cells, "--max-cells");
+  }
+}
+
+void CheckBeamsMapCells(std::span<const mapping::Beam> beams, const mapping::SensorGeometry& sensor,
+                        double resolution_m, const Budgets& budgets, const std::string& what) {
+  // The map reaches as far as the longest beam, whatever the sensor model says.
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero();
+  Eigen::Vector3d hi = Eigen::Vector3d::Zero();
+  double reach_m = sensor.MaxRangeM();
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    const Eigen::Vector3d p = beams[b].T_world_sonar.translation();
+    lo = b == 0 ? p : lo.cwiseMin(p);
+    hi = b == 0 ? p : hi.cwiseMax(p);
+    reach_m =
+        std::max(reach_m, beams[b].bin_size_m * static_cast<double>(beams[b].intensities.size()));
+  }
+  const double estimate = MapCellsEstimate(sensor, reach_m, resolution_m, lo, hi);
+  if (!(estimate <= budgets.max_cells)) {
+    Refuse(what,
+           "its beams reach " + Number(reach_m) +
+               " m (the longest: bin size x bins) from poses "
+               "spanning " +
+               Number((hi - lo).maxCoeff()) + " m; at 'mapping.resolution_m' " +
+               Number(resolution_m) + " that gives a map of",
+           estimate, "cells", budgets.max_cells, "--max-cells");
   }
 }
 
@@ -174,6 +199,22 @@ void CheckBudgets(const Scene& scene, const Budgets& budgets) {
   if (cells) {
     Refuse(where + " at 'mapping.resolution_m' " + Number(res), "its ground truth takes",
            e.truth_cells, "cells", budgets.max_cells, "--max-cells");
+  }
+  if (!(e.map_cells <= budgets.max_cells)) {
+    // The trajectory's extent, when it is what makes the map large, is the key to change.
+    Eigen::Vector3d lo = Eigen::Vector3d::Zero();
+    Eigen::Vector3d hi = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < scene.trajectory.waypoints.size(); ++i) {
+      const Eigen::Vector3d& p = scene.trajectory.waypoints[i].position_m;
+      lo = i == 0 ? p : lo.cwiseMin(p);
+      hi = i == 0 ? p : hi.cwiseMax(p);
+    }
+    const double span = (hi - lo).maxCoeff();
+    if (span > 2.0 * scene.sensor.geometry.MaxRangeM()) {
+      Refuse(scene.file + ": 'trajectory' (its waypoints span " + Number(span) + " m)",
+             "with 'mapping.resolution_m' " + Number(res) + " it gives a map of", e.map_cells,
+             "cells", budgets.max_cells, "--max-cells");
+    }
   }
   CheckMapCells(e.map_cells, budgets, scene.file);
   const double beams = scene.sweeps * scene.sensor.geometry.BeamsPerSweep();

@@ -4,6 +4,7 @@
 #include <map>
 #include <numbers>
 
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/world/random.hpp"
 
@@ -28,8 +29,7 @@ void AddHeightField(TriangleMesh& mesh, const MeshSpec& spec, std::uint64_t seed
   // CheckBudgets refuses far fewer cells; this keeps the int conversions defined.
   if (!(spec.size_m[0] / spec.height_field.cell_m < 1e7 &&
         spec.size_m[1] / spec.height_field.cell_m < 1e7)) {
-    throw InputError("mesh '" + spec.name + "': 'cell_m' " +
-                     std::to_string(spec.height_field.cell_m) +
+    throw InputError("mesh '" + spec.name + "': 'cell_m' " + io::Number(spec.height_field.cell_m) +
                      " makes over 1e7 cells a side (expected a coarser grid)");
   }
   const int nx =
@@ -112,8 +112,8 @@ MeshCheck CheckMesh(TriangleMesh& mesh, const std::string& where) {
     const Eigen::Vector3f& v = mesh.vertices[i];
     if (!v.allFinite()) {
       throw InputError(where + ": vertex " + std::to_string(i) + " is not finite (" +
-                       std::to_string(v.x()) + ", " + std::to_string(v.y()) + ", " +
-                       std::to_string(v.z()) + "); the truth cannot be computed from it");
+                       io::Number(v.x()) + ", " + io::Number(v.y()) + ", " + io::Number(v.z()) +
+                       "); the truth cannot be computed from it");
     }
   }
   // Zero-area triangles have no surface: no echo, no truth cell. They are dropped and counted.

@@ -55,6 +55,12 @@ PlyType PlyTypeNamed(const std::string& name) {
   return found == kTypes.end() ? PlyType{} : found->second;
 }
 
+// A polygon past kMaxPolygonCorners, for a refusal.
+std::string TooManyCorners(double corners) {
+  return ": a face of " + Number(corners) + " corners, expected at most " +
+         Number(kMaxPolygonCorners) + " (Assimp triangulates a polygon in quadratic time)";
+}
+
 // One property of a PLY element: a scalar, or a list (a count, then that many items).
 struct PlyProperty {
   std::string name;
@@ -299,6 +305,7 @@ void CheckPly(const std::string& path, const std::string& bytes) {
         const bool indices =
             element.name == "face" && (p.name == "vertex_indices" || p.name == "vertex_index");
         if (indices && count == 0.0) throw fail(where() + ": a face of no vertices");
+        if (indices && count > kMaxPolygonCorners) throw fail(where() + TooManyCorners(count));
         for (double k = 0; k < count; ++k) {
           const double index = next(p.item);
           if (indices && (index < 0.0 || index >= static_cast<double>(vertices) ||
@@ -491,7 +498,8 @@ std::string Lowercase(std::string text) {
 // The triangles a mesh file holds, counted from its text without building them: an OBJ's faces
 // (n corners make n - 2), an STL's facets, a PLY's faces, a COLLADA file's primitives' counts.
 // Assimp makes at least this many (a polygon of n corners as n - 2).
-double CountTriangles(const std::string& bytes, const std::string& extension) {
+double CountTriangles(const std::string& path, const std::string& bytes,
+                      const std::string& extension) {
   const std::string lower = Lowercase(bytes.substr(0, 4096));
   double triangles = 0.0;
   if (extension == ".ply" || lower.starts_with("ply")) {
@@ -530,6 +538,7 @@ double CountTriangles(const std::string& bytes, const std::string& extension) {
         std::istringstream corners(bytes.substr(at + 2, end - at - 2));
         double n = 0;
         for (std::string corner; corners >> corner;) ++n;
+        if (n > kMaxPolygonCorners) throw InputError(path + ": an 'f' line" + TooManyCorners(n));
         triangles += std::max(0.0, n - 2);
       }
       at = end + 1;
@@ -556,7 +565,8 @@ MeshFileData LoadMeshFile(const std::string& path, double max_triangles) {
   } else if (extension == ".dae" || lower.find("<collada") != std::string::npos) {
     CheckCollada(path, bytes);
   }
-  if (const double triangles = CountTriangles(bytes, extension); !(triangles <= max_triangles)) {
+  if (const double triangles = CountTriangles(path, bytes, extension);
+      !(triangles <= max_triangles)) {
     char text[96];
     std::snprintf(text, sizeof text, "holds %.3g triangles, more than the %.3g", triangles,
                   max_triangles);

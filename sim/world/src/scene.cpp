@@ -16,6 +16,19 @@ using mapping::kDegToRad;
 
 Eigen::Vector3d ToVector(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
+// A waypoint's position [m]. The ray tracer works in single precision: its step is about a
+// millimetre 10 km from the origin.
+constexpr double kMaxWaypointM = 1e4;
+Eigen::Vector3d CheckedPosition(YamlReader& node, const std::array<double, 3>& position) {
+  const Eigen::Vector3d p = ToVector(position);
+  if (!(p.cwiseAbs().maxCoeff() <= kMaxWaypointM)) {
+    node.Fail("position_m",
+              "coordinates within 10000 m of the origin (the ray tracer's single "
+              "precision)");
+  }
+  return p;
+}
+
 Eigen::Isometry3d ReadPose(YamlReader& node) {
   std::array<double, 3> position{0, 0, 0};
   std::array<double, 3> rpy_deg{0, 0, 0};
@@ -99,7 +112,7 @@ Trajectory ReadTrajectory(YamlReader& node) {
     std::array<double, 3> rpy_deg{0, 0, 0};
     node.Required("position_m", position);
     node.Optional("rpy_deg", rpy_deg);
-    w.position_m = ToVector(position);
+    w.position_m = CheckedPosition(node, position);
     w.rpy_rad = ToVector(rpy_deg) * kDegToRad;
     t.waypoints.push_back(w);
   } else {
@@ -111,7 +124,7 @@ Trajectory ReadTrajectory(YamlReader& node) {
       item.Required("position_m", position);
       item.Optional("rpy_deg", rpy_deg);
       item.RejectUnknownKeys();
-      w.position_m = ToVector(position);
+      w.position_m = CheckedPosition(item, position);
       w.rpy_rad = ToVector(rpy_deg) * kDegToRad;
       if (!t.waypoints.empty() && w.time_s <= t.waypoints.back().time_s) {
         item.Fail("time_s", "a time later than the previous waypoint's");

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 // The bench's inputs and output directories: files read within a budget checked before the
@@ -21,6 +23,12 @@ void CreateOutputDirectory(const std::string& dir);
 /// folder.
 void ClaimExportFile(const std::string& path, bool force, bool ours, const std::string& kind);
 
+/// Removes what a killed writer of `path` left: "PATH.tmp.PID" files (WriteFileAtomically's) of a
+/// process no longer running whose first bytes `ours` recognises as sonarbench's. Anything else so
+/// named stays.
+void RemoveDeadTemporaries(const std::string& path,
+                           const std::function<bool(const std::string& head)>& ours);
+
 /// The most the readers take from one file, checked before they allocate (bytes).
 /// A YAML file: a scene, a sensor model, a mapping configuration (yaml-cpp takes ~100x its size).
 inline constexpr std::uint64_t kMaxYamlBytes = std::uint64_t{2} << 20;
@@ -28,6 +36,10 @@ inline constexpr std::uint64_t kMaxYamlBytes = std::uint64_t{2} << 20;
 inline constexpr std::uint64_t kMaxJsonBytes = std::uint64_t{16} << 20;
 /// A log (.mat or MCAP) by default: the file and what it decompresses to, together.
 inline constexpr std::uint64_t kMaxLogBytes = std::uint64_t{384} << 20;
+
+/// Range bins of one beam: a Micron's 399, an imaging sonar's some thousands; what the readers,
+/// the sensor model and the mapper take.
+inline constexpr std::size_t kMaxBinsPerBeam = 16384;
 
 /// Throws InputError naming `path` unless it is a regular file of at most `max_bytes` bytes: a
 /// FIFO, device, socket or directory is refused by its type, never read. Returns its size.

@@ -116,7 +116,9 @@ void WriteLabelFile(const std::string& path, std::span<const BeamLabels> beams);
                                                         const Dataset& dataset);
 
 /// Reads a label file; throws InputError naming `path` on a bad frame, magic or size, before
-/// allocating more than the frame says it holds (itself refused over 1 GiB).
-[[nodiscard]] std::vector<BeamLabels> ReadLabelFile(const std::string& path);
+/// allocating more than the frame says it holds (refused over `max_bytes`, and over 1 GiB).
+[[nodiscard]] std::vector<BeamLabels> ReadLabelFile(const std::string& path,
+                                                    std::uint64_t max_bytes = std::uint64_t{1}
+                                                                              << 30);
 
 }  // namespace sonarbench::io

@@ -72,10 +72,11 @@ void LabelFileBeams(std::span<const SynthesizedBeam> beams, int threads,
                     std::vector<io::BeamLabels>& out);
 
 /// Simulates a scene into a dataset directory (io::ReadDataset's format). Every file is
-/// written atomically; a sweep is complete when its beam, truth and image files all exist, and
-/// a rerun skips complete sweeps. manifest.json is written last, once every sweep is present (by
-/// whichever shard finishes last, or by a rerun without --shard). A directory holding another
-/// configuration's dataset, or files that are not a dataset, is refused unless `force`.
+/// written atomically; a sweep is complete when the record this writer left for it lists each of
+/// its files with the sha256 the file still has, and a rerun skips complete sweeps. manifest.json
+/// is written last, once every sweep is present (by whichever shard finishes last, or by a rerun
+/// without --shard). A directory holding another configuration's dataset, or files that are not a
+/// dataset, is refused unless `force`.
 DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
                                const DatasetOptions& options);
 
@@ -93,9 +94,10 @@ struct ImportedLog {
 [[nodiscard]] ImportedLog ImportedMatLog(io::MatLog log);
 
 /// Writes a recorded log (a .mat log, static at the origin, or a ROS 2 bag) as a dataset: its
-/// beams by sweep, polar images, the sonar's poses, no truth. Same atomicity and overwrite rules.
+/// beams by sweep, polar images, the sonar's poses, no truth. Same atomicity and overwrite rules;
+/// `sensor_file` ("" for none), like the log, is an input no output may overwrite.
 DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& log,
                                 const mapping::SensorGeometry& sensor, const std::string& dir,
-                                bool force);
+                                bool force, const std::string& sensor_file = "");
 
 }  // namespace sonarbench::sim

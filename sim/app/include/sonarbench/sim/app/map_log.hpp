@@ -45,6 +45,10 @@ struct LogMapResult {
 /// dataset, a file, or a directory without one. Throws InputError when it holds several.
 [[nodiscard]] std::string MatLogInDirectory(const std::string& input);
 
+/// The files reading `input` opens (a log, the log a folder holds, or a dataset's manifest and
+/// the files of its folders): what no output may overwrite.
+[[nodiscard]] std::vector<std::string> LogInputFiles(const std::string& input);
+
 /// Reads a real `.mat` log (a file, or a folder holding just one, see MatLogInDirectory) or a
 /// dataset directory (io::ReadDataset; its own sensor geometry replaces `sensor`) and maps it
 /// sweep by sweep (BeamsPerSweep() consecutive beams each; the last sweep may be partial). A

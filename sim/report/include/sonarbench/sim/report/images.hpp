@@ -28,7 +28,8 @@ void WritePolarImage(const std::string& path, std::span<const mapping::Beam> swe
                      const std::string& title);
 
 /// Renders one sweep as a top-down Cartesian fan: the sonar at the centre, x (head angle 0,
-/// marked) to the right, y up, `pixel_m` per pixel; each pixel shows the bin at its range on the
+/// marked) to the right, y up, `pixel_m` per pixel (larger when the reach would need more than
+/// 4097 pixels a side); each pixel shows the bin at its range on the
 /// beam nearest its bearing. Framed with `title`, axes in metres, a scale bar and the colour bar.
 [[nodiscard]] cv::Mat RenderFanImage(std::span<const mapping::Beam> sweep, double pixel_m,
                                      const std::string& title);

@@ -4,6 +4,7 @@
 #include <span>
 #include <string>
 
+#include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
 namespace sonarbench::sim {
@@ -37,12 +38,18 @@ struct SceneEstimate {
 /// resolution_m), the estimate and the limit, and the option that raises it.
 void CheckBudgets(const Scene& scene, const Budgets& budgets);
 
-/// Cells a map of `resolution_m` can hold when the sonar stays within the box [lo, hi]: the box
-/// grown by the sonar's range, over the cell volume.
-[[nodiscard]] double MapCellsEstimate(const mapping::SensorGeometry& sensor, double resolution_m,
-                                      const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+/// Cells a map of `resolution_m` can hold when the sonar stays within the box [lo, hi] and its
+/// beams reach `range_m`: the box grown by that range, over the cell volume.
+[[nodiscard]] double MapCellsEstimate(const mapping::SensorGeometry& sensor, double range_m,
+                                      double resolution_m, const Eigen::Vector3d& lo,
+                                      const Eigen::Vector3d& hi);
 
 /// Throws InputError when `estimate` map cells exceed `budgets.max_cells`; `what` names the input.
 void CheckMapCells(double estimate, const Budgets& budgets, const std::string& what);
+
+/// Throws InputError (naming `what` and --max-cells) when a map of `beams` at `resolution_m` would
+/// hold more than `budgets.max_cells` cells: their poses' box grown by the longest beam's reach.
+void CheckBeamsMapCells(std::span<const mapping::Beam> beams, const mapping::SensorGeometry& sensor,
+                        double resolution_m, const Budgets& budgets, const std::string& what);
 
 }  // namespace sonarbench::sim

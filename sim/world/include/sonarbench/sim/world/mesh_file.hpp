@@ -25,5 +25,7 @@ struct MeshFileData {
 
 /// The largest mesh file read (bytes).
 inline constexpr std::uint64_t kMaxMeshFileBytes = std::uint64_t{1} << 30;
+/// Corners of one polygon (OBJ and PLY faces): Assimp triangulates one in quadratic time.
+inline constexpr double kMaxPolygonCorners = 1024;
 
 }  // namespace sonarbench::sim
