@@ -193,8 +193,8 @@ std::string Decompress(const std::string& path, std::uint64_t max_bytes) {
     throw InputError(path + ": not a label file (expected one zstd frame that states its size)");
   }
   if (size > max_bytes) {
-    throw InputError(path + ": its frame states " + std::to_string(size) +
-                     " bytes uncompressed; expected at most " + std::to_string(max_bytes) +
+    throw InputError(path + ": its frame states " + ByteCount(size) +
+                     " uncompressed; expected at most " + ByteCount(max_bytes) +
                      " for the beams it labels");
   }
   std::string raw(static_cast<std::size_t>(size), '\0');
