@@ -262,8 +262,17 @@ def labels():
     write(CORPUS / "labels" / "two_beams.bin", frame.stdout)
 
 
+def mapper():
+    """Seeds for the mapper's harness: the bins first, then what FuzzedDataProvider draws from
+    the end (resolution, detection, threshold, the beam count, each beam's geometry)."""
+    bins = bytes(min(255, 40 + 200 * (k % 97 == 60)) for k in range(399))
+    for name, tail in (("zeros", bytes(96)), ("ones", b"\x01" * 96), ("ramp", bytes(range(96)))):
+        write(CORPUS / "mapper" / name, bins + tail)
+
+
 if __name__ == "__main__":
     scenes()
+    mapper()
     meshes()
     octrees()
     bags()

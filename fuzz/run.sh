@@ -13,7 +13,7 @@ seconds="$2"
 runs="${3:--1}"
 shift $(($# < 3 ? $# : 3))
 names=("$@")
-if [ ${#names[@]} -eq 0 ]; then names=(scene sensor_model criteria mat_log mesh dataset octomap rosbag labels); fi
+if [ ${#names[@]} -eq 0 ]; then names=(scene sensor_model criteria mat_log mesh dataset octomap rosbag labels mapper); fi
 
 run_one() {
   local name="$1" out="$build/fuzz-out/$1"

@@ -7,8 +7,9 @@ For `run`, `simulate`, `import` and `sweep`, each trial starts the command (into
 directory, or over a complete output of another seed; `import --force` over a simulated
 dataset), kills it with SIGKILL at a random moment,
 then checks that the record a reader trusts (report.json, manifest.json, study.json) is either
-absent or whole: every file it names has the sha256 it states. A rerun must then finish (resuming
-or replacing) with the bytes of an uninterrupted run. Then: two `simulate` runs of different seeds
+absent or whole: every file it names has the sha256 it states. For `simulate` and `import`, every
+trial that resumes then truncates one of the sweeps' files the kill left. A rerun must then finish
+(resuming or replacing) with the bytes of an uninterrupted run. Then: two `simulate` runs of different seeds
 started at once into one directory (one configuration wins; the other exits 2 naming it), and,
 where this machine lets us mount a tmpfs, a full disk and a read-only one (exit 2 with the OS's
 reason, nothing trusted left behind; a rerun that fills the disk leaves the last result whole). Exits 1 on the first broken promise, 0 otherwise.
@@ -115,12 +116,30 @@ def kill_trials(sonarbench, kind, scene, work, trials, rng):
         process.kill()
         process.wait()
         verify_record(kind, out)  # raises if a trusted record covers torn files
+        damaged = damage_a_sweep(kind, out, rng) if not over_old else None
         code, text = run(command(sonarbench, kind, scene, out, 1, force=over_old))
         check(code in (0, 1), f"{kind} trial {trial}: the rerun failed ({code}): {text}")
         check(fingerprint(kind, out) == expected,
-              f"{kind} trial {trial}: the rerun's output differs from an uninterrupted run's")
-    print(f"{kind}: {trials} kills at random points (a full run takes {full:.1f} s): "
+              f"{kind} trial {trial}: the rerun's output differs from an uninterrupted run's"
+              + (f" (after {damaged} was truncated)" if damaged else ""))
+    damage = (", a sweep's file truncated after each resumed kill"
+              if kind in ("simulate", "import") else "")
+    print(f"{kind}: {trials} kills at random points (a full run takes {full:.1f} s){damage}: "
           "every trusted record whole, every rerun identical to an uninterrupted run")
+
+
+def damage_a_sweep(kind, out, rng):
+    """A dataset's resume must not keep a file it cannot vouch for: one of the sweeps' files the
+    killed run left, truncated to 10 bytes (its name, or None when there is none)."""
+    if kind not in ("simulate", "import"):
+        return None
+    files = sorted(p for folder in ("beams", "images") for p in (out / folder).glob("*")
+                   if p.is_file() and ".tmp." not in p.name)
+    if not files:
+        return None
+    victim = rng.choice(files)
+    os.truncate(victim, 10)
+    return victim.relative_to(out)
 
 
 def concurrent_writers(sonarbench, scene, work, trials):

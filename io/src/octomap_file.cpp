@@ -223,7 +223,7 @@ OcTreeFileInfo CheckFile(const std::string& path, double max_cells, std::streamo
   if (!header.res || !header.size) reader.Fail("the header has no 'res' or no 'size' line");
   info.resolution_m = *header.res;
   if (!std::isfinite(info.resolution_m) || info.resolution_m <= 0.0) {
-    reader.Fail("'res' is " + std::to_string(info.resolution_m) + "; expected metres > 0");
+    reader.Fail("'res' is " + Number(info.resolution_m) + "; expected metres > 0");
   }
   data_offset = in.tellg();
   NodeWalk walk(reader, info.format == "ot", max_cells);

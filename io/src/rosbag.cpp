@@ -25,7 +25,7 @@ constexpr double kWidthTolerance = 1e-4;
 
 std::uint64_t Nanoseconds(double time_s) {
   if (!(time_s >= 0.0) || time_s > 2e9) {
-    throw InputError("beam time " + std::to_string(time_s) + " s: a ROS stamp needs 0..2e9 s");
+    throw InputError("beam time " + Number(time_s) + " s: a ROS stamp needs 0..2e9 s");
   }
   return static_cast<std::uint64_t>(std::llround(time_s * 1e9));
 }

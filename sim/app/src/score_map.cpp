@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "sonarbench/io/files.hpp"
+#include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/report/map_report.hpp"
 #include "sonarbench/sim/report/report.hpp"
@@ -47,10 +48,10 @@ void CheckTruthBudget(const std::string& map_file, double resolution_m, const Sc
   at_map.mapping.resolution_m = resolution_m;
   const double cells = EstimateScene(at_map).truth_cells;
   if (!(cells <= budgets.max_cells)) {
-    throw InputError(map_file + ": at the map's resolution " + std::to_string(resolution_m) +
-                     " m the ground truth of " + scene.file + " takes about " +
-                     std::to_string(cells) + " cells, over the limit of " +
-                     std::to_string(budgets.max_cells) + " (--max-cells raises it)");
+    throw InputError(map_file + ": at the map's resolution " + io::Number(resolution_m) +
+                     " m the ground truth of " + scene.file + " takes about " + io::Number(cells) +
+                     " cells, over the limit of " + io::Number(budgets.max_cells) +
+                     " (--max-cells raises it)");
   }
 }
 
@@ -61,8 +62,8 @@ void CheckKeyRange(const std::string& map_file, double resolution_m, const Scene
   for (const TriangleMesh& mesh : meshes) {
     for (const Eigen::Vector3f& v : mesh.vertices) {
       if (v.cast<double>().cwiseAbs().maxCoeff() < reach) continue;
-      throw InputError(map_file + ": a map of resolution " + std::to_string(resolution_m) +
-                       " m addresses only ±" + std::to_string(reach) + " m; mesh '" + mesh.name +
+      throw InputError(map_file + ": a map of resolution " + io::Number(resolution_m) +
+                       " m addresses only ±" + io::Number(reach) + " m; mesh '" + mesh.name +
                        "' of " + scene.file + " reaches " + Metres(v.cast<double>()));
     }
   }

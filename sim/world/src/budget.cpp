@@ -148,12 +148,22 @@ void CheckBeamsMapCells(std::span<const mapping::Beam> beams, const mapping::Sen
   Eigen::Vector3d lo = Eigen::Vector3d::Zero();
   Eigen::Vector3d hi = Eigen::Vector3d::Zero();
   double reach_m = sensor.MaxRangeM();
+  // OctoMap's keys address 2^15 cells each way from the origin.
+  const double half_range_m = 32768.0 * resolution_m;
   for (std::size_t b = 0; b < beams.size(); ++b) {
     const Eigen::Vector3d p = beams[b].T_world_sonar.translation();
     lo = b == 0 ? p : lo.cwiseMin(p);
     hi = b == 0 ? p : hi.cwiseMax(p);
-    reach_m =
-        std::max(reach_m, beams[b].bin_size_m * static_cast<double>(beams[b].intensities.size()));
+    const double beam_reach_m =
+        beams[b].bin_size_m * static_cast<double>(beams[b].intensities.size());
+    reach_m = std::max(reach_m, beam_reach_m);
+    if (!(p.cwiseAbs().maxCoeff() + beam_reach_m < half_range_m)) {
+      throw InputError(what + ": beam " + std::to_string(b) + " at (" + Number(p.x()) + ", " +
+                       Number(p.y()) + ", " + Number(p.z()) + ") m reaching " +
+                       Number(beam_reach_m) + " m leaves the +-" + Number(half_range_m) +
+                       " m a map at 'mapping.resolution_m' " + Number(resolution_m) +
+                       " addresses (OctoMap's 16-bit keys)");
+    }
   }
   const double estimate = MapCellsEstimate(sensor, reach_m, resolution_m, lo, hi);
   if (!(estimate <= budgets.max_cells)) {
