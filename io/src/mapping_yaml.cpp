@@ -19,6 +19,10 @@ const char* DetectionMethodName(DetectionConfig::Method method) {
       return "canny";
     case DetectionConfig::Method::kAutoCanny:
       return "auto_canny";
+    case DetectionConfig::Method::kCaCfar:
+      return "ca_cfar";
+    case DetectionConfig::Method::kOsCfar:
+      return "os_cfar";
   }
   return "?";
 }
@@ -58,10 +62,13 @@ MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
   if (auto detection = node.OptionalChild("detection")) {
     DetectionConfig& d = c.detection;
     std::string method = DetectionMethodName(d.method);
-    detection->Optional("method", method, OneOf({"threshold", "canny", "auto_canny"}));
-    d.method = method == "threshold" ? DetectionConfig::Method::kThreshold
-               : method == "canny"   ? DetectionConfig::Method::kCanny
-                                     : DetectionConfig::Method::kAutoCanny;
+    detection->Optional("method", method,
+                        OneOf({"threshold", "canny", "auto_canny", "ca_cfar", "os_cfar"}));
+    d.method = method == "threshold"    ? DetectionConfig::Method::kThreshold
+               : method == "canny"      ? DetectionConfig::Method::kCanny
+               : method == "auto_canny" ? DetectionConfig::Method::kAutoCanny
+               : method == "ca_cfar"    ? DetectionConfig::Method::kCaCfar
+                                        : DetectionConfig::Method::kOsCfar;
     detection->Optional("threshold", d.threshold, IntInRange(1, 255));
     detection->Optional("smoothing_bins", d.smoothing_bins, IntInRange(1, 99));
     detection->Optional("min_run_bins", d.min_run_bins, IntInRange(1, 1000));
@@ -80,6 +87,14 @@ MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
     detection->Optional("canny_high", d.canny_high, InRange(0.0, 2000.0));
     detection->Optional("canny_blur_sigma", d.canny_blur_sigma, InRange(0.1, 10.0));
     detection->Optional("auto_canny_sigma", d.auto_canny_sigma, InRange(0.0, 1.0));
+    if (auto cfar = detection->OptionalChild("cfar")) {
+      cfar->Optional("guard_bins", d.cfar.guard_bins, IntInRange(0, 1000));
+      cfar->Optional("training_bins", d.cfar.training_bins, IntInRange(1, 1000));
+      cfar->Optional("false_alarm", d.cfar.false_alarm, InRange(1e-12, 0.5));
+      cfar->Optional("order", d.cfar.order, InRange(0.01, 1.0));
+      cfar->Optional("db_per_count", d.cfar.db_per_count, InRange(0.001, 1.0));
+      cfar->RejectUnknownKeys();
+    }
     detection->RejectUnknownKeys();
     if (d.smoothing_bins % 2 == 0) {
       detection->Fail("smoothing_bins", "an odd number of bins (the window is centred)");

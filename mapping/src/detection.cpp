@@ -5,7 +5,9 @@
 #include <numbers>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
+#include "cfar.hpp"
 #include "walls.hpp"
 
 namespace sonarbench::mapping {
@@ -67,6 +69,43 @@ std::vector<Echo> ThresholdEchoes(const Beam& beam, const SensorGeometry& sensor
     }
   }
   return runs;
+}
+
+// The runs of at least `min_run_bins` bins that pass, from `first` on: echoes at their first bin,
+// each with its highest intensity.
+std::vector<Echo> PassingRuns(const Beam& beam, const std::vector<bool>& passes, int first,
+                              int min_run_bins) {
+  std::vector<Echo> runs;
+  const int n = static_cast<int>(passes.size());
+  for (int k = first; k < n;) {
+    if (!passes[static_cast<std::size_t>(k)]) {
+      ++k;
+      continue;
+    }
+    int end = k;
+    double peak = 0.0;
+    for (; end < n && passes[static_cast<std::size_t>(end)]; ++end) {
+      peak = std::max<double>(peak, beam.intensities[static_cast<std::size_t>(end)]);
+    }
+    if (end - k >= min_run_bins) runs.push_back({k, peak});
+    k = end;
+  }
+  return runs;
+}
+
+// The CFAR detector's candidate echoes of one beam, nearest first: on its power, past the
+// self-reflection bins.
+std::vector<Echo> CfarEchoes(const Beam& beam, const SensorGeometry& sensor,
+                             const DetectionConfig& config, const CfarFactors& factors) {
+  const int first = std::min(sensor.FirstUsableBin(), static_cast<int>(beam.intensities.size()));
+  const std::vector<bool> passes = CfarPasses(BeamPower(beam, config.cfar), first, config, factors);
+  return PassingRuns(beam, passes, first, config.min_run_bins);
+}
+
+// Whether `method` works on one beam at a time.
+bool PerBeam(DetectionConfig::Method method) {
+  return method == DetectionConfig::Method::kThreshold ||
+         method == DetectionConfig::Method::kCaCfar || method == DetectionConfig::Method::kOsCfar;
 }
 
 // The Canny detector's candidate echoes of every beam of a batch, nearest first.
@@ -255,11 +294,16 @@ std::vector<std::vector<double>> DetectObstacles(std::span<const Beam> beams,
                                                  const DetectionConfig& config,
                                                  std::vector<bool>* heard_through_walls) {
   std::vector<std::vector<Echo>> candidates(beams.size());
-  if (config.method != DetectionConfig::Method::kThreshold) {
+  if (!PerBeam(config.method)) {
     candidates = CannyEchoes(beams, sensor, config);
   } else {
-    for (std::size_t b = 0; b < beams.size(); ++b)
-      candidates[b] = ThresholdEchoes(beams[b], sensor, config);
+    const bool cfar = config.method != DetectionConfig::Method::kThreshold;
+    const std::optional<CfarFactors> factors =
+        cfar ? std::optional<CfarFactors>(config) : std::nullopt;
+    for (std::size_t b = 0; b < beams.size(); ++b) {
+      candidates[b] = cfar ? CfarEchoes(beams[b], sensor, config, *factors)
+                           : ThresholdEchoes(beams[b], sensor, config);
+    }
   }
   return ChooseAll(std::move(candidates), beams, sensor, config, heard_through_walls);
 }

@@ -53,6 +53,13 @@ const MapperConfig& Checked(const MapperConfig& c) {
   need(d.smoothing_bins >= 1 && d.smoothing_bins % 2 == 1, "detection.smoothing_bins odd, >= 1");
   need(d.min_run_bins >= 1, "detection.min_run_bins >= 1");
   need(d.max_obstacles >= 1, "detection.max_obstacles >= 1");
+  need(d.cfar.guard_bins >= 0 && d.cfar.training_bins >= 1,
+       "detection.cfar guard_bins >= 0 and training_bins >= 1");
+  need(d.cfar.false_alarm > 0.0 && d.cfar.false_alarm < 1.0,
+       "detection.cfar.false_alarm in (0, 1)");
+  need(d.cfar.order > 0.0 && d.cfar.order <= 1.0, "detection.cfar.order in (0, 1]");
+  need(d.cfar.db_per_count > 0.0 && d.cfar.db_per_count <= 1.0,
+       "detection.cfar.db_per_count in (0, 1]");
   return c;
 }
 

@@ -359,7 +359,8 @@ std::vector<DetectorItem> DetectorStudyItems(const Detection& base) {
     d.threshold = threshold;
     add(d);
   }
-  for (const auto method : {Detection::Method::kCanny, Detection::Method::kAutoCanny}) {
+  for (const auto method : {Detection::Method::kCanny, Detection::Method::kAutoCanny,
+                            Detection::Method::kCaCfar, Detection::Method::kOsCfar}) {
     Detection d = base;
     d.method = method;
     add(d);

@@ -21,7 +21,8 @@ TEST(DetectorStudy, ItemsAreEachDetectorWithEachEchoRule) {
   Detection base;
   base.smoothing_bins = 7;
   const std::vector<DetectorItem> items = DetectorStudyItems(base);
-  ASSERT_EQ(items.size(), 21u);  // 5 thresholds, Canny, automatic Canny; 3 echo rules each
+  // 5 thresholds, Canny, automatic Canny, CA- and OS-CFAR; 3 echo rules each.
+  ASSERT_EQ(items.size(), 27u);
   std::set<std::string> names;
   for (const DetectorItem& item : items) {
     names.insert(item.name);
@@ -32,7 +33,8 @@ TEST(DetectorStudy, ItemsAreEachDetectorWithEachEchoRule) {
   EXPECT_EQ(names.size(), items.size());
   EXPECT_EQ(items[6].name, "threshold 110, first echo");
   EXPECT_EQ(items[8].detection.later_echoes, Detection::LaterEchoes::kSupported);
-  EXPECT_EQ(items.back().detection.method, Detection::Method::kAutoCanny);
+  EXPECT_EQ(items[20].detection.method, Detection::Method::kAutoCanny);
+  EXPECT_EQ(items.back().detection.method, Detection::Method::kOsCfar);
 }
 
 // A dataset simulated from the scene, given as the log, is mapped and scored as the scene itself:

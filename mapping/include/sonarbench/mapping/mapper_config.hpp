@@ -10,6 +10,25 @@ struct DetectionConfig {
     kThreshold,  ///< runs of bins over an intensity threshold (the paper's earlier work)
     kCanny,      ///< rising Canny edges on the sweep's polar image (the paper, section 4)
     kAutoCanny,  ///< Canny with thresholds from the image's median (the paper's future work)
+    kCaCfar,     ///< cell-averaging CFAR along range: a bin above its training bins' mean power
+                 ///< times the factor its false-alarm probability sets (docs/mapper.md, "CFAR")
+    kOsCfar,     ///< ordered-statistic CFAR: the same over the training bins' k-th smallest
+  };
+  /// kCaCfar, kOsCfar: the constant-false-alarm-rate detector along each beam's range bins.
+  struct Cfar {
+    /// Bins left out each side of the bin under test (the echo's own spread) [bins].
+    int guard_bins = 2;
+    /// Bins each side of the guard bins whose power estimates the background [bins].
+    int training_bins = 12;
+    /// Probability that a bin of exponentially distributed (Rayleigh-envelope) noise passes.
+    double false_alarm = 1e-3;
+    /// kOsCfar: the order statistic k as a share of the training bins (Rohling's 3/4).
+    double order = 0.75;
+    /// The intensity's scale [dB per count]: power = 10^(count · this / 10). The Micron's
+    /// converter spans 40 dB over 255 counts.
+    double db_per_count = 40.0 / 255.0;
+
+    bool operator==(const Cfar&) const = default;
   };
   Method method = Method::kThreshold;
   /// kThreshold: intensity [0-255] at or above which a bin belongs to an obstacle. 70 sits above
@@ -18,7 +37,8 @@ struct DetectionConfig {
   int threshold = 70;
   /// kThreshold: width of the moving average applied along range first [bins, odd].
   int smoothing_bins = 3;
-  /// kThreshold: a run of bins at or above the threshold must be this long to count [bins].
+  /// kThreshold, kCaCfar, kOsCfar: a run of bins at or above the threshold must be this long to
+  /// count [bins].
   int min_run_bins = 2;
   /// Obstacles reported per beam: 1 is the paper's "first obstacle"; more add the strongest of
   /// the later echoes (by peak intensity). 2 maps a wall behind a weaker object or the floor.
@@ -46,6 +66,7 @@ struct DetectionConfig {
   double canny_blur_sigma = 1.4;
   /// kAutoCanny: thresholds are (1 ∓ sigma) · median of the blurred image's usable bins.
   double auto_canny_sigma = 0.33;
+  Cfar cfar;
 
   bool operator==(const DetectionConfig&) const = default;
 };
