@@ -14,11 +14,26 @@
 namespace sonarbench::app {
 
 std::string MetricsLine(const sonarbench::sim::MapMetrics& m) {
+  // A share of `total` cells and the count behind it (the shares are ratios of these counts).
+  auto share = [](double value, std::size_t total) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.3f (%.0f/%zu)", value,
+                  std::round(value * static_cast<double>(total)), total);
+    return std::string(text);
+  };
+  char f1[16];
+  std::snprintf(f1, sizeof f1, "%.3f", m.f1_within[1]);
   std::ostringstream line;
-  line << "occupied precision " << m.occupied_precision << " (" << m.true_positive_cells << "/"
-       << m.occupied_cells << "), recall " << m.occupied_recall << " (" << m.observed_occupied_cells
-       << "/" << m.observable_cells << "), coverage " << m.coverage << " ("
-       << m.known_observable_cells << "/" << m.observable_cells << ")";
+  line << "within a cell: precision " << share(m.precision_within[1], m.occupied_cells)
+       << ", recall " << share(m.recall_within[1], m.observable_cells) << ", F1 " << f1
+       << "; ghosts " << share(m.ghost_share, m.occupied_cells);
+  if (m.ghost_arc_share && m.ghost_echo_share) {
+    line << ": on echoes' arcs " << share(*m.ghost_arc_share, m.occupied_cells)
+         << ", where no surface answers " << share(*m.ghost_echo_share, m.occupied_cells);
+  }
+  line << "\n  exact cells: precision " << share(m.occupied_precision, m.occupied_cells)
+       << ", recall " << share(m.occupied_recall, m.observable_cells) << ", coverage "
+       << share(m.coverage, m.observable_cells);
   return line.str();
 }
 

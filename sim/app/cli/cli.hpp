@@ -95,7 +95,8 @@ class ProgressLine {
   std::chrono::steady_clock::time_point last_print_;
 };
 
-/// "occupied precision P (tp/occupied), recall R (..), coverage C (..)": a map's scores.
+/// A map's scores for the terminal: precision, recall and F1 within a cell, the ghosts and their
+/// split, each with its count; then the exact cells' precision, recall and coverage.
 [[nodiscard]] std::string MetricsLine(const sim::MapMetrics& m);
 /// A command line CLI11 refused, as one line: "sonarbench: error: COMMAND: what (did you mean
 /// --out?; sonarbench COMMAND --help)", an unknown option matched to the nearest the command has.

@@ -72,7 +72,8 @@ TEST(Cli, MapScoresALogAgainstASceneAsRunScoresItsSimulation) {
              &output),
       0)
       << output;
-  EXPECT_NE(output.find("against " + scene.string() + ": occupied precision"), std::string::npos)
+  EXPECT_NE(output.find("against " + scene.string() + ": within a cell: precision"),
+            std::string::npos)
       << output;
   const auto scored = nlohmann::json::parse(ReadFile(map / "report.json"))["metrics"];
   // The same figures, but the split by the labels, which only the run that made them has.
