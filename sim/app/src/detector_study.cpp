@@ -35,29 +35,56 @@ std::string EchoRule(const Detection& d) {
   return std::to_string(d.max_obstacles) + " echoes, " + io::LaterEchoesName(d.later_echoes);
 }
 
-// Beams to map, each sweep's (of those kept) integrated as one batch.
+// Beams to map by sweep, each sweep detected whole (the walls fitted on all its first echoes) and
+// its beams within the head angles studied integrated as one batch.
 struct Batches {
   std::vector<mapping::Beam> beams;
   std::vector<std::size_t> sizes;
+  std::vector<bool> scored;  // a beam's: within the head angles studied
 };
 
-// The beams of `beams` that `heads` keeps (all without it), batched by the sweeps of
-// `per_sweep` consecutive beams they come from; `keep` is called with each kept beam's index.
+// `beams` batched by the sweeps of `per_sweep` consecutive beams, each marked scored when
+// `heads` keeps it (all without it); `keep` is called with each scored beam's index.
 Batches SelectBeams(std::span<const mapping::Beam> beams, std::size_t per_sweep,
                     const std::optional<std::pair<double, double>>& heads,
                     const std::function<void(std::size_t)>& keep = {}) {
   Batches out;
+  out.beams.assign(beams.begin(), beams.end());
   for (std::size_t first = 0; first < beams.size(); first += per_sweep) {
-    std::size_t kept = 0;
-    for (std::size_t b = first; b < std::min(first + per_sweep, beams.size()); ++b) {
-      if (heads && !InHeads(beams[b].head_angle_rad, *heads)) continue;
-      out.beams.push_back(beams[b]);
-      if (keep) keep(b);
-      ++kept;
-    }
-    if (kept > 0) out.sizes.push_back(kept);
+    out.sizes.push_back(std::min(per_sweep, beams.size() - first));
+  }
+  for (std::size_t b = 0; b < beams.size(); ++b) {
+    out.scored.push_back(!heads || InHeads(beams[b].head_angle_rad, *heads));
+    if (out.scored.back() && keep) keep(b);
   }
   return out;
+}
+
+// Calls `use` with each sweep's scored beams and their echoes, detected on the whole sweep; a
+// beam heard only through a wall is left out, as the mapper leaves it (Mapper::Integrate).
+void ForEachScoredSweep(const Batches& batches, const mapping::SensorGeometry& sensor,
+                        const Detection& detection,
+                        const std::function<void(std::span<const mapping::Beam>,
+                                                 std::span<const std::vector<double>>,
+                                                 std::span<const std::size_t>)>& use) {
+  const std::span<const mapping::Beam> all(batches.beams);
+  std::size_t first = 0;
+  for (const std::size_t size : batches.sizes) {
+    std::vector<bool> through;
+    std::vector<std::vector<double>> echoes =
+        mapping::DetectObstacles(all.subspan(first, size), sensor, detection, &through);
+    std::vector<mapping::Beam> beams;
+    std::vector<std::vector<double>> kept;
+    std::vector<std::size_t> index;
+    for (std::size_t b = 0; b < size; ++b) {
+      if (!batches.scored[first + b] || through[b]) continue;
+      beams.push_back(all[first + b]);
+      kept.push_back(std::move(echoes[b]));
+      index.push_back(first + b);
+    }
+    if (!beams.empty()) use(beams, kept, index);
+    first += size;
+  }
 }
 
 // A map of `batches` with `detection`, scored against the truth and what a perfect sensor sees.
@@ -68,12 +95,8 @@ MapMetrics MapAndScore(const mapping::MapperConfig& base, const Detection& detec
   mapping::MapperConfig config = base;
   config.detection = detection;
   mapping::Mapper mapper(config, sensor);
-  const std::span<const mapping::Beam> all(batches.beams);
-  std::size_t first = 0;
-  for (const std::size_t size : batches.sizes) {
-    (void)mapper.Integrate(all.subspan(first, size));
-    first += size;
-  }
+  ForEachScoredSweep(batches, sensor, detection,
+                     [&](auto beams, auto echoes, auto) { (void)mapper.Integrate(beams, echoes); });
   return ScoreMap(mapper.tree(), truth, observable, {}, {}, &direct);
 }
 
@@ -90,25 +113,21 @@ std::size_t PathOfEcho(const std::vector<std::uint8_t>& paths, std::size_t bin) 
   return path;
 }
 
-// The echoes `detection` finds in `batches` (the simulated scene's, `kept` their beams' indices
-// in `bin_paths`) by the path they came by (PathOfEcho).
+// The echoes `detection` finds in `batches`' scored beams (the simulated scene's, one entry of
+// `bin_paths` a beam) by the path they came by (PathOfEcho).
 EchoPathCounts CountEchoPaths(const Detection& detection, const mapping::SensorGeometry& sensor,
-                              const Batches& batches, const std::vector<std::size_t>& kept,
+                              const Batches& batches,
                               const std::vector<std::vector<std::uint8_t>>& bin_paths) {
   EchoPathCounts counts;
-  const std::span<const mapping::Beam> all(batches.beams);
-  std::size_t first = 0;
-  for (const std::size_t size : batches.sizes) {
-    const auto echoes = mapping::DetectObstacles(all.subspan(first, size), sensor, detection);
-    for (std::size_t b = 0; b < size; ++b) {
-      const std::vector<std::uint8_t>& paths = bin_paths[kept[first + b]];
+  ForEachScoredSweep(batches, sensor, detection, [&](auto, auto echoes, auto index) {
+    for (std::size_t b = 0; b < echoes.size(); ++b) {
+      const std::vector<std::uint8_t>& paths = bin_paths[index[b]];
       for (std::size_t e = 0; e < echoes[b].size(); ++e) {
         const auto bin = static_cast<std::size_t>(echoes[b][e] / sensor.bin_size_m);
         if (bin < paths.size()) ++(e == 0 ? counts.first : counts.later)[PathOfEcho(paths, bin)];
       }
     }
-    first += size;
-  }
+  });
   return counts;
 }
 
@@ -391,10 +410,9 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
   const RayTracer tracer(meshes);
   const SimulatedScene simulated = SimulateForScoring(
       scene, meshes, tracer, options.seed.value_or(scene.seed), options.threads, options.heads_deg);
-  std::vector<std::size_t> sim_kept;
   const Batches sim_beams =
       SelectBeams(simulated.beams, static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep()),
-                  options.heads_deg, [&](std::size_t b) { sim_kept.push_back(b); });
+                  options.heads_deg);
 
   std::vector<DetectorRow> rows;
   for (const DetectorItem& item : items) {
@@ -402,7 +420,7 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
                     MapAndScore(base, item.detection, scene.sensor.geometry, sim_beams,
                                 simulated.truth, simulated.observable, simulated.direct),
                     std::nullopt,
-                    CountEchoPaths(item.detection, scene.sensor.geometry, sim_beams, sim_kept,
+                    CountEchoPaths(item.detection, scene.sensor.geometry, sim_beams,
                                    simulated.bin_paths)};
     if (log) {
       row.log = MapAndScore(base, item.detection, log->sensor, log_beams, log_score->truth,
