@@ -428,15 +428,21 @@ def main():
     args = parser.parse_args()
     if args.probe:
         return probe(args.sonarbench, args.sanitized, args.args)
+    cases = [import_over_simulate, linked_locks, special_files, memory_bombs,
+             failed_rerun_keeps_the_last_result]
+    if not args.sanitized:
+        cases.append(corpus)
+    return run_groups("hostile", cases, args)
+
+
+def run_groups(name, cases, args):
+    """Runs each group of cases in a work folder (--keep's, or a temporary one): exit 1 when any
+    found a broken promise, each named on stderr."""
     sb = Runner(args.sonarbench, args.sanitized)
-    work = Path(args.keep or tempfile.mkdtemp(prefix="sonarbench-hostile-"))
+    work = Path(args.keep or tempfile.mkdtemp(prefix=f"sonarbench-{name.replace(' ', '-')}-"))
     work.mkdir(parents=True, exist_ok=True)
     broken = 0
     try:
-        cases = [import_over_simulate, linked_locks, special_files, memory_bombs,
-                 failed_rerun_keeps_the_last_result]
-        if not sb.sanitized:
-            cases.append(corpus)
         for case in cases:
             try:
                 case(sb, work)
@@ -448,7 +454,7 @@ def main():
             shutil.rmtree(work, ignore_errors=True)
     if broken:
         return 1
-    print("hostile: every check held")
+    print(f"{name}: every check held")
     return 0
 
 

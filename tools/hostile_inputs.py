@@ -22,11 +22,10 @@ import shutil
 import struct
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from hostile import LOG, REPO, TANK, Broken, Runner, check, measured, refused  # noqa: E402
+from hostile import LOG, REPO, TANK, check, measured, refused, run_groups  # noqa: E402
 
 SEABED = REPO / "scenes/seabed.yaml"
 SENSOR = REPO / "sensor-models/shad-micron.yaml"
@@ -331,26 +330,9 @@ def main():
     parser.add_argument("sonarbench")
     parser.add_argument("--sanitized", action="store_true")
     parser.add_argument("--keep", help="work in this directory and keep it")
-    args = parser.parse_args()
-    sb = Runner(args.sonarbench, args.sanitized)
-    work = Path(args.keep or tempfile.mkdtemp(prefix="sonarbench-hostile-inputs-"))
-    work.mkdir(parents=True, exist_ok=True)
-    broken = 0
-    try:
-        for case in (inputs_under_outputs, resumes_by_hash, hostile_sizes, names_and_options,
-                     killed_exports):
-            try:
-                case(sb, work)
-            except Broken as why:
-                print(f"BROKEN: {case.__name__}: {why}", file=sys.stderr)
-                broken += 1
-    finally:
-        if not args.keep:
-            shutil.rmtree(work, ignore_errors=True)
-    if broken:
-        return 1
-    print("hostile inputs: every check held")
-    return 0
+    return run_groups("hostile inputs", [inputs_under_outputs, resumes_by_hash, hostile_sizes,
+                                         names_and_options, killed_exports],
+                      parser.parse_args())
 
 
 if __name__ == "__main__":

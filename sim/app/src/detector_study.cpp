@@ -62,11 +62,10 @@ Batches SelectBeams(std::span<const mapping::Beam> beams, std::size_t per_sweep,
 
 // Calls `use` with each sweep's scored beams and their echoes, detected on the whole sweep; a
 // beam heard only through a wall is left out, as the mapper leaves it (Mapper::Integrate).
-void ForEachScoredSweep(const Batches& batches, const mapping::SensorGeometry& sensor,
-                        const Detection& detection,
-                        const std::function<void(std::span<const mapping::Beam>,
-                                                 std::span<const std::vector<double>>,
-                                                 std::span<const std::size_t>)>& use) {
+void ForEachScoredSweep(
+    const Batches& batches, const mapping::SensorGeometry& sensor, const Detection& detection,
+    const std::function<void(std::span<const mapping::Beam>, std::span<const std::vector<double>>,
+                             std::span<const std::size_t>)>& use) {
   const std::span<const mapping::Beam> all(batches.beams);
   std::size_t first = 0;
   for (const std::size_t size : batches.sizes) {
@@ -416,12 +415,12 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
 
   std::vector<DetectorRow> rows;
   for (const DetectorItem& item : items) {
-    DetectorRow row{item,
-                    MapAndScore(base, item.detection, scene.sensor.geometry, sim_beams,
-                                simulated.truth, simulated.observable, simulated.direct),
-                    std::nullopt,
-                    CountEchoPaths(item.detection, scene.sensor.geometry, sim_beams,
-                                   simulated.bin_paths)};
+    DetectorRow row{
+        item,
+        MapAndScore(base, item.detection, scene.sensor.geometry, sim_beams, simulated.truth,
+                    simulated.observable, simulated.direct),
+        std::nullopt,
+        CountEchoPaths(item.detection, scene.sensor.geometry, sim_beams, simulated.bin_paths)};
     if (log) {
       row.log = MapAndScore(base, item.detection, log->sensor, log_beams, log_score->truth,
                             log_score->observable, log_score->direct);
