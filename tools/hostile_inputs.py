@@ -212,7 +212,8 @@ def hostile_sizes(sb, work):
     mat_log(work / "step.mat", usual[:100] + [(1.0, (1, 399))] + usual[101:])
     add("a .mat beam 1 m a bin", ("map", work / "step.mat", "--out", work / "s1"), "--max-cells")
     mat_log(work / "far.mat", usual[:100] + [(1e30, (1, 399))] + usual[101:])
-    add("a .mat beam 1e30 m a bin", ("map", work / "far.mat", "--out", work / "s2"), "--max-cells")
+    add("a .mat beam 1e30 m a bin", ("map", work / "far.mat", "--out", work / "s2"),
+        "OctoMap's 16-bit keys")
     mat_log(work / "tenth.mat", [(0.1, (1, 399))] * 200)
     add("every bin 0.1 m", ("map", work / "tenth.mat", "--out", work / "s3"), "--max-cells")
     mat_log(work / "long.mat", usual[:5] + [(0.01, (1, 400_000))])
