@@ -31,6 +31,9 @@ CfarFactors::CfarFactors(const DetectionConfig& config) {
   const DetectionConfig::Cfar& cfar = config.cfar;
   const bool ordered = config.method == DetectionConfig::Method::kOsCfar;
   const int most = 2 * cfar.training_bins;
+  for (std::size_t c = 0; c < power_.size(); ++c) {
+    power_[c] = std::pow(10.0, static_cast<double>(c) * cfar.db_per_count / 10.0);
+  }
   factor_.assign(static_cast<std::size_t>(most) + 1, 0.0);
   order_.assign(static_cast<std::size_t>(most) + 1, 0);
   for (int count = 2; count <= most; ++count) {
@@ -75,12 +78,9 @@ std::vector<bool> CfarPasses(std::span<const double> power, int first,
   return passes;
 }
 
-std::vector<double> BeamPower(const Beam& beam, const DetectionConfig::Cfar& cfar) {
-  // One power per count: a table of 256.
-  double table[256];
-  for (int c = 0; c < 256; ++c) table[c] = std::pow(10.0, c * cfar.db_per_count / 10.0);
+std::vector<double> BeamPower(const Beam& beam, const CfarFactors& factors) {
   std::vector<double> power(beam.intensities.size());
-  for (std::size_t k = 0; k < power.size(); ++k) power[k] = table[beam.intensities[k]];
+  for (std::size_t k = 0; k < power.size(); ++k) power[k] = factors.power(beam.intensities[k]);
   return power;
 }
 

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -24,10 +26,13 @@ class CfarFactors {
   [[nodiscard]] double factor(int count) const { return factor_[static_cast<std::size_t>(count)]; }
   /// OS-CFAR's k over `count` training bins: ceil(order · count), at least 1.
   [[nodiscard]] int order(int count) const { return order_[static_cast<std::size_t>(count)]; }
+  /// The linear power of an 8-bit intensity: 10^(count · db_per_count / 10).
+  [[nodiscard]] double power(std::uint8_t count) const { return power_[count]; }
 
  private:
   std::vector<double> factor_;
   std::vector<int> order_;
+  std::array<double, 256> power_{};
 };
 
 /// Which bins of `power` (linear, from bin `first` on; those before are never training bins nor
@@ -38,7 +43,7 @@ class CfarFactors {
                                            const DetectionConfig& config,
                                            const CfarFactors& factors);
 
-/// A beam's 8-bit intensities as linear power (10^(count · db_per_count / 10)).
-[[nodiscard]] std::vector<double> BeamPower(const Beam& beam, const DetectionConfig::Cfar& cfar);
+/// A beam's 8-bit intensities as linear power (CfarFactors::power).
+[[nodiscard]] std::vector<double> BeamPower(const Beam& beam, const CfarFactors& factors);
 
 }  // namespace sonarbench::mapping

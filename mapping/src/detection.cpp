@@ -98,7 +98,7 @@ std::vector<Echo> PassingRuns(const Beam& beam, const std::vector<bool>& passes,
 std::vector<Echo> CfarEchoes(const Beam& beam, const SensorGeometry& sensor,
                              const DetectionConfig& config, const CfarFactors& factors) {
   const int first = std::min(sensor.FirstUsableBin(), static_cast<int>(beam.intensities.size()));
-  const std::vector<bool> passes = CfarPasses(BeamPower(beam, config.cfar), first, config, factors);
+  const std::vector<bool> passes = CfarPasses(BeamPower(beam, factors), first, config, factors);
   return PassingRuns(beam, passes, first, config.min_run_bins);
 }
 

@@ -79,6 +79,33 @@ TEST(Dataset, AManifestWithoutItsListOfFilesIsRefused) {
   EXPECT_TRUE(io::ReadDataset(dir.path().string()).beams.empty());
 }
 
+// A pose stamped at 1e300 s is named in a number a person reads, not in 300 digits.
+TEST(Dataset, APoseStampedOffItsBeamIsNamedInShortNumbers) {
+  test::TempDir dir;
+  fs::create_directories(dir.path() / "beams");
+  fs::create_directories(dir.path() / "poses");
+  Beam beam;
+  beam.bin_size_m = 0.01;
+  beam.intensities.assign(4, 9);
+  std::ostringstream beams;
+  io::WriteBeamFile(beams, std::span<const Beam>(&beam, 1));
+  const std::string beam_file = test::WriteFile(dir, "beams/sweep_0000.bin", beams.str());
+  const std::string poses = test::WriteFile(dir, "poses/sonar.tum", "1e300 0 0 0 0 0 0 1\n");
+  nlohmann::json manifest = {{"format", io::kDatasetFormat},
+                             {"schema_version", io::kDatasetSchemaVersion},
+                             {"sweeps", 1},
+                             {"sensor", io::SensorGeometryJson(mapping::SensorGeometry{})}};
+  manifest["files"] = nlohmann::json::array();
+  for (const auto& [relative, path] :
+       {std::pair{"beams/sweep_0000.bin", beam_file}, std::pair{"poses/sonar.tum", poses}}) {
+    manifest["files"].push_back(
+        {{"path", relative}, {"sha256", io::Sha256OfFile(path)}, {"bytes", fs::file_size(path)}});
+  }
+  test::WriteFile(dir, "manifest.json", manifest.dump());
+  EXPECT_EQ(test::InputErrorOf([&] { (void)io::ReadDataset(dir.path().string()); }),
+            poses + ": pose 0 is stamped 1e+300 s, its beam 0 s");
+}
+
 TEST(Tum, RoundTripsAPoseAndNamesTheBadLine) {
   test::TempDir dir;
   Eigen::Isometry3d pose = mapping::PoseFromXyzRpy({1, -2, 0.5}, {0.1, -0.2, 2.5});

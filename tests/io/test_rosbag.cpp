@@ -128,6 +128,39 @@ TEST(Rosbag, InterpolatesTransformsAndLeavesOutBeamsTheyDoNotCover) {
   EXPECT_TRUE(read.beams[0].T_world_sonar.isApprox(expected, 1e-12));
 }
 
+// Transforms that make a loop (head's parent a, a's parent head) are refused naming the bag.
+TEST(Rosbag, ATransformLoopIsRefusedNamingTheBag) {
+  const test::TempDir dir;
+  std::ostringstream out;
+  {
+    io::McapWriter w(out, "ros2", "test");
+    w.Add(io::McapSchema{1, io::ros2::kProjectedSonarImage, "ros2msg",
+                         io::ros2::Definition(io::ros2::kProjectedSonarImage)});
+    w.Add(io::McapSchema{2, io::ros2::kTfMessage, "ros2msg",
+                         io::ros2::Definition(io::ros2::kTfMessage)});
+    w.Add(io::McapChannel{1, 1, "/sonar", "cdr", {}});
+    w.Add(io::McapChannel{2, 2, "/tf_static", "cdr", {}});
+    std::vector<io::ros2::TransformStamped> links(2);
+    links[0].header.frame_id = "a";
+    links[0].child_frame_id = "head";
+    links[1].header.frame_id = "head";
+    links[1].child_frame_id = "a";
+    w.Write({2, 0, 0, 0, io::ros2::EncodeTfMessage(links)});
+    io::ros2::ProjectedSonarImage image;
+    image.header = {10, 0, "head"};
+    image.beam_directions = {{1, 0, 0}};
+    image.ranges = {static_cast<float>(0.5 * mapping::SensorGeometry{}.bin_size_m)};
+    image.beam_count = 1;
+    image.data = {7};
+    w.Write({1, 0, 0, 0, io::ros2::Encode(image)});
+    w.Finish();
+  }
+  const std::string path = test::WriteFile(dir, "loop.mcap", out.str());
+  const std::string error = test::InputErrorOf([&] { (void)io::ReadRosbag(path, {}); });
+  EXPECT_EQ(error.rfind(path + ": the transforms from ", 0), 0U) << error;
+  EXPECT_NE(error.find("form a loop"), std::string::npos) << error;
+}
+
 // One bag a case: an image message that breaks one rule of what a sonar beam is.
 TEST(Rosbag, RefusesImagesThatAreNotOneMechanicalScanningBeam) {
   const test::TempDir dir;
