@@ -83,6 +83,27 @@ TEST(Rosbag, ABinSizeTheRangesCarryAsFloat32ReadsBackExactly) {
   EXPECT_EQ(read.beams[0].bin_size_m, bag.beams[0].bin_size_m);
 }
 
+// The sonar's channel (1, schema 1) and a transforms' channel (2, schema 2) on `tf_topic`.
+void AddSonarAndTf(io::McapWriter& w, const std::string& tf_topic) {
+  w.Add(io::McapSchema{1, io::ros2::kProjectedSonarImage, "ros2msg",
+                       io::ros2::Definition(io::ros2::kProjectedSonarImage)});
+  w.Add(io::McapSchema{2, io::ros2::kTfMessage, "ros2msg",
+                       io::ros2::Definition(io::ros2::kTfMessage)});
+  w.Add(io::McapChannel{1, 1, "/sonar", "cdr", {}});
+  w.Add(io::McapChannel{2, 2, tf_topic, "cdr", {}});
+}
+
+// A beam of one bin (intensity 7) at `sec` in frame "head", looking along its x axis.
+io::ros2::ProjectedSonarImage OneBinImage(std::int32_t sec, double bin_size_m) {
+  io::ros2::ProjectedSonarImage image;
+  image.header = {sec, 0, "head"};
+  image.beam_directions = {{1, 0, 0}};
+  image.ranges = {static_cast<float>(0.5 * bin_size_m)};
+  image.beam_count = 1;
+  image.data = {7};
+  return image;
+}
+
 // A beam between two transforms gets the interpolated pose: a third of the way in time, a third
 // of the way along the path and the turn; beams outside the transforms' span are left out and
 // counted.
@@ -92,12 +113,7 @@ TEST(Rosbag, InterpolatesTransformsAndLeavesOutBeamsTheyDoNotCover) {
   std::ostringstream out;
   {
     io::McapWriter w(out, "ros2", "test");
-    w.Add(io::McapSchema{1, io::ros2::kProjectedSonarImage, "ros2msg",
-                         io::ros2::Definition(io::ros2::kProjectedSonarImage)});
-    w.Add(io::McapSchema{2, io::ros2::kTfMessage, "ros2msg",
-                         io::ros2::Definition(io::ros2::kTfMessage)});
-    w.Add(io::McapChannel{1, 1, "/sonar", "cdr", {}});
-    w.Add(io::McapChannel{2, 2, "/tf", "cdr", {}});
+    AddSonarAndTf(w, "/tf");
     const auto tf = [&](std::int32_t sec, double x, double yaw) {
       io::ros2::TransformStamped t;
       t.header.sec = sec;
@@ -109,13 +125,7 @@ TEST(Rosbag, InterpolatesTransformsAndLeavesOutBeamsTheyDoNotCover) {
     tf(10, 1.0, 0.0);
     tf(13, 4.0, 0.6);
     for (const std::int32_t sec : {9, 11, 14}) {
-      io::ros2::ProjectedSonarImage image;
-      image.header = {sec, 0, "head"};
-      image.beam_directions = {{1, 0, 0}};
-      image.ranges = {static_cast<float>(0.5 * bag.sensor.bin_size_m)};
-      image.beam_count = 1;
-      image.data = {7};
-      w.Write({1, 0, 0, 0, io::ros2::Encode(image)});
+      w.Write({1, 0, 0, 0, io::ros2::Encode(OneBinImage(sec, bag.sensor.bin_size_m))});
     }
     w.Finish();
   }
@@ -134,25 +144,14 @@ TEST(Rosbag, ATransformLoopIsRefusedNamingTheBag) {
   std::ostringstream out;
   {
     io::McapWriter w(out, "ros2", "test");
-    w.Add(io::McapSchema{1, io::ros2::kProjectedSonarImage, "ros2msg",
-                         io::ros2::Definition(io::ros2::kProjectedSonarImage)});
-    w.Add(io::McapSchema{2, io::ros2::kTfMessage, "ros2msg",
-                         io::ros2::Definition(io::ros2::kTfMessage)});
-    w.Add(io::McapChannel{1, 1, "/sonar", "cdr", {}});
-    w.Add(io::McapChannel{2, 2, "/tf_static", "cdr", {}});
+    AddSonarAndTf(w, "/tf_static");
     std::vector<io::ros2::TransformStamped> links(2);
     links[0].header.frame_id = "a";
     links[0].child_frame_id = "head";
     links[1].header.frame_id = "head";
     links[1].child_frame_id = "a";
     w.Write({2, 0, 0, 0, io::ros2::EncodeTfMessage(links)});
-    io::ros2::ProjectedSonarImage image;
-    image.header = {10, 0, "head"};
-    image.beam_directions = {{1, 0, 0}};
-    image.ranges = {static_cast<float>(0.5 * mapping::SensorGeometry{}.bin_size_m)};
-    image.beam_count = 1;
-    image.data = {7};
-    w.Write({1, 0, 0, 0, io::ros2::Encode(image)});
+    w.Write({1, 0, 0, 0, io::ros2::Encode(OneBinImage(10, mapping::SensorGeometry{}.bin_size_m))});
     w.Finish();
   }
   const std::string path = test::WriteFile(dir, "loop.mcap", out.str());
