@@ -184,10 +184,17 @@ std::vector<std::size_t> HeadAngleOrder(std::span<const Beam> beams) {
 // Drops every echo heard more than a margin behind the walls that the batch's first echoes
 // outline (FitWalls, top-down in the world frame), along the beam's bearing. The margin is what
 // the wall's own echoes can reach past its line: the slant range of its top or foot at the beam's
-// vertical edge, d (1 / cos(β/2) - 1), plus the line's band and a bin. Marks the beams that lose
-// every echo so.
+// vertical edge, d (1 / cos(β/2 + α) - 1) for a fan tilted α from vertical, plus the line's band
+// and a bin. Only beams whose fan stands within kMaxWallFanTilt of vertical take part: top-down,
+// another's bearing and range say nothing of a vertical wall. Marks the beams that lose every echo.
 void DropEchoesBehindWalls(std::vector<std::vector<Echo>>& candidates, std::span<const Beam> beams,
                            const SensorGeometry& sensor, std::vector<bool>& heard_through) {
+  const auto tilt = [](const Beam& beam) {
+    const double up = (beam.T_world_sonar.linear() * Eigen::Vector3d::UnitZ()).z();
+    return std::acos(std::clamp(std::abs(up), 0.0, 1.0));
+  };
+  std::vector<bool> upright(beams.size());
+  for (std::size_t b = 0; b < beams.size(); ++b) upright[b] = tilt(beams[b]) <= kMaxWallFanTilt;
   auto top_down = [&](const Beam& beam) {
     const Eigen::Vector3d axis =
         beam.T_world_sonar.linear() * SonarRayDirection(beam.head_angle_rad, 0.0);
@@ -196,17 +203,19 @@ void DropEchoesBehindWalls(std::vector<std::vector<Echo>>& candidates, std::span
   };
   std::vector<FirstEcho> firsts;
   for (const std::size_t b : HeadAngleOrder(beams)) {
-    if (candidates[b].empty()) continue;
+    if (candidates[b].empty() || !upright[b]) continue;
     const auto [origin, bearing] = top_down(beams[b]);
     const double range = beams[b].BinCentreRange(static_cast<std::size_t>(candidates[b][0].bin));
     firsts.push_back({origin, origin + range * bearing});
   }
   const std::vector<WallLine> walls = FitWalls(firsts);
-  const double slant = 1.0 / std::cos(sensor.beam_width_vertical_rad / 2.0) - 1.0;
   for (std::size_t b = 0; b < beams.size(); ++b) {
+    if (!upright[b]) continue;
     const auto [origin, bearing] = top_down(beams[b]);
     const std::optional<double> wall = WallAhead(origin, bearing, walls);
     if (!wall || candidates[b].empty()) continue;
+    const double slant =
+        1.0 / std::cos(sensor.beam_width_vertical_rad / 2.0 + tilt(beams[b])) - 1.0;
     const double limit = *wall * (1.0 + slant) + kWallBand + beams[b].bin_size_m;
     std::erase_if(candidates[b], [&](const Echo& e) {
       return beams[b].BinCentreRange(static_cast<std::size_t>(e.bin)) > limit;

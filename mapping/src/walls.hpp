@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <numbers>
 #include <optional>
 #include <span>
 #include <vector>
@@ -9,6 +10,10 @@ namespace sonarbench::mapping {
 
 /// How far [m] a wall's first echoes lie from its line.
 inline constexpr double kWallBand = 0.05;
+
+/// How far [rad] a beam's fan (its 35° plane) may lean from vertical and still fit and refuse by
+/// walls: 20°, so that its edge stays within 37.5° of horizontal (docs/mapper.md).
+inline constexpr double kMaxWallFanTilt = 20.0 * std::numbers::pi / 180.0;
 
 /// A vertical wall seen from above: the line through `centre` along the unit `direction` (world
 /// x-y [m]), over [from, to] of its length from `centre` (its points' extent, widened).

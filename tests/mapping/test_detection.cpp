@@ -373,13 +373,18 @@ TEST(DetectObstacles, SupportComesFromWithinTheWindowAndTolerance) {
 // In test::RectangleWallRange's tank every beam hears its wall and, 0.6 m behind it, a mirror path;
 // the beams at 10.8° to 16.2° hear the mirror path only (the wall too weak there). Beam `inside`
 // hears a second echo `by` [m] within the wall's margin, beam `inside` + 1 the same beyond it.
-std::vector<Beam> TankSweep(const SensorGeometry& sensor, std::size_t inside, double by) {
+// With `R_world_sonar`, each beam hears the wall at the range the tank gives its axis's bearing
+// seen from above, so that its echoes, laid top-down along that bearing, outline the rectangle.
+std::vector<Beam> TankSweep(const SensorGeometry& sensor, std::size_t inside, double by,
+                            const Eigen::Matrix3d& R_world_sonar = Eigen::Matrix3d::Identity()) {
   std::vector<Beam> sweep;
   const double margin_per_m = 1.0 / std::cos(sensor.beam_width_vertical_rad / 2.0) - 1.0;
   for (int b = 0; b < sensor.BeamsPerSweep(); ++b) {
     Beam beam = MakeBeam(sensor);
     beam.head_angle_rad = b * sensor.step_angle_rad;
-    const double wall = test::RectangleWallRange(beam.head_angle_rad);
+    beam.T_world_sonar.linear() = R_world_sonar;
+    const Eigen::Vector3d axis = R_world_sonar * SonarRayDirection(beam.head_angle_rad, 0.0);
+    const double wall = test::RectangleWallRange(std::atan2(axis.y(), axis.x()));
     const auto bin = [&](double range) { return static_cast<int>(range / sensor.bin_size_m); };
     if (b < 6 || b > 9) Fill(beam, bin(wall), bin(wall) + 5, 150);
     Fill(beam, bin(wall + 0.6), bin(wall + 0.6) + 5, 200);
@@ -426,6 +431,36 @@ TEST(DetectObstacles, EchoesBehindTheWallsAreRefused) {
   }
   config.max_obstacles = 1;  // the first echo alone is refused as well
   EXPECT_TRUE(DetectObstacles(sweep, sensor, config)[8].empty());
+}
+
+// Top-down bearings and ranges outline vertical walls only when the fan stands near vertical: the
+// tank's echoes laid out along a rolled sonar's bearings are refused behind its walls at 10° of
+// roll, as upright, and not at 30° (past kMaxWallFanTilt), though they outline the same walls.
+TEST(DetectObstacles, OnlyAFanNearVerticalRefusesBehindWalls) {
+  const SensorGeometry sensor;
+  DetectionConfig config;
+  config.smoothing_bins = 1;
+  config.threshold = 100;
+  config.max_obstacles = 3;
+  config.behind_walls = DetectionConfig::BehindWalls::kRefuse;
+  for (const double roll_deg : {10.0, 30.0}) {
+    const std::vector<Beam> sweep =
+        TankSweep(sensor, 50, 0.0,
+                  Eigen::AngleAxisd(roll_deg * std::numbers::pi / 180.0, Eigen::Vector3d::UnitX())
+                      .toRotationMatrix());
+    std::vector<bool> through;
+    const auto kept = DetectObstacles(sweep, sensor, config, &through);
+    const auto refused = std::count(through.begin(), through.end(), true);
+    if (roll_deg < 20.0) {
+      EXPECT_EQ(refused, 4) << roll_deg;  // the beams at 10.8-16.2° hear only the mirror path
+      EXPECT_EQ(kept[0].size(), 1u) << roll_deg;
+    } else {  // as if kept: even the mirror paths 0.6 m behind the 1 m wall stay
+      DetectionConfig keep = config;
+      keep.behind_walls = DetectionConfig::BehindWalls::kKeep;
+      EXPECT_EQ(refused, 0) << roll_deg;
+      EXPECT_EQ(kept, DetectObstacles(sweep, sensor, keep)) << roll_deg;
+    }
+  }
 }
 
 // The mapper sets aside a beam that heard only through a wall: it neither marks the echo behind

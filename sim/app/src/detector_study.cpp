@@ -31,8 +31,11 @@ using Detection = mapping::DetectionConfig;
 
 // The echo rule of a setting, as the CSV, the plot's legend and the item's name give it.
 std::string EchoRule(const Detection& d) {
-  if (d.max_obstacles == 1) return "first echo";
-  return std::to_string(d.max_obstacles) + " echoes, " + io::LaterEchoesName(d.later_echoes);
+  const std::string walls =
+      d.behind_walls == Detection::BehindWalls::kRefuse ? ", nothing behind walls" : "";
+  if (d.max_obstacles == 1) return "first echo" + walls;
+  return std::to_string(d.max_obstacles) + " echoes, " + io::LaterEchoesName(d.later_echoes) +
+         walls;
 }
 
 // Beams to map by sweep, each sweep detected whole (the walls fitted on all its first echoes) and
@@ -167,7 +170,7 @@ const std::vector<std::string> kMetricColumns = {
 
 void WriteCsv(const std::string& path, const std::vector<DetectorRow>& rows, bool with_log) {
   std::ostringstream csv;
-  csv << "item,method,threshold,max_obstacles,later_echoes";
+  csv << "item,method,threshold,max_obstacles,later_echoes,behind_walls";
   for (const char* source : {"scene", "log"}) {
     if (std::string(source) == "log" && !with_log) continue;
     for (const std::string& c : kMetricColumns) csv << "," << source << "_" << c;
@@ -177,7 +180,8 @@ void WriteCsv(const std::string& path, const std::vector<DetectorRow>& rows, boo
     const Detection& d = rows[i].item.detection;
     csv << i << "," << io::DetectionMethodName(d.method) << ","
         << (d.method == Detection::Method::kThreshold ? std::to_string(d.threshold) : "") << ","
-        << d.max_obstacles << "," << io::LaterEchoesName(d.later_echoes);
+        << d.max_obstacles << "," << io::LaterEchoesName(d.later_echoes) << ","
+        << io::BehindWallsName(d.behind_walls);
     for (const MapMetrics* m : {&rows[i].scene, rows[i].log ? &*rows[i].log : nullptr}) {
       if (!m) continue;
       const json values = MetricsJson(*m);
@@ -189,11 +193,12 @@ void WriteCsv(const std::string& path, const std::vector<DetectorRow>& rows, boo
 }
 
 // Precision against recall at one cell of tolerance, of the scene's maps or the log's: the
-// threshold detector a series per echo rule (its thresholds' points), Canny and automatic Canny a
-// series each (a point per echo rule).
+// threshold detector a series per echo rule (its thresholds' points), each other detector a
+// series (a point per echo rule); each twice, with echoes behind walls kept and refused.
 void WritePlot(const std::string& path, const std::vector<DetectorRow>& rows, bool log) {
-  const std::vector<cv::Scalar> colours = {
-      {200, 80, 0}, {30, 30, 220}, {40, 160, 40}, {160, 40, 160}, {0, 140, 200}};
+  const std::vector<cv::Scalar> colours = {{200, 80, 0},   {30, 30, 220}, {40, 160, 40},
+                                           {160, 40, 160}, {0, 140, 200}, {120, 120, 120},
+                                           {0, 0, 0},      {90, 60, 30}};
   std::map<std::string, std::size_t> order;
   std::vector<PlotSeries> series;
   for (const DetectorRow& row : rows) {
@@ -201,7 +206,9 @@ void WritePlot(const std::string& path, const std::vector<DetectorRow>& rows, bo
     const std::string name =
         d.method == Detection::Method::kThreshold
             ? "threshold, " + EchoRule(d)
-            : std::string(io::DetectionMethodName(d.method)) + ", each echo rule";
+            : std::string(io::DetectionMethodName(d.method)) + ", each echo rule" +
+                  (d.behind_walls == Detection::BehindWalls::kRefuse ? ", nothing behind walls"
+                                                                     : "");
     auto [it, added] = order.emplace(name, series.size());
     if (added) series.push_back({name, colours[series.size() % colours.size()], {}, {}});
     const MapMetrics& m = log ? *row.log : row.scene;
@@ -371,17 +378,20 @@ std::vector<DetectorItem> DetectorStudyItems(const Detection& base) {
       items.push_back({name.str(), d});
     }
   };
-  for (int threshold = 70; threshold <= 150; threshold += 20) {
+  // Every detector and echo rule with the echoes behind walls kept, then with them refused.
+  for (const auto walls : {Detection::BehindWalls::kKeep, Detection::BehindWalls::kRefuse}) {
     Detection d = base;
-    d.method = Detection::Method::kThreshold;
-    d.threshold = threshold;
-    add(d);
-  }
-  for (const auto method : {Detection::Method::kCanny, Detection::Method::kAutoCanny,
-                            Detection::Method::kCaCfar, Detection::Method::kOsCfar}) {
-    Detection d = base;
-    d.method = method;
-    add(d);
+    d.behind_walls = walls;
+    for (int threshold = 70; threshold <= 150; threshold += 20) {
+      d.method = Detection::Method::kThreshold;
+      d.threshold = threshold;
+      add(d);
+    }
+    for (const auto method : {Detection::Method::kCanny, Detection::Method::kAutoCanny,
+                              Detection::Method::kCaCfar, Detection::Method::kOsCfar}) {
+      d.method = method;
+      add(d);
+    }
   }
   return items;
 }
@@ -446,6 +456,7 @@ void WriteDetectorStudy(const std::string& dir, const Scene& scene,
                  {"threshold", d.threshold},
                  {"max_obstacles", d.max_obstacles},
                  {"later_echoes", io::LaterEchoesName(d.later_echoes)},
+                 {"behind_walls", io::BehindWallsName(d.behind_walls)},
                  {"scene", MetricsJson(row.scene)},
                  {"scene_echo_paths",
                   {{"first", PathCountsJson(row.scene_paths.first)},

@@ -215,7 +215,8 @@ TEST(Cli, MessagesNameWhatToDoNext) {
   EXPECT_FALSE(fs::exists(imported / "truth"));  // an imported log has no truth
   const auto map = dir.path() / "map";
   ASSERT_EQ(RunCli("map " + imported.string() + " --out " + map.string(), &output), 0) << output;
-  EXPECT_NE(output.find("detection: threshold 110, the first echo a beam, arc_marking at 0.05 m "
+  EXPECT_NE(output.find("detection: threshold 110, the first echo a beam, none behind a wall, "
+                        "arc_marking at 0.05 m "
                         "(from " +
                         test::SourcePath("sensor-models/shad-micron.yaml") + ")"),
             std::string::npos)
@@ -231,7 +232,7 @@ TEST(Cli, MessagesNameWhatToDoNext) {
             0)
       << output;
   EXPECT_NE(output.find("detection: threshold 110, at most 2 echoes a beam (later echoes: "
-                        "strongest), arc_marking at 0.05 m (from " +
+                        "strongest), none behind a wall, arc_marking at 0.05 m (from " +
                         test::SourcePath("sensor-models/shad-micron.yaml") + " and " +
                         mapping.string() + ")"),
             std::string::npos)

@@ -21,8 +21,9 @@ TEST(DetectorStudy, ItemsAreEachDetectorWithEachEchoRule) {
   Detection base;
   base.smoothing_bins = 7;
   const std::vector<DetectorItem> items = DetectorStudyItems(base);
-  // 5 thresholds, Canny, automatic Canny, CA- and OS-CFAR; 3 echo rules each.
-  ASSERT_EQ(items.size(), 27u);
+  // 5 thresholds, Canny, automatic Canny, CA- and OS-CFAR; 3 echo rules each; echoes behind
+  // walls kept, then refused.
+  ASSERT_EQ(items.size(), 54u);
   std::set<std::string> names;
   for (const DetectorItem& item : items) {
     names.insert(item.name);
@@ -34,7 +35,16 @@ TEST(DetectorStudy, ItemsAreEachDetectorWithEachEchoRule) {
   EXPECT_EQ(items[6].name, "threshold 110, first echo");
   EXPECT_EQ(items[8].detection.later_echoes, Detection::LaterEchoes::kSupported);
   EXPECT_EQ(items[20].detection.method, Detection::Method::kAutoCanny);
-  EXPECT_EQ(items.back().detection.method, Detection::Method::kOsCfar);
+  EXPECT_EQ(items[26].detection.method, Detection::Method::kOsCfar);
+  for (std::size_t i = 0; i < 27; ++i) {
+    EXPECT_EQ(items[i].detection.behind_walls, Detection::BehindWalls::kKeep) << items[i].name;
+    const Detection& refused = items[i + 27].detection;
+    EXPECT_EQ(refused.behind_walls, Detection::BehindWalls::kRefuse) << items[i + 27].name;
+    Detection same = refused;
+    same.behind_walls = Detection::BehindWalls::kKeep;
+    EXPECT_EQ(same, items[i].detection) << items[i + 27].name;
+  }
+  EXPECT_EQ(items[33].name, "threshold 110, first echo, nothing behind walls");
 }
 
 // A dataset simulated from the scene, given as the log, is mapped and scored as the scene itself:

@@ -28,11 +28,10 @@ TEST(Cli, ADatasetThroughARos2BagMapsToTheSameBytes) {
   ASSERT_EQ(RunCli("import " + path("real.mcap") + " --out " + path("ds2"), &output), 0) << output;
   const std::string tank = test::SourcePath("scenes/cras-tank.yaml");
   for (const char* ds : {"ds", "ds2"}) {
-    ASSERT_EQ(
-        RunCli("map " + path(ds) + " --scene " + tank + " --score --out " + path(ds) + "-scored",
-               &output),
-        0)
-        << output;
+    // Scored: 0 or 1, as the simulated tank's criteria judge the real log.
+    const int status = RunCli(
+        "map " + path(ds) + " --scene " + tank + " --score --out " + path(ds) + "-scored", &output);
+    ASSERT_TRUE(status == 0 || status == 1) << output;
   }
   EXPECT_EQ(ReadFile(path("ds-scored/map.bt")), ReadFile(path("ds2-scored/map.bt")));
   const auto log = nlohmann::json::parse(ReadFile(path("ds2/manifest.json")))["log"];
