@@ -47,9 +47,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   mapping::MapperConfig config;
   config.threads = 1;
   config.resolution_m = in.PickValueInArray({0.02, 0.05, 0.1, 0.25});
-  config.detection.method = in.PickValueInArray(
-      {mapping::DetectionConfig::Method::kThreshold, mapping::DetectionConfig::Method::kCanny});
+  using Detection = mapping::DetectionConfig;
+  config.detection.method =
+      in.PickValueInArray({Detection::Method::kThreshold, Detection::Method::kCanny,
+                           Detection::Method::kCaCfar, Detection::Method::kOsCfar});
   config.detection.threshold = in.ConsumeIntegralInRange<int>(1, 255);
+  config.detection.behind_walls =
+      in.PickValueInArray({Detection::BehindWalls::kKeep, Detection::BehindWalls::kRefuse});
+  if (in.ConsumeBool()) {  // a water column somewhere within the poses' reach
+    config.water.floor_z_m = in.ConsumeFloatingPointInRange<double>(-20.0, 20.0);
+    config.water.surface_z_m =
+        config.water.floor_z_m + in.ConsumeFloatingPointInRange<double>(0.01, 20.0);
+  }
   const mapping::SensorGeometry sensor;
   std::vector<Beam> beams(in.ConsumeIntegralInRange<std::size_t>(1, 12));
   for (Beam& beam : beams) {

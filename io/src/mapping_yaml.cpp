@@ -4,6 +4,7 @@
 #include <string>
 
 #include "sonarbench/io/files.hpp"
+#include "sonarbench/io/text.hpp"
 
 namespace sonarbench::io {
 
@@ -115,6 +116,14 @@ MapperConfig ReadMapperConfig(YamlReader& node, MapperConfig base) {
   node.Optional("prob_miss", c.prob_miss, InRange(0.0, 0.5));
   node.Optional("clamp_min", c.clamp_min, InRange(0.0, 0.5));
   node.Optional("clamp_max", c.clamp_max, InRange(0.5, 1.0));
+  if (auto water = node.OptionalChild("water")) {
+    water->Optional("floor_z_m", c.water.floor_z_m, InRange(-1e4, 1e4));
+    water->Optional("surface_z_m", c.water.surface_z_m, InRange(-1e4, 1e4));
+    water->RejectUnknownKeys();
+    if (c.water.floor_z_m >= c.water.surface_z_m) {
+      water->Fail("floor_z_m", "a height below surface_z_m (" + Number(c.water.surface_z_m) + ")");
+    }
+  }
   node.Optional("clear_without_obstacle", c.clear_without_obstacle);
   node.Optional("free_range_m", c.free_range_m, NonNegative());
   node.Optional("threads", c.threads, IntInRange(0, 1024));

@@ -17,6 +17,7 @@
 #include "sonarbench/mapping/beam.hpp"
 #include "sonarbench/mapping/beam_cells.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
+#include "water_keys.hpp"
 
 namespace sonarbench::mapping {
 
@@ -97,12 +98,14 @@ using BeamCells = BasicBeamCells<KeySet>;
 /// out to `free_range_m` without one (0 = clear nothing): OctoMap's computeRayKeys cells for
 /// each ray, each distinct cell of the beam inserted into the set once. `directions` are from
 /// BeamRayDirections. Occupied does not yet win over free here: IntegrateBatch resolves that.
-/// With `evidence` on, the occupied cells go to `cells.occupied_shares` with their shares.
+/// With `evidence` on, the occupied cells go to `cells.occupied_shares` with their shares. No cell
+/// that `water` does not hold is occupied.
 template <typename Set>
 void CastBeam(const octomap::OcTree& tree, const Beam& beam,
               std::span<const Eigen::Vector3d> directions,
               std::span<const double> obstacle_ranges_m, double free_range_m,
-              BasicBeamCells<Set>& cells, const ArcEvidence& evidence = {}) {
+              BasicBeamCells<Set>& cells, const ArcEvidence& evidence = {},
+              const WaterKeys& water = {}) {
   const double free_end_m = obstacle_ranges_m.empty() ? free_range_m : obstacle_ranges_m.front();
   if (obstacle_ranges_m.empty() && free_end_m <= 0.0) return;
   const Eigen::Matrix3d R_world_beam =
@@ -131,6 +134,9 @@ void CastBeam(const octomap::OcTree& tree, const Beam& beam,
       }
     }
   }
+  if (!water.all()) {
+    std::erase_if(cells.fresh_occupied, [&](std::uint64_t k) { return !water.Holds(k); });
+  }
   if (evidence.on()) {
     std::sort(cells.fresh_occupied.begin(), cells.fresh_occupied.end());
     cells.fresh_occupied.erase(
@@ -158,16 +164,21 @@ void CastBeam(const octomap::OcTree& tree, const Beam& beam,
 /// Adds to `cells` the keys of one beam under the exact semantics (ExactBeamCells): every cell
 /// of the wedge examined once, free before the first obstacle, occupied on each obstacle's shell,
 /// clearing out to `free_range_m` without an obstacle (0 = clear nothing). With `evidence` on,
-/// the occupied cells go to `cells.occupied_shares` with their shares.
+/// the occupied cells go to `cells.occupied_shares` with their shares. No cell that `water` does
+/// not hold is occupied.
 template <typename Set>
 void CastBeamExact(const octomap::OcTree& tree, const SensorGeometry& sensor, const Beam& beam,
                    std::span<const double> obstacle_ranges_m, double free_range_m,
-                   BasicBeamCells<Set>& cells, const ArcEvidence& evidence = {}) {
+                   BasicBeamCells<Set>& cells, const ArcEvidence& evidence = {},
+                   const WaterKeys& water = {}) {
   cells.beam_free.clear();
   cells.beam_occupied.clear();
   const BeamWedge wedge(sensor, beam);
   const WedgeCellCounts counts = ExactBeamCells(tree, wedge, obstacle_ranges_m, free_range_m,
                                                 cells.beam_free, cells.beam_occupied);
+  if (!water.all()) {
+    std::erase_if(cells.beam_occupied, [&](std::uint64_t k) { return !water.Holds(k); });
+  }
   cells.visits += counts.examined;
   cells.clipped += counts.clipped;
   cells.beam_free_cells += cells.beam_free.size();

@@ -264,11 +264,11 @@ BatchStats IntegrateBatch(MapTree& tree, std::span<const Beam> beams,
                           std::span<const std::vector<double>> obstacles,
                           std::span<const Eigen::Vector3d> directions, double free_range_m,
                           int threads, BatchWorkspace<Set>& workspace,
-                          const ArcEvidence& evidence = {}) {
+                          const ArcEvidence& evidence = {}, const WaterKeys& water = {}) {
   BatchStats stats = IntegrateCells(tree, beams, obstacles, threads, workspace, evidence,
                                     [&](std::size_t i, BasicBeamCells<Set>& cells) {
                                       CastBeam(tree, beams[i], directions, obstacles[i],
-                                               free_range_m, cells, evidence);
+                                               free_range_m, cells, evidence, water);
                                     });
   stats.ray_casts = beams.size() * directions.size();
   return stats;
@@ -279,11 +279,12 @@ template <typename Set>
 BatchStats IntegrateExactBatch(MapTree& tree, std::span<const Beam> beams,
                                std::span<const std::vector<double>> obstacles,
                                const SensorGeometry& sensor, double free_range_m, int threads,
-                               BatchWorkspace<Set>& workspace, const ArcEvidence& evidence = {}) {
+                               BatchWorkspace<Set>& workspace, const ArcEvidence& evidence = {},
+                               const WaterKeys& water = {}) {
   return IntegrateCells(tree, beams, obstacles, threads, workspace, evidence,
                         [&](std::size_t i, BasicBeamCells<Set>& cells) {
                           CastBeamExact(tree, sensor, beams[i], obstacles[i], free_range_m, cells,
-                                        evidence);
+                                        evidence, water);
                         });
 }
 

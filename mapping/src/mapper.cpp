@@ -22,6 +22,7 @@ struct Mapper::State {
   double free_range_m = 0.0;
   int threads = 1;
   ArcEvidence evidence;
+  WaterKeys water;
   std::vector<Eigen::Vector3d> directions;
   MapTree tree;
   /// The key sets and buffers of the batches, kept between them: those of config.key_set.
@@ -44,6 +45,9 @@ const MapperConfig& Checked(const MapperConfig& c) {
   need(c.rays_horizontal >= 1 && c.rays_vertical >= 1, "rays_horizontal and rays_vertical >= 1");
   need(c.threads >= 0, "threads >= 0 (0: all cores)");
   need(std::isfinite(c.free_range_m) && c.free_range_m >= 0.0, "free_range_m >= 0");
+  need(!std::isnan(c.water.floor_z_m) && !std::isnan(c.water.surface_z_m) &&
+           c.water.floor_z_m < c.water.surface_z_m,
+       "water.floor_z_m below water.surface_z_m");
   need(c.prob_hit >= 0.5 && c.prob_hit <= 1.0, "prob_hit in [0.5, 1]");
   need(c.prob_miss >= 0.0 && c.prob_miss <= 0.5, "prob_miss in [0, 0.5]");
   need(c.clamp_min >= 0.0 && c.clamp_min <= 0.5 && c.clamp_max >= 0.5 && c.clamp_max <= 1.0,
@@ -73,6 +77,7 @@ Mapper::Mapper(const MapperConfig& config, const SensorGeometry& sensor)
                          : config.free_range_m > 0.0    ? config.free_range_m
                                                         : sensor.MaxRangeM();
   state_->threads = config.threads > 0 ? config.threads : omp_get_max_threads();
+  state_->water = WaterKeysOf(config.water, config.resolution_m);
   if (config.occupancy == Occupancy::kArcEvidence) {
     // The two-way pattern's -3 dB points at the wedge's elevation limits (docs/physics.md).
     const double w = sensor.beam_width_vertical_rad;
@@ -148,10 +153,10 @@ BatchStats Mapper::Integrate(std::span<const Beam> beams,
   auto integrate = [&](auto& workspace) {
     if (config_.integration == Integration::kExact) {
       return IntegrateExactBatch(s.tree, beams, obstacles, sensor_, s.free_range_m, s.threads,
-                                 workspace, s.evidence);
+                                 workspace, s.evidence, s.water);
     }
     return IntegrateBatch(s.tree, beams, obstacles, s.directions, s.free_range_m, s.threads,
-                          workspace, s.evidence);
+                          workspace, s.evidence, s.water);
   };
   return std::visit(integrate, s.workspace);
 }

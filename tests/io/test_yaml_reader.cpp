@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -51,6 +52,20 @@ TEST(YamlReader, EchoesBehindWallsAreKeptUnlessRefused) {
   EXPECT_TRUE(ThrowsInputErrorWith(
       [] { (void)ReadMapping("detection:\n  behind_walls: drop\n"); },
       {"scene.yaml:2:17", "'detection.behind_walls'", "keep", "refuse", "got 'drop'"}));
+}
+
+TEST(YamlReader, TheWaterColumnIsUnboundedUnlessGivenAndItsFloorUnderItsSurface) {
+  EXPECT_EQ(ReadMapping("resolution_m: 0.1\n").water, mapping::WaterColumn{});
+  const mapping::WaterColumn water =
+      ReadMapping("water: {floor_z_m: -1.5, surface_z_m: 0.25}\n").water;
+  EXPECT_DOUBLE_EQ(water.floor_z_m, -1.5);
+  EXPECT_DOUBLE_EQ(water.surface_z_m, 0.25);
+  EXPECT_TRUE(std::isinf(ReadMapping("water: {floor_z_m: 0}\n").water.surface_z_m));
+  EXPECT_TRUE(
+      ThrowsInputErrorWith([] { (void)ReadMapping("water: {floor_z_m: 1.0, surface_z_m: 0.5}\n"); },
+                           {"scene.yaml:1:20", "'water.floor_z_m'", "below surface_z_m (0.5)"}));
+  EXPECT_TRUE(ThrowsInputErrorWith([] { (void)ReadMapping("water: {depth_m: 3}\n"); },
+                                   {"'water.depth_m'"}));
 }
 
 TEST(YamlReader, LaterEchoesAreTheStrongestUnlessSupportIsAskedFor) {

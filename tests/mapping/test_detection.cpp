@@ -398,6 +398,16 @@ std::vector<Beam> TankSweep(const SensorGeometry& sensor, std::size_t inside, do
   return sweep;
 }
 
+// TankSweep's detection: every bin as it is, its echoes over 100, up to three a beam.
+DetectionConfig TankDetection(DetectionConfig::BehindWalls walls) {
+  DetectionConfig config;
+  config.smoothing_bins = 1;
+  config.threshold = 100;
+  config.max_obstacles = 3;
+  config.behind_walls = walls;
+  return config;
+}
+
 // Nothing heard through a wall: the walls the first echoes outline refuse every echo beyond the
 // margin their own echoes can reach, and a beam that heard only through one is marked; echoes
 // within the margin stay. Two bins either side of the margin (the fitted wall lies within one).
@@ -405,10 +415,7 @@ TEST(DetectObstacles, EchoesBehindTheWallsAreRefused) {
   const SensorGeometry sensor;
   const double two_bins = 2.0 * sensor.bin_size_m;
   const std::vector<Beam> sweep = TankSweep(sensor, 50, two_bins);
-  DetectionConfig config;
-  config.smoothing_bins = 1;
-  config.threshold = 100;
-  config.max_obstacles = 3;
+  DetectionConfig config = TankDetection(DetectionConfig::BehindWalls::kKeep);
   std::vector<bool> through;
   const auto kept = DetectObstacles(sweep, sensor, config, &through);
   EXPECT_EQ(kept[0].size(), 2u);  // the wall and its mirror path
@@ -438,11 +445,7 @@ TEST(DetectObstacles, EchoesBehindTheWallsAreRefused) {
 // roll, as upright, and not at 30° (past kMaxWallFanTilt), though they outline the same walls.
 TEST(DetectObstacles, OnlyAFanNearVerticalRefusesBehindWalls) {
   const SensorGeometry sensor;
-  DetectionConfig config;
-  config.smoothing_bins = 1;
-  config.threshold = 100;
-  config.max_obstacles = 3;
-  config.behind_walls = DetectionConfig::BehindWalls::kRefuse;
+  const DetectionConfig config = TankDetection(DetectionConfig::BehindWalls::kRefuse);
   for (const double roll_deg : {10.0, 30.0}) {
     const std::vector<Beam> sweep =
         TankSweep(sensor, 50, 0.0,

@@ -72,6 +72,42 @@ TEST(Mapper, AnEchoIsOccupiedAtItsRangeAndFreeBeforeIt) {
   EXPECT_EQ(Cell(mapper, -1.025, 0.025, 0.025), nullptr);  // behind the sonar
 }
 
+// A wall 2.52 m away heard with a floor at z = -0.2 m and a surface at 0.3 m: its arc spans
+// ±2.52 tan 17.5° = ±0.79 m, and only the cells whose box reaches the water, [-0.25, 0.35), stay
+// occupied, each as without the water column, by both integrations; free space is the same.
+TEST(Mapper, NoEchoComesFromBeyondTheWaterColumn) {
+  const SensorGeometry sensor;
+  const std::vector<Beam> beams{AxisBeam(sensor)};
+  const std::vector<std::vector<double>> echoes{{2.52}};
+  for (const Integration integration : {Integration::kExact, Integration::kRays}) {
+    MapperConfig config = Config();
+    config.integration = integration;
+    Mapper open(config, sensor);
+    open.Integrate(beams, echoes);
+    config.water = {-0.2, 0.3};
+    Mapper bounded(config, sensor);
+    bounded.Integrate(beams, echoes);
+    std::size_t kept = 0, dropped = 0;
+    open.ForEachLeaf([&](const octomap::OcTreeKey& key, bool occupied) {
+      const double z = open.tree().keyToCoord(key).z();
+      const auto* node = bounded.tree().search(key);
+      if (!occupied) {
+        ASSERT_NE(node, nullptr) << z;
+        EXPECT_FALSE(bounded.tree().isNodeOccupied(node)) << z;
+        return;
+      }
+      const bool inside = z > -0.25 && z < 0.35;
+      EXPECT_EQ(node != nullptr && bounded.tree().isNodeOccupied(node), inside) << z;
+      (inside ? kept : dropped) += 1;
+    });
+    EXPECT_GT(kept, 0u);
+    EXPECT_GT(dropped, kept);  // 0.6 m of the arc's 1.58 m lie in the water
+    EXPECT_TRUE(IsOccupied(bounded, 2.525, 0.025, -0.225));  // the floor's own cell
+    EXPECT_TRUE(IsOccupied(bounded, 2.525, 0.025, 0.325));   // the surface's
+    EXPECT_EQ(Cell(bounded, 2.525, 0.025, -0.275), nullptr);
+  }
+}
+
 // A beam without an echo clears the wedge to the sensor's maximum range (5.0 m), or to the
 // configured free range, or nothing at all.
 TEST(Mapper, ABeamWithoutAnEchoClearsAsConfigured) {
@@ -180,6 +216,10 @@ TEST(Mapper, RefusesAConfigurationItCannotTakeNamingTheField) {
   EXPECT_NE(refused([](MapperConfig& c) { c.detection.smoothing_bins = 4; }).find("smoothing"),
             std::string::npos);
   EXPECT_NE(refused([](MapperConfig& c) { c.prob_hit = 0.4; }).find("prob_hit"), std::string::npos);
+  EXPECT_NE(refused([](MapperConfig& c) {
+              c.water = {1.0, 1.0};
+            }).find("water.floor_z_m"),
+            std::string::npos);
   EXPECT_EQ(refused([](MapperConfig& c) {
               c.detection.threshold = 255;
               c.prob_hit = 1.0;

@@ -2,6 +2,7 @@
 
 #include <openssl/evp.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -52,6 +53,11 @@ nlohmann::json MapperConfigJson(const mapping::MapperConfig& c) {
               {"order", c.detection.cfar.order},
               {"db_per_count", c.detection.cfar.db_per_count}}}}},
           {"occupancy", io::OccupancyName(c.occupancy)},
+          {"water",
+           {{"floor_z_m", std::isfinite(c.water.floor_z_m) ? nlohmann::json(c.water.floor_z_m)
+                                                           : nlohmann::json()},
+            {"surface_z_m", std::isfinite(c.water.surface_z_m) ? nlohmann::json(c.water.surface_z_m)
+                                                               : nlohmann::json()}}},
           {"key_set", io::KeySetName(c.key_set)},
           {"prob_hit", c.prob_hit},
           {"prob_miss", c.prob_miss},

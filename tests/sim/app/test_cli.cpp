@@ -215,8 +215,8 @@ TEST(Cli, MessagesNameWhatToDoNext) {
   EXPECT_FALSE(fs::exists(imported / "truth"));  // an imported log has no truth
   const auto map = dir.path() / "map";
   ASSERT_EQ(RunCli("map " + imported.string() + " --out " + map.string(), &output), 0) << output;
-  EXPECT_NE(output.find("detection: threshold 110, the first echo a beam, none behind a wall, "
-                        "arc_marking at 0.05 m "
+  EXPECT_NE(output.find("detection: threshold 110, at most 2 echoes a beam (later echoes: "
+                        "strongest), none behind a wall, arc_marking at 0.05 m "
                         "(from " +
                         test::SourcePath("sensor-models/shad-micron.yaml") + ")"),
             std::string::npos)
@@ -224,15 +224,15 @@ TEST(Cli, MessagesNameWhatToDoNext) {
   EXPECT_NE(ReadFile(map / "report.html").find("<td>detection.threshold</td><td>110</td>"),
             std::string::npos);
   // --mapping refines the model's defaults key by key.
-  const auto mapping = dir.path() / "two.yaml";
-  std::ofstream(mapping) << "detection: {max_obstacles: 2}\n";
+  const auto mapping = dir.path() / "first.yaml";
+  std::ofstream(mapping) << "detection: {max_obstacles: 1}\n";
   ASSERT_EQ(RunCli("map " + imported.string() + " --mapping " + mapping.string() + " --out " +
                        (dir.path() / "map2").string(),
                    &output),
             0)
       << output;
-  EXPECT_NE(output.find("detection: threshold 110, at most 2 echoes a beam (later echoes: "
-                        "strongest), none behind a wall, arc_marking at 0.05 m (from " +
+  EXPECT_NE(output.find("detection: threshold 110, the first echo a beam, none behind a wall, "
+                        "arc_marking at 0.05 m (from " +
                         test::SourcePath("sensor-models/shad-micron.yaml") + " and " +
                         mapping.string() + ")"),
             std::string::npos)

@@ -348,7 +348,8 @@ TEST(SensorModelFile, MappingDefaultsAreTheModelsAndTheSceneRefinesThem) {
   const sim::SensorModel micron =
       sim::LoadSensorModel(test::SourcePath("sensor-models/shad-micron.yaml"));
   EXPECT_EQ(micron.mapping.detection.threshold, 110);
-  EXPECT_EQ(micron.mapping.detection.max_obstacles, 1);
+  EXPECT_EQ(micron.mapping.detection.max_obstacles, 2);
+  EXPECT_EQ(micron.mapping.detection.behind_walls, mapping::DetectionConfig::BehindWalls::kRefuse);
   EXPECT_EQ(micron.mapping.detection.smoothing_bins, 5);
   EXPECT_EQ(micron.mapping.detection.min_run_bins, 3);
   EXPECT_EQ(micron.mapping.resolution_m, mapping::MapperConfig{}.resolution_m);
@@ -375,9 +376,10 @@ TEST(SensorModelFile, MappingDefaultsAreTheModelsAndTheSceneRefinesThem) {
     return sim::LoadScene(path);
   };
   EXPECT_EQ(scene_with("").mapping.detection, micron.mapping.detection);
-  const sim::Scene refined = scene_with("mapping: {detection: {max_obstacles: 2}}\n");
-  EXPECT_EQ(refined.mapping.detection.max_obstacles, 2);
+  const sim::Scene refined = scene_with("mapping: {detection: {max_obstacles: 1}}\n");
+  EXPECT_EQ(refined.mapping.detection.max_obstacles, 1);
   EXPECT_EQ(refined.mapping.detection.threshold, 110);
+  EXPECT_EQ(refined.mapping.detection.behind_walls, mapping::DetectionConfig::BehindWalls::kRefuse);
   EXPECT_TRUE(
       ThrowsInputErrorWith([&] { (void)scene_with("mapping: {detection: {threshold: 0}}\n"); },
                            {"scene.yaml:9:", "'mapping.detection.threshold'", "'0'"}));

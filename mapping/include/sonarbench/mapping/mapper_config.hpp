@@ -1,5 +1,6 @@
 #pragma once
 
+#include <limits>
 #include <string>
 
 namespace sonarbench::mapping {
@@ -90,6 +91,17 @@ enum class Occupancy {
   kArcEvidence,  ///< each gets a share, by the vertical beam pattern and what the map knows
 };
 
+/// The water's extent along the world's z axis [m]: its surface (the vehicle's depth gauge) and a
+/// flat floor (its altimeter), each infinite when unknown. No echo comes from beyond them, so no
+/// cell wholly above the surface or below the floor is marked occupied (docs/mapper.md, "The
+/// water column").
+struct WaterColumn {
+  double floor_z_m = -std::numeric_limits<double>::infinity();
+  double surface_z_m = std::numeric_limits<double>::infinity();
+
+  bool operator==(const WaterColumn&) const = default;
+};
+
 /// Parameters of the production mapper. In-class defaults are the seed paper's choices, but for
 /// `integration` and `key_set`.
 struct MapperConfig {
@@ -104,6 +116,7 @@ struct MapperConfig {
   int rays_vertical = 64;
   DetectionConfig detection;
   Occupancy occupancy = Occupancy::kArcMarking;
+  WaterColumn water;
   /// OctoMap hit / miss probabilities and clamping thresholds.
   double prob_hit = 0.7;
   double prob_miss = 0.4;
