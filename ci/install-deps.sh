@@ -1,16 +1,22 @@
 #!/usr/bin/env bash
-# Installs, from Debian's archive, every package sonarbench needs to build and test, and only
-# those that are missing, so it is cheap to call before every build. Needs root (or sudo).
+# Installs, from Debian's archive, the packages sonarbench needs, and only those that are missing,
+# so it is cheap to call before every build. `run`: what builds the sonarbench program (and lets
+# CMake configure the tests beside it); no argument: everything the tests and sanitizers use too.
+# Needs root (or sudo).
 set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config git
   libeigen3-dev liboctomap-dev libopencv-dev libembree-dev libyaml-cpp-dev
   libcli11-dev libmatio-dev zlib1g-dev libzstd-dev nlohmann-json3-dev libabsl-dev libassimp-dev
-  libxml2-utils libssl-dev python3 python3-numpy python3-matplotlib
-  libgtest-dev libbenchmark-dev
-  clang libclang-rt-14-dev libomp-14-dev
+  libssl-dev libgtest-dev libbenchmark-dev
 )
+case "${1:-all}" in
+  run) ;;
+  all) packages+=(libxml2-utils python3 python3-numpy python3-matplotlib
+                  clang libclang-rt-14-dev libomp-14-dev) ;;
+  *) echo "ci/install-deps.sh: expected 'run' or nothing, got '$1'" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do

@@ -4,5 +4,6 @@
 # when the scene's criteria fail.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash ci/build.sh
+bash ci/build.sh --target sonarbench
+echo "ci/run-tank.sh: running scenes/cras-tank.yaml"
 ./build/sim/sonarbench run scenes/cras-tank.yaml --out "${1:-out/cras-tank}"

@@ -15,6 +15,7 @@
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/detector_study.hpp"
+#include "sonarbench/sim/app/map_fidelity.hpp"
 #include "sonarbench/sim/app/map_log.hpp"
 #include "sonarbench/sim/report/fidelity_report.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
@@ -34,6 +35,7 @@ struct FidelityArgs {
   int threads = 0;
   double wall_min_range_m = 1.6;
   std::string maps = "all";
+  std::size_t seeds = 0;
 };
 
 // The log's beams: a .mat log, a folder holding one, or a dataset directory (as `map` takes).
@@ -98,16 +100,26 @@ int Fidelity(const FidelityArgs& args) {
   const auto& g = scene.sensor.geometry;
   const auto report = sim::CompareWithLog(beams, log_beams, g, args.wall_min_range_m);
   nlohmann::json maps;
-  if (map_settings) {
+  nlohmann::json spread;
+  if (map_settings || args.seeds > 0) {
     sim::DetectorStudyOptions options;
-    options.items = *map_settings;
+    if (map_settings) options.items = *map_settings;
     options.seed = args.seed;
     options.log = args.log;
     options.threads = args.threads;
     options.progress = [&](std::size_t done, std::size_t total) {
       progress.Update("maps", done, total);
     };
-    maps = sim::MapFidelity(scene, options);
+    if (args.seeds > 0) {
+      sim::MapSpreadOptions runs;
+      for (std::size_t s = 0; s < args.seeds; ++s)
+        runs.seeds.push_back(args.seed.value_or(scene.seed) + s);
+      sim::MapSpread judged = sim::JudgeMapsAgainstSeeds(scene, options, runs);
+      maps = std::move(judged.maps);
+      spread = std::move(judged.spread);
+    } else {
+      maps = sim::MapFidelity(scene, options);
+    }
     progress.Clear();
   }
   const auto per_sweep = static_cast<std::size_t>(g.BeamsPerSweep());
@@ -115,13 +127,15 @@ int Fidelity(const FidelityArgs& args) {
   const std::span<const sonarbench::mapping::Beam> real_all(log_beams);
   sim::WriteFidelityOutputs(
       out.write_root().string(), report, sim_all.first(std::min(per_sweep, sim_all.size())),
-      real_all.first(std::min(per_sweep, real_all.size())), g, args.scene, args.log, maps);
+      real_all.first(std::min(per_sweep, real_all.size())), g, args.scene, args.log, maps, spread);
   out.Commit();
   nlohmann::json brief = sim::FidelityJson(report, args.scene, args.log);
   if (!maps.is_null()) brief["maps"] = maps;
+  if (!spread.is_null()) brief["spread"] = spread;
   std::cout << sim::FidelityBrief(brief) << "wrote " << args.out
             << "/report.html, fidelity.json (every statistic)"
-            << (maps.is_null() ? "" : ", maps.csv") << ", profile.png, polar.png, fan.png\n";
+            << (maps.is_null() ? "" : ", maps.csv") << (spread.is_null() ? "" : ", spread.csv")
+            << ", profile.png, polar.png, fan.png\n";
   return 0;
 }
 
@@ -150,6 +164,14 @@ CLI::App* AddOptions(CLI::App& app, FidelityArgs& args) {
                    "or indices as in detectors.csv, e.g. 6,7,8) over the whole sweep and each half "
                    "of it, and compare the maps (fidelity.json's maps, maps.csv, report.html)")
       ->capture_default_str();
+  command
+      ->add_option(
+          "--seeds", args.seeds,
+          "Also judge the log against N simulated runs (seeds SEED to SEED+N-1, SEED the "
+          "scene's or --seed): per figure and part, whether the log lies within the runs' "
+          "own spread at the scene's mapping and over the --maps settings (fidelity.json's "
+          "spread, spread.csv, report.html)")
+      ->check(CLI::Range(std::size_t{4}, std::size_t{64}));
   command->add_option("-o,--out", args.out, "Output directory")->capture_default_str();
   AddSeedOption(command, args.seed, "Overrides the scene's seed");
   AddThreadsOption(command, args.threads);

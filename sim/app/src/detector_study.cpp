@@ -154,15 +154,6 @@ json MetricsJson(const MapMetrics& m) {
           {"occupied_cells", m.occupied_cells}};
 }
 
-// The figures the scene's maps are held to the log's by: their names in study.json and
-// fidelity.json, and the criteria metrics (MetricValue) they are.
-const std::pair<const char*, const char*> kAgreementFigures[] = {
-    {"precision_1", "occupied_precision_within_1"},
-    {"recall_1", "occupied_recall_within_1"},
-    {"f1_1", "occupied_f1_within_1"},
-    {"ghost_arc_share", "ghost_arc_share"},
-    {"ghost_echo_share", "ghost_echo_share"}};
-
 const std::vector<std::string> kMetricColumns = {
     "precision",   "recall",          "precision_1",      "recall_1",         "f1_1",
     "ghost_share", "ghost_arc_share", "ghost_echo_share", "column_precision", "column_recall",
@@ -317,45 +308,6 @@ json AgreementJson(const std::vector<DetectorRow>& rows, const MapGoals& goals) 
             {"max_abs_difference", goals.max_abs_difference},
             {"min_spearman", goals.min_spearman}}},
           {"meets", meets && best_scene == best_log}};
-}
-
-json MapFidelity(const Scene& scene, DetectorStudyOptions options, const MapGoals& goals) {
-  const std::vector<DetectorItem> items =
-      options.items.empty() ? DetectorStudyItems(scene.mapping.detection) : options.items;
-  options.items = items;
-  const auto progress = options.progress;
-  json parts = json::array();
-  bool meets = true;
-  const std::vector<std::pair<std::string, std::optional<std::pair<double, double>>>> halves = {
-      {"all head angles", std::nullopt},
-      {"head angles 0-180 deg", std::pair{0.0, 180.0}},
-      {"head angles 180-360 deg", std::pair{180.0, 360.0}}};
-  for (std::size_t p = 0; p < halves.size(); ++p) {
-    options.heads_deg = halves[p].second;
-    options.progress = [&](std::size_t done, std::size_t) {
-      if (progress) progress(p * items.size() + done, halves.size() * items.size());
-    };
-    const std::vector<DetectorRow> rows = RunDetectorStudy(scene, options);
-    json table = json::array();
-    for (const DetectorRow& row : rows) {
-      json scene_values, log_values;
-      for (const auto& [figure, metric] : kAgreementFigures) {
-        scene_values[figure] = MetricValue(row.scene, metric);
-        log_values[figure] = MetricValue(*row.log, metric);
-      }
-      table.push_back({{"name", row.item.name}, {"scene", scene_values}, {"log", log_values}});
-    }
-    json agreement = AgreementJson(rows, goals);
-    meets = meets && agreement.value("meets", false);
-    const auto& heads = halves[p].second;
-    parts.push_back({{"name", halves[p].first},
-                     {"heads_deg", heads ? json::array({heads->first, heads->second}) : json()},
-                     {"agreement", std::move(agreement)},
-                     {"rows", std::move(table)}});
-  }
-  json names = json::array();
-  for (const DetectorItem& item : items) names.push_back(item.name);
-  return {{"settings", names}, {"parts", parts}, {"meets", meets}};
 }
 
 bool InHeads(double head_angle_rad, const std::pair<double, double>& heads_deg) {

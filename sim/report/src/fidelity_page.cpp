@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -89,6 +90,97 @@ std::string AgreementHtml(const nlohmann::json& part) {
   return html.str();
 }
 
+// The spread's verdict in a sentence, and the runs standing in for the log.
+std::string SpreadVerdict(const nlohmann::json& spread) {
+  std::string text = spread.at("within").get<bool>()
+                         ? "The log lies within the simulator's own spread"
+                         : "The log lies outside the simulator's own spread";
+  text += " (" + std::to_string(spread.at("seeds").size()) + " seeds, " +
+          std::to_string(spread.at("judgements").get<std::size_t>()) + " judgements, size " +
+          Fixed(spread.at("level"), 2) + " over all); ";
+  const auto& size = spread.at("size");
+  text += std::to_string(size.at("seeds_within").get<std::size_t>()) + " of " +
+          std::to_string(size.at("seeds").get<std::size_t>()) +
+          " runs, each standing in for the log against the others, are within.";
+  return text;
+}
+
+// One part's spread as an SVG strip per figure at the scene's mapping: the runs (grey dots), the
+// interval the verdict allows around their mean (the bar) and the log (red), each strip scaled
+// to what it shows, its ends labelled.
+std::string SpreadSvg(const nlohmann::json& part) {
+  constexpr int kRow = 30, kLeft = 150, kWidth = 420, kRight = 70;
+  std::ostringstream svg;
+  const auto& figures = part.at("figures");
+  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << kLeft + kWidth + kRight
+      << "\" height=\"" << kRow * static_cast<int>(std::size(kFigures)) + 10
+      << "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+  int y = 20;
+  for (const char* figure : kFigures) {
+    const auto& entry = figures.at(figure);
+    svg << "<text x=\"0\" y=\"" << y + 4 << "\">" << figure << "</text>\n";
+    if (entry.is_null()) {
+      svg << "<text x=\"" << kLeft << "\" y=\"" << y + 4 << "\">not judged</text>\n";
+      y += kRow;
+      continue;
+    }
+    const auto& j = entry.at("scene_mapping");
+    const double log = j.at("log").get<double>();
+    const double centre = log - j.at("statistic").get<double>();
+    const double bound = j.at("bound").get<double>();
+    double lo = std::min(log, centre - bound), hi = std::max(log, centre + bound);
+    for (const auto& run : j.at("runs")) {
+      lo = std::min(lo, run.get<double>());
+      hi = std::max(hi, run.get<double>());
+    }
+    const double pad = 0.05 * std::max(hi - lo, 1e-6);
+    lo -= pad;
+    hi += pad;
+    const auto x = [&](double v) { return kLeft + (v - lo) / (hi - lo) * kWidth; };
+    svg << "<line x1=\"" << x(centre - bound) << "\" x2=\"" << x(centre + bound) << "\" y1=\"" << y
+        << "\" y2=\"" << y << "\" stroke=\"#9ab\" stroke-width=\"8\"/>\n";
+    for (const auto& run : j.at("runs")) {
+      svg << "<circle cx=\"" << x(run.get<double>()) << "\" cy=\"" << y
+          << "\" r=\"3\" fill=\"#555\"/>\n";
+    }
+    svg << "<rect x=\"" << x(log) - 4 << "\" y=\"" << y - 8
+        << "\" width=\"8\" height=\"16\" fill=\"" << (j.at("within").get<bool>() ? "#2a2" : "#d22")
+        << "\"/>\n"
+        << "<text x=\"" << kLeft << "\" y=\"" << y + 14 << "\" fill=\"#777\">" << Fixed(lo, 3)
+        << "</text><text x=\"" << kLeft + kWidth << "\" y=\"" << y + 14
+        << "\" fill=\"#777\" text-anchor=\"end\">" << Fixed(hi, 3) << "</text>\n"
+        << "<text x=\"" << kLeft + kWidth + 8 << "\" y=\"" << y + 4 << "\">log " << Fixed(log, 3)
+        << "</text>\n";
+    y += kRow;
+  }
+  svg << "</svg>\n";
+  return svg.str();
+}
+
+// One part's judgements as a table: a row per figure, at the scene's mapping and over settings.
+std::string SpreadTableHtml(const nlohmann::json& part) {
+  std::ostringstream html;
+  html << "<table>\n<tr><th>figure</th><th>log - runs' mean</th><th>bound</th><th>within</th>"
+       << "<th>mean |difference| over settings</th><th>bound</th><th>within</th></tr>\n";
+  for (const char* figure : kFigures) {
+    const auto& entry = part.at("figures").at(figure);
+    html << "<tr><td>" << figure << "</td>";
+    for (const char* kind : {"scene_mapping", "settings"}) {
+      if (entry.is_null() || !entry.contains(kind)) {
+        html << "<td></td><td></td><td></td>";
+        continue;
+      }
+      const auto& j = entry.at(kind);
+      html << "<td class=\"n\">" << Fixed(j.at("statistic"), 3) << "</td><td class=\"n\">"
+           << Fixed(j.at("bound"), 3) << "</td><td>"
+           << (j.at("within").get<bool>() ? "yes" : "no, by " + Fixed(j.at("excess"), 3))
+           << "</td>";
+    }
+    html << "</tr>\n";
+  }
+  return html.str() + "</table>\n";
+}
+
 }  // namespace
 
 std::string FidelityHtml(const nlohmann::json& r) {
@@ -100,6 +192,11 @@ std::string FidelityHtml(const nlohmann::json& r) {
     html << "<p class=\"verdict " << (maps.at("meets").get<bool>() ? "pass" : "fail") << "\">"
          << XmlEscape(MapsVerdict(maps)) << "</p>\n";
   }
+  const nlohmann::json spread = r.value("spread", nlohmann::json());
+  if (!spread.is_null()) {
+    html << "<p class=\"verdict " << (spread.at("within").get<bool>() ? "pass" : "fail") << "\">"
+         << XmlEscape(SpreadVerdict(spread)) << "</p>\n";
+  }
   html << "<p>Scene " << XmlEscape(r.at("scene").dump()) << ", log "
        << XmlEscape(r.at("log").dump())
        << ". Maps are scored against the scene's surfaces at 1 cell of tolerance (shares, 0-1); "
@@ -108,6 +205,22 @@ std::string FidelityHtml(const nlohmann::json& r) {
   if (!maps.is_null()) {
     html << "<h2>The maps, setting by setting (maps.csv)</h2>\n";
     for (const auto& part : maps.at("parts")) html << AgreementHtml(part);
+  }
+  if (!spread.is_null()) {
+    html << "<h2>The log against the simulator's own spread</h2>\n<p>Per figure at the scene's "
+            "mapping: the runs (grey), the interval the verdict allows (bar) and the log (green "
+            "within, red outside); docs/fidelity.md, \"The verdict\".</p>\n";
+    for (const auto& part : spread.at("parts")) {
+      html << "<h3>" << XmlEscape(part.at("name").get<std::string>()) << "</h3>\n"
+           << SpreadSvg(part) << SpreadTableHtml(part);
+    }
+    if (!spread.at("missed").empty()) {
+      html << "<p>Outside:</p>\n<ul>\n";
+      for (const auto& line : spread.at("missed")) {
+        html << "<li>" << XmlEscape(line.get<std::string>()) << "</li>\n";
+      }
+      html << "</ul>\n";
+    }
   }
   html << "<h2>Images</h2>\n";
   for (const char* file : {"profile.png", "polar.png", "fan.png"}) {
@@ -121,6 +234,13 @@ std::string FidelityHtml(const nlohmann::json& r) {
 std::string FidelityBrief(const nlohmann::json& r) {
   std::ostringstream text;
   for (const auto& [label, value] : BeamRows(r)) text << label << ": " << value << "\n";
+  const nlohmann::json spread = r.value("spread", nlohmann::json());
+  if (!spread.is_null()) {
+    text << SpreadVerdict(spread) << "\n";
+    for (const auto& line : spread.at("missed")) {
+      text << "  outside: " << line.get<std::string>() << "\n";
+    }
+  }
   const nlohmann::json maps = r.value("maps", nlohmann::json());
   if (maps.is_null()) return text.str();
   text << "maps, simulated against the log over " << maps.at("settings").size()
@@ -148,6 +268,23 @@ std::string FidelityBrief(const nlohmann::json& r) {
   }
   text << MapsVerdict(maps) << "\n";
   return text.str();
+}
+
+std::string SpreadCsv(const nlohmann::json& spread) {
+  std::ostringstream csv;
+  csv << "part,figure,judgement,statistic,bound,excess,within\n";
+  for (const auto& part : spread.at("parts")) {
+    for (const char* figure : kFigures) {
+      const auto& entry = part.at("figures").at(figure);
+      if (entry.is_null()) continue;
+      for (const auto& [kind, j] : entry.items()) {
+        csv << part.at("name").get<std::string>() << "," << figure << "," << kind << ","
+            << j.at("statistic").get<double>() << "," << j.at("bound").get<double>() << ","
+            << j.at("excess").get<double>() << "," << (j.at("within").get<bool>() ? 1 : 0) << "\n";
+      }
+    }
+  }
+  return csv.str();
 }
 
 std::string MapsCsv(const nlohmann::json& maps) {

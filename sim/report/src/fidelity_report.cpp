@@ -147,7 +147,7 @@ std::string FidelitySummary(const nlohmann::json& report) {
   std::string text;
   for (const auto& [key, value] : report.items()) {
     if (key == "schema_version" || key == "tool" || key == "scene" || key == "log" ||
-        key == "outputs") {
+        key == "outputs" || key == "spread") {
       continue;
     }
     if (value.is_object()) {
@@ -226,7 +226,8 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
                           std::span<const mapping::Beam> sim_sweep,
                           std::span<const mapping::Beam> real_sweep,
                           const mapping::SensorGeometry& sensor, const std::string& scene_file,
-                          const std::string& log_file, const nlohmann::json& maps) {
+                          const std::string& log_file, const nlohmann::json& maps,
+                          const nlohmann::json& spread) {
   namespace fs = std::filesystem;
   CreateOutputDirectory(out_dir);
   const fs::path dir(out_dir);
@@ -255,6 +256,11 @@ void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& r,
     report["maps"] = maps;
     report["outputs"].push_back("maps.csv");
     WriteText((dir / "maps.csv").string(), MapsCsv(maps));
+  }
+  if (!spread.is_null()) {
+    report["spread"] = spread;
+    report["outputs"].push_back("spread.csv");
+    WriteText((dir / "spread.csv").string(), SpreadCsv(spread));
   }
   report["outputs"].push_back("report.html");
   WriteText((dir / "report.html").string(), FidelityHtml(report));

@@ -79,5 +79,58 @@ TEST(FidelityCli, DetectorsHeadsIsAnIntervalOfHeadAngles) {
   }
 }
 
+// --seeds judges the log against the scene's own runs: each figure of each part at the scene's
+// mapping, with the runs, the bound and how far outside, in fidelity.json, spread.csv, report.html
+// (a strip per figure) and on the terminal. A scene 20 dB louder than the one that made the log
+// hears far more of the tank: its runs leave the log outside on recall, named with its part.
+TEST(FidelityCli, SeedsJudgeTheLogAgainstTheScenesOwnSpread) {
+  test::TempDir dir;
+  const std::string base =
+      "extends: " + test::SourcePath("scenes/cras-tank.yaml") + "\nsweeps: 1\n";
+  const std::string scene = test::WriteFile(dir, "tank.yaml", "name: cras-tank\n" + base);
+  const std::string louder = test::WriteFile(
+      dir, "louder.yaml", "name: cras-tank\n" + base + "sonar_acoustics:\n  gain_db: 26.0\n");
+  const auto dataset = dir.path() / "dataset";
+  const auto out = dir.path() / "fidelity";
+  std::string output;
+  ASSERT_EQ(RunCli("simulate " + scene + " --seed 99 --out " + dataset.string(), &output), 0)
+      << output;
+  ASSERT_EQ(RunCli("fidelity " + louder + " " + dataset.string() +
+                       " --seeds 4 --maps none --no-progress --out " + out.string(),
+                   &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("The log lies outside the simulator's own spread (4 seeds, 15 judgements"),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("outside: recall_1 (all head angles) at the scene's mapping"),
+            std::string::npos)
+      << output;
+  const auto report = nlohmann::json::parse(test::ReadFile(out / "fidelity.json"));
+  const auto& spread = report.at("spread");
+  EXPECT_EQ(spread.at("seeds"), nlohmann::json::array({1, 2, 3, 4}));
+  EXPECT_FALSE(spread.at("within").get<bool>());
+  EXPECT_LE(spread.at("size").at("seeds_within").get<int>(), 4);
+  ASSERT_EQ(spread.at("parts").size(), 3u);
+  const auto& recall = spread.at("parts")[0].at("figures").at("recall_1").at("scene_mapping");
+  EXPECT_EQ(recall.at("runs").size(), 4u);
+  EXPECT_EQ(recall.at("left_out").size(), 4u);
+  EXPECT_FALSE(recall.at("within").get<bool>());
+  EXPECT_NEAR(recall.at("excess").get<double>(),
+              std::abs(recall.at("statistic").get<double>()) - recall.at("bound").get<double>(),
+              1e-12);
+  const std::string csv = test::ReadFile(out / "spread.csv");
+  EXPECT_EQ(csv.rfind("part,figure,judgement,statistic,bound,excess,within\n", 0), 0u);
+  const std::string html = test::ReadFile(out / "report.html");
+  EXPECT_NE(html.find("class=\"verdict fail\">The log lies outside"), std::string::npos);
+  EXPECT_NE(html.find("<svg"), std::string::npos);
+  // Fewer than four seeds leave too few runs to judge a run left out: refused, naming --seeds.
+  EXPECT_EQ(RunCli("fidelity " + scene + " " + dataset.string() + " --seeds 3 --out " +
+                       (dir.path() / "three").string(),
+                   &output),
+            2);
+  EXPECT_NE(output.find("--seeds"), std::string::npos) << output;
+}
+
 }  // namespace
 }  // namespace sonarbench

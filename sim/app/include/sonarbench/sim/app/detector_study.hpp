@@ -70,6 +70,15 @@ struct DetectorRow {
 [[nodiscard]] std::vector<DetectorRow> RunDetectorStudy(const Scene& scene,
                                                         const DetectorStudyOptions& options);
 
+/// The figures the scene's maps are held to the log's by: their names in study.json and
+/// fidelity.json, and the criteria metrics (MetricValue) they are.
+inline constexpr std::pair<const char*, const char*> kAgreementFigures[] = {
+    {"precision_1", "occupied_precision_within_1"},
+    {"recall_1", "occupied_recall_within_1"},
+    {"f1_1", "occupied_f1_within_1"},
+    {"ghost_arc_share", "ghost_arc_share"},
+    {"ghost_echo_share", "ghost_echo_share"}};
+
 /// How closely the simulated scene's maps follow the log's over the study's settings, for one
 /// figure (a MapMetrics value in [0, 1]): the Spearman rank correlation of the two columns
 /// (average ranks for ties; NaN when either column is constant) and their mean and largest
@@ -100,14 +109,6 @@ struct MapGoals {
 /// log: null.
 [[nodiscard]] nlohmann::json AgreementJson(const std::vector<DetectorRow>& rows,
                                            const MapGoals& goals = {});
-
-/// The study with the log over the whole sweep and over each half of it ([0, 180) and [180, 360)
-/// degrees of head angle; `options.heads_deg` is ignored), as fidelity.json's "maps": "settings"
-/// (their names), "parts" (per part its name, "heads_deg", AgreementJson as "agreement", and
-/// "rows": each setting's P@1, R@1, F1@1 and ghost split, scene and log) and "meets" (every part
-/// does). `options.progress` counts the settings over the three parts.
-[[nodiscard]] nlohmann::json MapFidelity(const Scene& scene, DetectorStudyOptions options,
-                                         const MapGoals& goals = {});
 
 /// detectors.csv (a row per setting), precision_vs_recall_scene.png and, with a log,
 /// precision_vs_recall_log.png (precision against recall at one cell of tolerance) and study.json,

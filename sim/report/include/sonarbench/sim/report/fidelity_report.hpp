@@ -29,6 +29,7 @@ inline const std::vector<std::string> kFidelityOutputFiles = {"fidelity.json",
                                                               "polar.png",
                                                               "fan.png",
                                                               "maps.csv",
+                                                              "spread.csv",
                                                               "report.html"};
 
 /// fidelity.json's content: the report's header, the scene and log, and every statistic.
@@ -47,13 +48,17 @@ inline const std::vector<std::string> kFidelityOutputFiles = {"fidelity.json",
 [[nodiscard]] std::string FidelityBrief(const nlohmann::json& report);
 /// maps.csv from fidelity.json's "maps": a row per part and setting, scene and log columns.
 [[nodiscard]] std::string MapsCsv(const nlohmann::json& maps);
+/// spread.csv from fidelity.json's "spread": a row per part, figure and judgement.
+[[nodiscard]] std::string SpreadCsv(const nlohmann::json& spread);
 
 /// With `maps` (fidelity.json's "maps", null for none), also "maps" in fidelity.json and
-/// maps.csv; report.html always.
+/// maps.csv; with `spread` (the verdict against the seeds' spread), "spread" and spread.csv;
+/// report.html always.
 void WriteFidelityOutputs(const std::string& out_dir, const FidelityReport& report,
                           std::span<const mapping::Beam> sim_sweep,
                           std::span<const mapping::Beam> real_sweep,
                           const mapping::SensorGeometry& sensor, const std::string& scene_file,
-                          const std::string& log_file, const nlohmann::json& maps = nullptr);
+                          const std::string& log_file, const nlohmann::json& maps = nullptr,
+                          const nlohmann::json& spread = nullptr);
 
 }  // namespace sonarbench::sim
