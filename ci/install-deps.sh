@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs, from Debian's archive, the packages sonarbench needs, and only those that are missing,
 # so it is cheap to call before every build. `run`: what builds the sonarbench program (and lets
-# CMake configure the tests beside it); no argument: everything the tests and sanitizers use too.
+# CMake configure the tests beside it); `slurm`: the one-node cluster of ci/test-slurm.sh; no
+# argument: everything the tests and sanitizers use too.
 # Needs root (or sudo).
 set -euo pipefail
 
@@ -13,9 +14,10 @@ packages=(
 )
 case "${1:-all}" in
   run) ;;
+  slurm) packages=(slurmctld slurmd slurm-client munge python3) ;;
   all) packages+=(libxml2-utils python3 python3-numpy python3-matplotlib
                   clang libclang-rt-14-dev libomp-14-dev) ;;
-  *) echo "ci/install-deps.sh: expected 'run' or nothing, got '$1'" >&2; exit 2 ;;
+  *) echo "ci/install-deps.sh: expected 'run', 'slurm' or nothing, got '$1'" >&2; exit 2 ;;
 esac
 
 missing=()

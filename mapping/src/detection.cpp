@@ -193,8 +193,9 @@ void DropEchoesBehindWalls(std::vector<std::vector<Echo>>& candidates, std::span
     const double up = (beam.T_world_sonar.linear() * Eigen::Vector3d::UnitZ()).z();
     return std::acos(std::clamp(std::abs(up), 0.0, 1.0));
   };
-  std::vector<bool> upright(beams.size());
-  for (std::size_t b = 0; b < beams.size(); ++b) upright[b] = tilt(beams[b]) <= kMaxWallFanTilt;
+  std::vector<double> tilts(beams.size());
+  for (std::size_t b = 0; b < beams.size(); ++b) tilts[b] = tilt(beams[b]);
+  const auto upright = [&](std::size_t b) { return tilts[b] <= kMaxWallFanTilt; };
   auto top_down = [&](const Beam& beam) {
     const Eigen::Vector3d axis =
         beam.T_world_sonar.linear() * SonarRayDirection(beam.head_angle_rad, 0.0);
@@ -203,19 +204,18 @@ void DropEchoesBehindWalls(std::vector<std::vector<Echo>>& candidates, std::span
   };
   std::vector<FirstEcho> firsts;
   for (const std::size_t b : HeadAngleOrder(beams)) {
-    if (candidates[b].empty() || !upright[b]) continue;
+    if (candidates[b].empty() || !upright(b)) continue;
     const auto [origin, bearing] = top_down(beams[b]);
     const double range = beams[b].BinCentreRange(static_cast<std::size_t>(candidates[b][0].bin));
     firsts.push_back({origin, origin + range * bearing});
   }
   const std::vector<WallLine> walls = FitWalls(firsts);
   for (std::size_t b = 0; b < beams.size(); ++b) {
-    if (!upright[b]) continue;
+    if (!upright(b)) continue;
     const auto [origin, bearing] = top_down(beams[b]);
     const std::optional<double> wall = WallAhead(origin, bearing, walls);
     if (!wall || candidates[b].empty()) continue;
-    const double slant =
-        1.0 / std::cos(sensor.beam_width_vertical_rad / 2.0 + tilt(beams[b])) - 1.0;
+    const double slant = 1.0 / std::cos(sensor.beam_width_vertical_rad / 2.0 + tilts[b]) - 1.0;
     const double limit = *wall * (1.0 + slant) + kWallBand + beams[b].bin_size_m;
     std::erase_if(candidates[b], [&](const Echo& e) {
       return beams[b].BinCentreRange(static_cast<std::size_t>(e.bin)) > limit;

@@ -29,10 +29,14 @@ namespace {
 using nlohmann::json;
 using Detection = mapping::DetectionConfig;
 
+// What a setting's names say of its wall rule.
+std::string WallsSuffix(const Detection& d) {
+  return d.behind_walls == Detection::BehindWalls::kRefuse ? ", nothing behind walls" : "";
+}
+
 // The echo rule of a setting, as the CSV, the plot's legend and the item's name give it.
 std::string EchoRule(const Detection& d) {
-  const std::string walls =
-      d.behind_walls == Detection::BehindWalls::kRefuse ? ", nothing behind walls" : "";
+  const std::string walls = WallsSuffix(d);
   if (d.max_obstacles == 1) return "first echo" + walls;
   return std::to_string(d.max_obstacles) + " echoes, " + io::LaterEchoesName(d.later_echoes) +
          walls;
@@ -197,9 +201,7 @@ void WritePlot(const std::string& path, const std::vector<DetectorRow>& rows, bo
     const std::string name =
         d.method == Detection::Method::kThreshold
             ? "threshold, " + EchoRule(d)
-            : std::string(io::DetectionMethodName(d.method)) + ", each echo rule" +
-                  (d.behind_walls == Detection::BehindWalls::kRefuse ? ", nothing behind walls"
-                                                                     : "");
+            : std::string(io::DetectionMethodName(d.method)) + ", each echo rule" + WallsSuffix(d);
     auto [it, added] = order.emplace(name, series.size());
     if (added) series.push_back({name, colours[series.size() % colours.size()], {}, {}});
     const MapMetrics& m = log ? *row.log : row.scene;

@@ -104,59 +104,60 @@ struct Judged {
   std::vector<std::string> missed;
 };
 
+// One figure f of part p judged, into `out`: at the scene's mapping (the last setting) and, if
+// there are others, over them. Null when the log or a run lacks it (NaN).
+json JudgeFigure(const Figures& log, const std::vector<Figures>& runs, std::size_t p, std::size_t f,
+                 double level_each, Judged& out) {
+  const std::size_t settings = log[p].size() - 1;
+  std::vector<double> at_scene;
+  std::vector<std::vector<double>> by_setting;
+  bool finite = true;
+  for (std::size_t k = 0; k <= settings; ++k) finite = finite && std::isfinite(log[p][k][f]);
+  for (const Figures& run : runs) {
+    at_scene.push_back(run[p][settings][f]);
+    by_setting.emplace_back();
+    for (std::size_t k = 0; k <= settings; ++k) {
+      finite = finite && std::isfinite(run[p][k][f]);
+      if (k < settings) by_setting.back().push_back(run[p][k][f]);
+    }
+  }
+  if (!finite) return nullptr;
+  const std::string where = std::string(kAgreementFigures[f].first) + " (" + kParts[p].name + ")";
+  const auto miss = [&](const SpreadJudgement& j, const std::string& what) {
+    out.within = out.within && j.within;
+    if (j.within) return;
+    std::ostringstream text;
+    text << std::fixed << std::setprecision(3) << where << what << j.statistic << ", " << j.excess
+         << " beyond the bound " << j.bound;
+    out.missed.push_back(text.str());
+  };
+  const double value = log[p][settings][f];
+  const SpreadJudgement mapping = JudgeValue(value, at_scene, level_each);
+  json entry = {{"scene_mapping", JudgementJson(mapping)}};
+  entry["scene_mapping"]["log"] = value;
+  entry["scene_mapping"]["runs"] = at_scene;
+  std::ostringstream at;
+  at << std::fixed << std::setprecision(3) << " at the scene's mapping: " << value
+     << ", from the runs' mean ";
+  miss(mapping, at.str());
+  if (settings > 0) {
+    std::vector<double> log_settings;
+    for (std::size_t k = 0; k < settings; ++k) log_settings.push_back(log[p][k][f]);
+    const SpreadJudgement over = JudgeSettings(log_settings, by_setting, level_each);
+    entry["settings"] = JudgementJson(over);
+    miss(over, " over " + std::to_string(settings) + " settings: mean |difference| ");
+  }
+  return entry;
+}
+
 // Every judgement of `log` against `runs`; the last setting is the scene's mapping, the ones
-// before it the study's settings. A figure some run lacks (NaN) is not judged.
+// before it the study's settings.
 Judged JudgeAll(const Figures& log, const std::vector<Figures>& runs, double level_each) {
   Judged out;
-  const std::size_t settings = log[0].size() - 1;
   for (std::size_t p = 0; p < kPartCount; ++p) {
     json figures = json::object();
     for (std::size_t f = 0; f < kFigureCount; ++f) {
-      std::vector<double> at_scene;
-      std::vector<std::vector<double>> by_setting;
-      bool finite = std::isfinite(log[p][settings][f]);
-      for (const Figures& run : runs) {
-        at_scene.push_back(run[p][settings][f]);
-        by_setting.emplace_back();
-        for (std::size_t k = 0; k <= settings; ++k) {
-          finite = finite && std::isfinite(run[p][k][f]) && std::isfinite(log[p][k][f]);
-          if (k < settings) by_setting.back().push_back(run[p][k][f]);
-        }
-      }
-      const char* figure = kAgreementFigures[f].first;
-      if (!finite) {
-        figures[figure] = nullptr;
-        continue;
-      }
-      const std::string where = std::string(figure) + " (" + kParts[p].name + ")";
-      const SpreadJudgement mapping = JudgeValue(log[p][settings][f], at_scene, level_each);
-      json entry = {{"scene_mapping", JudgementJson(mapping)}};
-      entry["scene_mapping"]["log"] = log[p][settings][f];
-      entry["scene_mapping"]["runs"] = at_scene;
-      std::ostringstream why;
-      why << std::fixed << std::setprecision(3);
-      if (!mapping.within) {
-        why << where << " at the scene's mapping: " << log[p][settings][f] << ", "
-            << mapping.statistic << " from the runs' mean, " << mapping.excess
-            << " beyond the bound " << mapping.bound;
-        out.missed.push_back(why.str());
-      }
-      out.within = out.within && mapping.within;
-      if (settings > 0) {
-        std::vector<double> log_settings;
-        for (std::size_t k = 0; k < settings; ++k) log_settings.push_back(log[p][k][f]);
-        const SpreadJudgement over = JudgeSettings(log_settings, by_setting, level_each);
-        entry["settings"] = JudgementJson(over);
-        if (!over.within) {
-          std::ostringstream text;
-          text << std::fixed << std::setprecision(3) << where << " over " << settings
-               << " settings: mean |difference| " << over.statistic << ", " << over.excess
-               << " beyond the bound " << over.bound;
-          out.missed.push_back(text.str());
-        }
-        out.within = out.within && over.within;
-      }
-      figures[figure] = std::move(entry);
+      figures[kAgreementFigures[f].first] = JudgeFigure(log, runs, p, f, level_each, out);
     }
     out.parts.push_back(
         {{"name", kParts[p].name}, {"heads_deg", HeadsJson(kParts[p])}, {"figures", figures}});
