@@ -62,6 +62,7 @@ JobRequeue=1
 JobCompType=jobcomp/none
 AccountingStorageType=accounting_storage/none
 JobAcctGatherType=jobacct_gather/none
+SchedulerParameters=sched_interval=2,bf_interval=2
 NodeName=$host NodeAddr=127.0.0.1 CPUs=$(nproc) State=UNKNOWN
 PartitionName=bench Nodes=$host Default=YES MaxTime=INFINITE State=UP
 EOF
@@ -142,15 +143,16 @@ same "$work/out/one-$dataset" "$work/out/$dataset"
 same "$work/out/one-$study" "$work/out/$study"
 
 # A task killed mid-way: requeued once its shard (task K writes the sweeps s with s mod 4 = K - 1)
-# has a sweep on disk, and before it has all of them.
+# has a sweep complete (its record in .sonarbench-partial/, which a resume trusts), and before it
+# has all of them.
 shards=$(echo "${lines[0]}" | grep -oE -- '--array=1-[0-9]+' | grep -oE '[0-9]+$')
 scene=$(echo "${lines[0]}" | grep -oE 'scenes/[^ ]+\.yaml')
 share=$(( ($(grep -oE '^sweeps: *[0-9]+' "$scene" | grep -oE '[0-9]+$') + shards - 1) / shards ))
-written() {  # the sweeps of shard $2 in dataset $1
+written() {  # the complete sweeps of shard $2 in dataset $1
   local n=0 f
-  for f in "$1"/beams/sweep_*.bin; do
+  for f in "$1"/.sonarbench-partial/sweep_*.json; do
     [ -e "$f" ] || continue
-    f=${f##*sweep_}; f=$((10#${f%.bin}))
+    f=${f##*sweep_}; f=$((10#${f%.json}))
     [ $((f % shards)) -eq $(($2 - 1)) ] && n=$((n + 1))
   done
   echo "$n"
