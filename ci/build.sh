@@ -8,6 +8,8 @@ targets=()
 names=()
 while [ $# -ge 2 ] && [ "$1" = "--target" ]; do targets+=(--target "$2"); names+=("$2"); shift 2; done
 if [ ${#targets[@]} -gt 0 ]; then bash ci/install-deps.sh run; else bash ci/install-deps.sh; fi
+# three.js for report.html's 3D view (from the npm registry; without it the page says so).
+bash ci/install-three.sh
 build_dir=${SONARBENCH_BUILD_DIR:-build}
 werror=OFF
 if [ "${CI:-}" = "true" ]; then werror=ON; fi

@@ -15,7 +15,7 @@ packages=(
 case "${1:-all}" in
   run) ;;
   slurm) packages=(slurmctld slurmd slurm-client munge python3) ;;
-  all) packages+=(libxml2-utils python3 python3-numpy python3-matplotlib
+  all) packages+=(libxml2-utils python3 python3-numpy python3-matplotlib chromium
                   clang libclang-rt-14-dev libomp-14-dev) ;;
   *) echo "ci/install-deps.sh: expected 'run', 'slurm' or nothing, got '$1'" >&2; exit 2 ;;
 esac

@@ -21,6 +21,7 @@
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/report/report_page.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
+#include "sonarbench/sim/report/view3d.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
 #include "sonarbench/sim/world/ray_tracer.hpp"
@@ -342,6 +343,12 @@ void WriteLogMapOutputs(const std::string& out_dir, const LogMapResult& result,
   r.title = "sonarbench map: " + name;
   r.heading = "sonarbench map: " + name + (scored ? " against " + scene->name : "");
   r.intro_html = LogMapIntroHtml(result, scored ? scene : nullptr, cells);
+  std::vector<Eigen::Vector3d> path;
+  for (std::size_t b = 0; b < result.poses.size(); b += 10) {
+    path.push_back(result.poses[b].T_world_sonar.translation());
+  }
+  r.view3d_html = View3dHtml(cells, result.mapper->config().resolution_m,
+                             scored ? &*result.score : nullptr, path);
   WriteMapReport(out_dir, r);
 }
 

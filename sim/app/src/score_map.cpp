@@ -12,6 +12,7 @@
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/report/report_page.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
+#include "sonarbench/sim/report/view3d.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
 #include "sonarbench/sim/world/ray_tracer.hpp"
@@ -164,6 +165,8 @@ void WriteMapFileScoreOutputs(const std::string& out_dir, const Scene& scene,
   r.images = MapTruthImages(
       *s.map, s.score.truth, s.score.observable, s.score.detector_ghosts, s.sonar_start_m,
       scene.name + ", " + std::filesystem::path(s.map_file).filename().string());
+  r.view3d_html = View3dHtml(CollectMapCells(*s.map), s.file.resolution_m, &s.score,
+                             SonarPath(scene, ScenarioBeamCount(scene)));
   r.scene = &scene;
   r.score = &s.score;
   r.junit = {

@@ -28,6 +28,9 @@ SceneScore ScoreAgainstScene(const octomap::OcTree& map, const Scene& scene,
   if (labelled) s.metrics.labelled_ghost_split = SplitGhostsBy(map, s.truth, *labelled);
   s.verdict = Evaluate(scene.criteria, s.metrics);
   s.score_s = seconds(start);
+  for (const TriangleMesh& mesh : meshes) {
+    if (mesh.truth) s.surfaces.push_back(mesh);
+  }
   return s;
 }
 

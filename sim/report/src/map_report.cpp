@@ -17,7 +17,7 @@ std::string MapReportHtml(const MapReport& r) {
                         verdict)
        << r.intro_html;
   if (r.score) html << CriteriaHtml(*verdict) << MetricsHtml(r.score->metrics);
-  html << r.after_scores_html << ImagesHtmlAndEnd(r.images);
+  html << r.view3d_html << r.after_scores_html << ImagesHtmlAndEnd(r.images);
   return html.str();
 }
 

@@ -132,7 +132,13 @@ std::string HtmlPageStart(const std::string& title, const std::string& heading,
           ".pass{background:#d9f2d9}.acceptable{background:#fff3cd}.fail{background:#f8d7da}"
           ".verdict{font-size:1.5em;padding:.4em .8em;display:inline-block}"
           "figure{margin:1.5em 0}figcaption{max-width:60em}"
-          "img{max-width:100%;image-rendering:pixelated}</style></head><body>\n";
+          "img{max-width:100%;image-rendering:pixelated}"
+          ".view3d{position:relative;height:38em;background:#1e1e1e}"
+          ".view3d canvas{display:block;width:100%;height:100%}"
+          ".view3d-legend{position:absolute;top:.5em;left:.5em;padding:.3em .6em;"
+          "background:rgba(255,255,255,.85);font-size:.9em}.view3d-legend label{display:block}"
+          ".swatch{display:inline-block;width:.9em;height:.9em;margin:0 .4em;"
+          "vertical-align:middle;border:1px solid #555}</style></head><body>\n";
   html << "<h1>" << HtmlEscape(heading) << "</h1>\n";
   if (!verdict) return html.str();
   const Verdict& v = *verdict;

@@ -14,6 +14,7 @@
 #include "sonarbench/sim/report/map_report.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/report/report_page.hpp"
+#include "sonarbench/sim/report/view3d.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 
 namespace sonarbench::sim {
@@ -160,25 +161,23 @@ double TotalSeconds(const StageTimings& t) {
   return t.build_scene_s + t.simulate_s + t.map_s + t.ground_truth_s + t.score_s;
 }
 
-// Where the sonar was (the true path), every tenth beam: what the map views mark.
-std::vector<Eigen::Vector3d> SonarPath(const Scene& scene, std::size_t beams) {
-  std::vector<Eigen::Vector3d> path;
-  for (std::size_t b = 0; b < beams; b += 10) {
-    path.push_back(ScheduleBeam(scene, b).pose.T_world_sonar.translation());
-  }
-  return path;
-}
-
-std::vector<ReportImage> RenderImages(const Scene& scene, const ScenarioResult& result) {
+// The images and, beside them on the run's threads, the 3D view's section (`view3d_html`).
+std::vector<ReportImage> RenderImages(const Scene& scene, const ScenarioResult& result,
+                                      std::string& view3d_html) {
   const std::string name = scene.name + ", seed " + std::to_string(result.seed);
+  const std::vector<Eigen::Vector3d> path = SonarPath(scene, result.beams);
   std::vector<ReportImage> images(2);
   std::vector<ReportImage> map_images;
+  const octomap::OcTree& tree = result.mapper->tree();  // built once, then only read
   const std::function<void()> tasks[] = {
       [&] { images[1] = FanImage(result.first_sweep, name); },
       [&] {
-        map_images = MapTruthImages(result.mapper->tree(), result.score.truth,
-                                    result.score.observable, result.score.detector_ghosts,
-                                    result.sonar_start_m, name, SonarPath(scene, result.beams));
+        map_images = MapTruthImages(tree, result.score.truth, result.score.observable,
+                                    result.score.detector_ghosts, result.sonar_start_m, name, path);
+      },
+      [&] {
+        view3d_html =
+            View3dHtml(CollectMapCells(*result.mapper), tree.getResolution(), &result.score, path);
       },
       [&] { images[0] = PolarImage(result.first_sweep, name); }};
   RunTasks(result.threads, tasks);
@@ -211,6 +210,14 @@ std::string TimingHtml(const StageTimings& t) {
 }
 
 }  // namespace
+
+std::vector<Eigen::Vector3d> SonarPath(const Scene& scene, std::size_t beams) {
+  std::vector<Eigen::Vector3d> path;
+  for (std::size_t b = 0; b < beams; b += 10) {
+    path.push_back(ScheduleBeam(scene, b).pose.T_world_sonar.translation());
+  }
+  return path;
+}
 
 nlohmann::json SceneJson(const Scene& scene) {
   return {{"name", scene.name},
@@ -344,7 +351,7 @@ void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
   report.heading = "sonarbench scenario: " + scene.name;
   report.intro_html = ScenarioIntroHtml(scene, result);
   report.after_scores_html = TimingHtml(result.timings);
-  report.images = RenderImages(scene, result);
+  report.images = RenderImages(scene, result, report.view3d_html);
   report.json = ScenarioReportJson(scene, result);
   report.files = {"map.bt"};
   report.scene = &scene;

@@ -18,10 +18,11 @@ namespace sonarbench::sim {
 
 /// A map scored against a scene: what `run`, `score` and `map --scene` report.
 struct SceneScore {
-  mapping::KeySet truth;            ///< the scene's surface cells, at the map's resolution
-  mapping::KeySet observable;       ///< those a perfect sensor sees from the beams' poses
-  DirectEchoes direct;              ///< the beams' direct echoes
-  mapping::KeySet detector_ghosts;  ///< the ghosts no direct echo explains
+  mapping::KeySet truth;               ///< the scene's surface cells, at the map's resolution
+  mapping::KeySet observable;          ///< those a perfect sensor sees from the beams' poses
+  DirectEchoes direct;                 ///< the beams' direct echoes
+  mapping::KeySet detector_ghosts;     ///< the ghosts no direct echo explains
+  std::vector<TriangleMesh> surfaces;  ///< the truth's meshes (world frame), for the 3D view
   MapMetrics metrics;
   Verdict verdict;              ///< the metrics against the scene's criteria
   double ground_truth_s = 0.0;  ///< wall-clock time of truth and observable cells [s]

@@ -24,7 +24,8 @@ struct MapReport {
   std::string title;              ///< report.html's <title>, before " PASS" or " FAIL"
   std::string heading;            ///< its <h1>
   std::string intro_html;         ///< what was mapped, before the criteria
-  std::string after_scores_html;  ///< after the metrics (the run's timings)
+  std::string view3d_html;        ///< the 3D view (View3dHtml), after the metrics
+  std::string after_scores_html;  ///< after the 3D view (the run's timings)
   std::vector<ReportImage> images;
   nlohmann::json json;             ///< report.json but for the scores and files_sha256
   std::vector<std::string> files;  ///< what the command wrote beside, covered by files_sha256
@@ -34,9 +35,9 @@ struct MapReport {
 };
 
 /// Writes into `out_dir`, each file atomically: the images; with a score, junit.xml; report.html
-/// (the verdict, `intro_html`, criteria and metrics, `after_scores_html`, the images embedded);
-/// and, last, report.json: `json` with the verdict, criteria and metrics, and the sha256 of
-/// `files`, the images, junit.xml and report.html.
+/// (the verdict, `intro_html`, criteria and metrics, the 3D view, `after_scores_html`, the
+/// images embedded); and, last, report.json: `json` with the verdict, criteria and metrics, and the
+/// sha256 of `files`, the images, junit.xml and report.html.
 void WriteMapReport(const std::string& out_dir, const MapReport& report);
 
 }  // namespace sonarbench::sim

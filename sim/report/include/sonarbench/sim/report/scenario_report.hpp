@@ -33,6 +33,10 @@ inline constexpr int kScenarioReportSchema = 2;
 /// expected and margin, the verdict, mapping totals and stage timings.
 [[nodiscard]] nlohmann::json ScenarioReportJson(const Scene& scene, const ScenarioResult& result);
 
+/// Where the sonar was on the scene's true path [m], world frame, every tenth of its first
+/// `beams` beams: what the map views mark.
+[[nodiscard]] std::vector<Eigen::Vector3d> SonarPath(const Scene& scene, std::size_t beams);
+
 /// JUnit XML for a run that broke before it produced a result: one test case with an <error>
 /// (type "input_error" for bad input, "internal_error" for a bug or the environment).
 [[nodiscard]] std::string ErrorJunitXml(std::string_view scenario, std::string_view error_type,
