@@ -2,8 +2,8 @@
 #include <memory>
 
 #include "cli.hpp"
-#include "sonarbench/sim/app/numpy_export.hpp"
-#include "sonarbench/sim/app/rosbag_export.hpp"
+#include "sonarbench/io/numpy_export.hpp"
+#include "sonarbench/io/rosbag_export.hpp"
 
 namespace sonarbench::app {
 namespace {
@@ -17,13 +17,13 @@ struct ExportArgs {
 
 int Export(const ExportArgs& args) {
   if (args.out.ends_with(".npz")) {
-    sim::WriteNpzFromDataset(args.dataset, args.out, args.force);
+    io::WriteNpzFromDataset(args.dataset, args.out, args.force);
     std::cout << "wrote " << args.out << " (numpy.load reads it: docs/dataset-format.md)\n";
     return 0;
   }
-  io::RosbagContent bag = sim::RosbagFromDataset(args.dataset);
+  io::RosbagContent bag = io::RosbagFromDataset(args.dataset);
   bag.sound_speed_m_s = args.sound_speed;
-  sim::WriteRosbagFile(bag, args.out, args.force);
+  io::WriteRosbagFile(bag, args.out, args.force);
   std::cout << bag.beams.size() << " beams on " << io::kSonarTopic << ", /tf, /tf_static"
             << (bag.true_vehicle.empty() ? "" : std::string(", ") + io::kGroundTruthTopic)
             << (bag.labels.empty()

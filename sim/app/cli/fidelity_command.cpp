@@ -18,9 +18,9 @@
 #include "sonarbench/sim/app/map_fidelity.hpp"
 #include "sonarbench/sim/app/map_log.hpp"
 #include "sonarbench/sim/report/fidelity_report.hpp"
+#include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
-#include "sonarbench/sim/world/ray_tracer.hpp"
 
 namespace sonarbench::app {
 namespace {
@@ -85,15 +85,14 @@ int Fidelity(const FidelityArgs& args) {
   const std::vector<sonarbench::mapping::Beam> log_beams = ReadLogBeams(args.log);
   sim::CheckBeamsMapCells(log_beams, scene.sensor.geometry, scene.mapping.resolution_m,
                           args.budgets, args.log);
-  const auto meshes = sim::BuildSceneMeshes(scene);
+  const sim::SceneWorld world(scene);
   std::vector<std::string> inputs = sim::SceneInputFiles(scene);
   const std::vector<std::string> log_files = sim::LogInputFiles(args.log);
   inputs.insert(inputs.end(), log_files.begin(), log_files.end());
   sim::OutputDirectory out(args.out, OneShotClaim("fidelity", sim::kFidelityOutputFiles, inputs));
-  const sim::RayTracer tracer(meshes);
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   const auto synthesized = sim::SimulateScene(
-      scene, tracer, args.seed.value_or(scene.seed), args.threads,
+      scene, world.tracer, args.seed.value_or(scene.seed), args.threads,
       [&](std::size_t done, std::size_t total) { progress.Update("simulate", done, total); });
   progress.Clear();
   const std::vector<sonarbench::mapping::Beam> beams = sim::BeamsOf(synthesized);
@@ -107,6 +106,7 @@ int Fidelity(const FidelityArgs& args) {
     options.seed = args.seed;
     options.log = args.log;
     options.threads = args.threads;
+    options.world = &world;
     options.progress = [&](std::size_t done, std::size_t total) {
       progress.Update("maps", done, total);
     };

@@ -23,9 +23,9 @@
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/output_directory.hpp"
 #include "sonarbench/sim/report/report.hpp"
+#include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
-#include "sonarbench/sim/world/ray_tracer.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -371,9 +371,8 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   // The output directory checked, then the meshes' preflight, before the directory is made: bad
   // input leaves none.
   CheckOutputDirectory(dir);
-  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
-  const RayTracer tracer(meshes);
-  const BeamSynthesizer synthesizer = SceneSynthesizer(scene, tracer, seed);
+  const SceneWorld world(scene);
+  const BeamSynthesizer synthesizer = SceneSynthesizer(scene, world.tracer, seed);
   OutputClaim claim = DatasetClaim("simulate", summary.config_sha256, summary.sweeps_total, true,
                                    options.labels, options.force);
   claim.inputs = SceneInputFiles(scene);
@@ -423,7 +422,7 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
     // Other shards' sweeps are still due.
     if (!records.Vouched(s, SweepFiles(s, true, options.labels))) return summary;
   }
-  WritePosesAndTruth(root, scene, seed, beam_count, meshes);
+  WritePosesAndTruth(root, scene, seed, beam_count, world.meshes);
   const json manifest = SimulatedManifest(scene, summary, seed, beam_count, options.labels);
   Finalize(out, claim.files, manifest, records);
   summary.complete = true;

@@ -19,9 +19,9 @@
 #include "sonarbench/sim/eval/verdict.hpp"
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/report.hpp"
+#include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
-#include "sonarbench/sim/world/ray_tracer.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -367,12 +367,12 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
         SelectBeams(log->mapped, static_cast<std::size_t>(log->sensor.BeamsPerSweep()),
                     options.heads_deg, [&](std::size_t b) { poses.push_back(log->poses[b]); });
     log->poses = std::move(poses);
-    log_score = ScoreLogMap(*log, scene);
   }
-  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
-  const RayTracer tracer(meshes);
+  std::optional<SceneWorld> own_world;
+  const SceneWorld& world = options.world ? *options.world : own_world.emplace(scene);
+  if (log) log_score = ScoreLogMap(*log, scene, &world);
   const SimulatedScene simulated = SimulateForScoring(
-      scene, meshes, tracer, options.seed.value_or(scene.seed), options.threads, options.heads_deg);
+      scene, world, options.seed.value_or(scene.seed), options.threads, options.heads_deg);
   const Batches sim_beams =
       SelectBeams(simulated.beams, static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep()),
                   options.heads_deg);

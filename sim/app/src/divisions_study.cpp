@@ -20,9 +20,9 @@
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/output_directory.hpp"
 #include "sonarbench/sim/report/report.hpp"
+#include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
-#include "sonarbench/sim/world/ray_tracer.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -63,11 +63,10 @@ struct StudyInputs {
   std::vector<CoverageBeam> coverage_beams;
 };
 
-StudyInputs PrepareInputs(const Scene& scene, const std::vector<TriangleMesh>& meshes,
-                          std::uint64_t seed, int coverage_beams, int threads) {
+StudyInputs PrepareInputs(const Scene& scene, const SceneWorld& world, std::uint64_t seed,
+                          int coverage_beams, int threads) {
   StudyInputs in;
-  const RayTracer tracer(meshes);
-  in.simulated = SimulateForScoring(scene, meshes, tracer, seed, threads);
+  in.simulated = SimulateForScoring(scene, world, seed, threads);
   const std::vector<SynthesizedBeam>& synthesized = in.simulated.synthesized;
   const octomap::OcTree key_space(scene.mapping.resolution_m);
   const auto per_sweep = static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep());
@@ -264,7 +263,7 @@ std::optional<std::vector<json>> CollectItems(const fs::path& root, std::size_t 
 
 // Runs this shard's items that `root/items/` does not hold yet, each written as it finishes;
 // an item file of another configuration is refused. Counts them in `summary`.
-void RunShardItems(const Scene& scene, const std::vector<TriangleMesh>& meshes, std::uint64_t seed,
+void RunShardItems(const Scene& scene, const SceneWorld& world, std::uint64_t seed,
                    const std::vector<StudyItem>& items, const std::string& config,
                    const fs::path& root, const StudyOptions& options, StudySummary& summary) {
   std::vector<std::size_t> mine;
@@ -284,7 +283,7 @@ void RunShardItems(const Scene& scene, const std::vector<TriangleMesh>& meshes, 
       ++summary.items_skipped;
     } else {
       if (!inputs) {
-        inputs = PrepareInputs(scene, meshes, seed, options.coverage_beams, options.threads);
+        inputs = PrepareInputs(scene, world, seed, options.coverage_beams, options.threads);
       }
       json result = RunItem(scene, *inputs, items[i], options.threads);
       result["index"] = i;
@@ -309,7 +308,7 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
                  std::to_string(options.items.size()));
   CheckOutputDirectory(dir);
   // The meshes' preflight before the directory is made: bad input leaves none.
-  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
+  const SceneWorld world(scene);
   const std::vector<StudyItem> items =
       options.items.empty() ? DivisionsStudyItems() : options.items;
   const OutputClaim claim = StudyClaim(scene, config, items.size(), options.force);
@@ -319,7 +318,7 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
 
   StudySummary summary;
   summary.items_total = items.size();
-  RunShardItems(scene, meshes, seed, items, config, root, options, summary);
+  RunShardItems(scene, world, seed, items, config, root, options, summary);
 
   const std::optional<std::vector<json>> results = CollectItems(root, items.size(), config);
   if (!results) return summary;

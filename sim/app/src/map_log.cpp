@@ -22,9 +22,8 @@
 #include "sonarbench/sim/report/report_page.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
 #include "sonarbench/sim/report/view3d.hpp"
+#include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
-#include "sonarbench/sim/world/mesh.hpp"
-#include "sonarbench/sim/world/ray_tracer.hpp"
 
 namespace sonarbench::sim {
 
@@ -176,10 +175,10 @@ Eigen::Isometry3d StaticSonarPose(const Scene& scene) {
   return first;
 }
 
-SceneScore ScoreLogMap(const LogMapResult& result, const Scene& scene) {
-  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
-  const RayTracer tracer(meshes);
-  return ScoreAgainstScene(result.mapper->tree(), scene, meshes, tracer, result.poses,
+SceneScore ScoreLogMap(const LogMapResult& result, const Scene& scene, const SceneWorld* world) {
+  std::optional<SceneWorld> own;
+  if (!world) world = &own.emplace(scene);
+  return ScoreAgainstScene(result.mapper->tree(), scene, world->meshes, world->tracer, result.poses,
                            result.sensor);
 }
 

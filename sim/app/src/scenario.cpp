@@ -5,9 +5,8 @@
 #include <chrono>
 
 #include "sonarbench/sim/eval/ground_truth.hpp"
+#include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
-#include "sonarbench/sim/world/mesh.hpp"
-#include "sonarbench/sim/world/ray_tracer.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -33,12 +32,11 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
   result.threads = options.threads > 0 ? options.threads : omp_get_max_threads();
   Stopwatch clock;
 
-  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
-  for (const TriangleMesh& mesh : meshes)
+  const SceneWorld world(scene);
+  for (const TriangleMesh& mesh : world.meshes)
     result.meshes.push_back({mesh.name, mesh.triangles.size(), mesh.check});
   for (const TriangleMesh& part : BuildVehicleMeshes(scene))
     result.meshes.push_back({part.name, part.triangles.size(), part.check, true});
-  const RayTracer tracer(meshes);
   result.timings.build_scene_s = clock.Lap();
 
   auto report = [&](std::string_view stage) {
@@ -56,8 +54,8 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
                              g.bin_size_m, labelled.tolerance_m));
     }
   };
-  const std::vector<SynthesizedBeam> synthesized =
-      SimulateScene(scene, tracer, result.seed, result.threads, report("simulate"), take_labels);
+  const std::vector<SynthesizedBeam> synthesized = SimulateScene(
+      scene, world.tracer, result.seed, result.threads, report("simulate"), take_labels);
   result.beams = synthesized.size();
   result.timings.simulate_s = clock.Lap();
 
@@ -71,10 +69,9 @@ ScenarioResult RunScenario(const Scene& scene, const RunOptions& options) {
                             beams.begin() + static_cast<long>(std::min(per_sweep, beams.size())));
   result.timings.map_s = clock.Lap();
 
-  std::vector<BeamPose> poses;
-  for (std::size_t b = 0; b < synthesized.size(); ++b) poses.push_back(ScheduleBeam(scene, b).pose);
+  const std::vector<BeamPose> poses = TruePoses(scene, synthesized.size());
   if (!poses.empty()) result.sonar_start_m = poses.front().T_world_sonar.translation();
-  result.score = ScoreAgainstScene(result.mapper->tree(), scene, meshes, tracer, poses,
+  result.score = ScoreAgainstScene(result.mapper->tree(), scene, world.meshes, world.tracer, poses,
                                    scene.sensor.geometry, options.progress, &labelled);
   result.timings.ground_truth_s = result.score.ground_truth_s;
   result.timings.score_s = result.score.score_s;

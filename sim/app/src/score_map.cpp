@@ -13,9 +13,8 @@
 #include "sonarbench/sim/report/report_page.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
 #include "sonarbench/sim/report/view3d.hpp"
+#include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
-#include "sonarbench/sim/world/mesh.hpp"
-#include "sonarbench/sim/world/ray_tracer.hpp"
 
 namespace sonarbench::sim {
 namespace {
@@ -129,19 +128,15 @@ MapFileScore ScoreMapFile(const std::string& map_file, const Scene& scene, const
   s.map_file = map_file;
   s.map = io::ReadOcTreeFile(map_file, budgets.max_cells, &s.file);
   CheckTruthBudget(map_file, s.file.resolution_m, scene, budgets);
-  std::vector<BeamPose> poses;
-  for (std::size_t b = 0; b < ScenarioBeamCount(scene); ++b) {
-    poses.push_back(ScheduleBeam(scene, b).pose);
-  }
+  const std::vector<BeamPose> poses = TruePoses(scene, ScenarioBeamCount(scene));
   if (!poses.empty()) s.sonar_start_m = poses.front().T_world_sonar.translation();
   CheckFrame(s, scene, poses);
   s.read_s = SecondsSince(clock);
 
-  const std::vector<TriangleMesh> meshes = BuildSceneMeshes(scene);
-  CheckKeyRange(map_file, s.file.resolution_m, scene, meshes);
-  const RayTracer tracer(meshes);
+  const SceneWorld world(scene);
+  CheckKeyRange(map_file, s.file.resolution_m, scene, world.meshes);
   s.score =
-      ScoreAgainstScene(*s.map, scene, meshes, tracer, poses, scene.sensor.geometry,
+      ScoreAgainstScene(*s.map, scene, world.meshes, world.tracer, poses, scene.sensor.geometry,
                         [&progress](std::string_view stage, std::size_t done, std::size_t total) {
                           if (progress && stage == "observable") progress(done, total);
                         });

@@ -17,24 +17,24 @@ std::vector<std::uint8_t> DominantPaths(const SynthesizedBeam& beam) {
 
 }  // namespace
 
-SimulatedScene SimulateForScoring(const Scene& scene, const std::vector<TriangleMesh>& meshes,
-                                  const RayTracer& tracer, std::uint64_t seed, int threads,
+SimulatedScene SimulateForScoring(const Scene& scene, const SceneWorld& world, std::uint64_t seed,
+                                  int threads,
                                   const std::optional<std::pair<double, double>>& heads_deg) {
   SimulatedScene s;
-  s.synthesized =
-      SimulateScene(scene, tracer, seed, threads, {}, [&](std::span<const SynthesizedBeam> sweep) {
-        for (const SynthesizedBeam& beam : sweep) s.bin_paths.push_back(DominantPaths(beam));
-      });
+  s.synthesized = SimulateScene(scene, world.tracer, seed, threads, {},
+                                [&](std::span<const SynthesizedBeam> sweep) {
+                                  for (const SynthesizedBeam& beam : sweep)
+                                    s.bin_paths.push_back(DominantPaths(beam));
+                                });
   s.beams = BeamsOf(s.synthesized);
   const octomap::OcTree key_space(scene.mapping.resolution_m);
-  s.truth = VoxelizeMeshes(meshes, key_space);
-  std::vector<BeamPose> poses;
-  for (std::size_t b = 0; b < s.synthesized.size(); ++b) {
-    const BeamPose pose = ScheduleBeam(scene, b).pose;
-    if (!heads_deg || InHeads(pose.head_angle_rad, *heads_deg)) poses.push_back(pose);
+  s.truth = VoxelizeMeshes(world.meshes, key_space);
+  std::vector<BeamPose> poses = TruePoses(scene, s.synthesized.size());
+  if (heads_deg) {
+    std::erase_if(poses, [&](const BeamPose& p) { return !InHeads(p.head_angle_rad, *heads_deg); });
   }
-  s.observable = PerfectSensorCells(tracer, poses, scene.sensor.geometry, scene.sensor.acoustics,
-                                    key_space, {}, &s.direct);
+  s.observable = PerfectSensorCells(world.tracer, poses, scene.sensor.geometry,
+                                    scene.sensor.acoustics, key_space, {}, &s.direct);
   return s;
 }
 

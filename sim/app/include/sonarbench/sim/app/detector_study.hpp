@@ -12,6 +12,7 @@
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/sonar/bin_labels.hpp"
+#include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 
 namespace sonarbench::sim {
@@ -40,6 +41,8 @@ struct DetectorStudyOptions {
   /// one half of a sweep to fit a model on, the other to check it.
   std::optional<std::pair<double, double>> heads_deg;
   std::function<void(std::size_t done, std::size_t total)> progress;
+  /// The scene's world, when the caller has built it already; else the study builds it.
+  const SceneWorld* world = nullptr;
 };
 
 /// Whether `head_angle_rad` lies in [heads.first, heads.second) degrees, taken modulo 360.

@@ -9,6 +9,7 @@
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/app/certainty.hpp"
 #include "sonarbench/sim/eval/scene_score.hpp"
+#include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 
 namespace sonarbench::sim {
@@ -71,8 +72,9 @@ struct LogMapResult {
 
 /// Scores `result`'s map against `scene` as `sonarbench run` scores a simulated one
 /// (ScoreAgainstScene), from the poses the log's beams were mapped from and over the log's own
-/// beam geometry.
-[[nodiscard]] SceneScore ScoreLogMap(const LogMapResult& result, const Scene& scene);
+/// beam geometry, in the scene's `world` (built here when null).
+[[nodiscard]] SceneScore ScoreLogMap(const LogMapResult& result, const Scene& scene,
+                                     const SceneWorld* world = nullptr);
 
 /// The files WriteLogMapOutputs writes, relative to its `out_dir`.
 inline const std::vector<std::string> kLogMapOutputFiles = {

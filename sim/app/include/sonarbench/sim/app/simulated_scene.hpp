@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "sonarbench/sim/eval/ground_truth.hpp"
+#include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
-#include "sonarbench/sim/world/ray_tracer.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 
 namespace sonarbench::sim {
@@ -25,12 +25,11 @@ struct SimulatedScene {
   DirectEchoes direct;
 };
 
-/// Simulates `scene` with `seed` on `tracer` (built from `meshes`, the scene's) and voxelises its
-/// truth and observable cells; with `heads_deg`, the cells and echoes that the beams whose head
-/// angle lies in [first, second) degrees see (every beam is simulated and kept).
+/// Simulates `scene` with `seed` in its `world` and voxelises its truth and observable cells; with
+/// `heads_deg`, the cells and echoes that the beams whose head angle lies in [first, second)
+/// degrees see (every beam is simulated and kept).
 [[nodiscard]] SimulatedScene SimulateForScoring(
-    const Scene& scene, const std::vector<TriangleMesh>& meshes, const RayTracer& tracer,
-    std::uint64_t seed, int threads,
+    const Scene& scene, const SceneWorld& world, std::uint64_t seed, int threads,
     const std::optional<std::pair<double, double>>& heads_deg = std::nullopt);
 
 }  // namespace sonarbench::sim

@@ -5,12 +5,13 @@
 #include <vector>
 
 #include "sonarbench/io/dataset.hpp"
+#include "sonarbench/io/version.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 
 namespace sonarbench::sim {
 
 /// sonarbench's version: CMake's project(VERSION).
-inline constexpr const char* kVersion = SONARBENCH_VERSION;
+inline constexpr const char* kVersion = io::kVersion;
 
 /// The fields every JSON report starts with: its schema version and the tool that wrote it.
 [[nodiscard]] inline nlohmann::json ReportHeader() {

@@ -1,4 +1,4 @@
-#include "sonarbench/sim/app/numpy_export.hpp"
+#include "sonarbench/io/numpy_export.hpp"
 
 #include <filesystem>
 
@@ -6,11 +6,11 @@
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/labels.hpp"
 #include "sonarbench/io/npz.hpp"
+#include "sonarbench/io/version.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
-#include "sonarbench/sim/report/report.hpp"
 
-namespace sonarbench::sim {
+namespace sonarbench::io {
 namespace {
 
 namespace fs = std::filesystem;
@@ -27,19 +27,18 @@ void AppendPose(std::vector<double>& out, const Eigen::Isometry3d& pose) {
   out.insert(out.end(), {t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w()});
 }
 
-void AddStrings(io::NpzArchive& npz, const std::string& name,
-                const std::vector<std::string>& strings) {
-  const auto [bytes, width] = io::NumpyUnicode(strings);
+void AddStrings(NpzArchive& npz, const std::string& name, const std::vector<std::string>& strings) {
+  const auto [bytes, width] = NumpyUnicode(strings);
   npz.Add(name, "<U" + std::to_string(width), {strings.size()}, bytes);
 }
 
 // A simulated dataset's labels (ReadDatasetLabels: a beam each) as sweeps × beams × bins arrays,
 // beam b in slot b as the intensities are.
-void AddLabels(io::NpzArchive& npz, const std::vector<io::BeamLabels>& labels, const io::Dataset& d,
+void AddLabels(NpzArchive& npz, const std::vector<BeamLabels>& labels, const Dataset& d,
                std::size_t per_sweep, std::size_t bins) {
   const std::size_t cells = d.sweeps * per_sweep * bins;
-  std::vector<std::uint8_t> shares(cells * io::kEchoPaths, 0);
-  std::vector<std::uint16_t> mesh(cells, io::kNoLabelMesh);
+  std::vector<std::uint8_t> shares(cells * kEchoPaths, 0);
+  std::vector<std::uint16_t> mesh(cells, kNoLabelMesh);
   std::vector<float> point(cells * 3, std::nanf(""));
   for (std::size_t b = 0; b < labels.size(); ++b) {
     if (labels[b].shares.size() > bins) {
@@ -50,28 +49,28 @@ void AddLabels(io::NpzArchive& npz, const std::vector<io::BeamLabels>& labels, c
     for (std::size_t k = 0; k < labels[b].shares.size(); ++k) {
       const std::size_t at = b * bins + k;
       std::copy(labels[b].shares[k].begin(), labels[b].shares[k].end(),
-                shares.begin() + static_cast<std::ptrdiff_t>(at * io::kEchoPaths));
+                shares.begin() + static_cast<std::ptrdiff_t>(at * kEchoPaths));
       mesh[at] = labels[b].mesh[k];
       for (int i = 0; i < 3; ++i)
         point[at * 3 + static_cast<std::size_t>(i)] = labels[b].point_sonar_m[k][i];
     }
   }
-  npz.Add("label_shares", "|u1", {d.sweeps, per_sweep, bins, io::kEchoPaths}, Bytes(shares));
+  npz.Add("label_shares", "|u1", {d.sweeps, per_sweep, bins, kEchoPaths}, Bytes(shares));
   npz.Add("label_mesh", "<u2", {d.sweeps, per_sweep, bins}, Bytes(mesh));
   npz.Add("label_point_sonar_m", "<f4", {d.sweeps, per_sweep, bins, 3}, Bytes(point));
-  AddStrings(npz, "label_paths", {io::kEchoPathNames.begin(), io::kEchoPathNames.end()});
+  AddStrings(npz, "label_paths", {kEchoPathNames.begin(), kEchoPathNames.end()});
   AddStrings(npz, "mesh_names", d.manifest.value("meshes", std::vector<std::string>{}));
 }
 
 }  // namespace
 
 void WriteNpzFromDataset(const std::string& dir, const std::string& path, bool force) {
-  const io::Dataset d = io::ReadDataset(dir);
+  const Dataset d = ReadDataset(dir);
   const auto per_sweep = static_cast<std::size_t>(d.sensor.BeamsPerSweep());
   // The longest beam's bins: a truncated beam is padded with zeros (bin_count says where).
   std::size_t bins = static_cast<std::size_t>(d.sensor.num_bins);
   for (const mapping::Beam& beam : d.beams) bins = std::max(bins, beam.intensities.size());
-  ClaimExportFile(path, force, io::NpzComment(path).value_or("").rfind("sonarbench", 0) == 0,
+  ClaimExportFile(path, force, NpzComment(path).value_or("").rfind("sonarbench", 0) == 0,
                   "an .npz file");
   // A killed export's archive starts with the local header of its first array.
   RemoveDeadTemporaries(path, [](const std::string& head) {
@@ -98,7 +97,7 @@ void WriteNpzFromDataset(const std::string& dir, const std::string& path, bool f
     head[b] = beam.head_angle_rad;
     AppendPose(pose, beam.T_world_sonar);
   }
-  io::NpzArchive npz;
+  NpzArchive npz;
   npz.Add("intensities", "|u1", {d.sweeps, per_sweep, bins}, Bytes(intensities));
   npz.Add("valid", "|b1", {d.sweeps, per_sweep}, Bytes(valid));
   npz.Add("bin_count", "<u4", {d.sweeps, per_sweep}, Bytes(bin_count));
@@ -109,13 +108,12 @@ void WriteNpzFromDataset(const std::string& dir, const std::string& path, bool f
   npz.Add("bin_size_m", "<f8", {}, Bytes(bin_size));
   if (d.manifest.value("source", "") == "simulate") {
     std::vector<double> true_pose;
-    for (const io::StampedPose& p :
-         io::ReadTum((fs::path(dir) / "poses/sonar_true.tum").string())) {
+    for (const StampedPose& p : ReadTum((fs::path(dir) / "poses/sonar_true.tum").string())) {
       AppendPose(true_pose, p.pose);
     }
     true_pose.resize(slots * 7, 0.0);
     npz.Add("sonar_pose_true", "<f8", {d.sweeps, per_sweep, 7}, Bytes(true_pose));
-    const std::vector<io::BeamLabels> labels = io::ReadDatasetLabels(dir, d);
+    const std::vector<BeamLabels> labels = ReadDatasetLabels(dir, d);
     if (!labels.empty()) AddLabels(npz, labels, d, per_sweep, bins);
   }
   WriteFileAtomically(path, [&](std::ostream& out) {
@@ -123,4 +121,4 @@ void WriteNpzFromDataset(const std::string& dir, const std::string& path, bool f
   });
 }
 
-}  // namespace sonarbench::sim
+}  // namespace sonarbench::io

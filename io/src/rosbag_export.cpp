@@ -1,4 +1,4 @@
-#include "sonarbench/sim/app/rosbag_export.hpp"
+#include "sonarbench/io/rosbag_export.hpp"
 
 #include <filesystem>
 
@@ -6,11 +6,11 @@
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/labels.hpp"
 #include "sonarbench/io/mcap.hpp"
+#include "sonarbench/io/version.hpp"
 #include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/error.hpp"
-#include "sonarbench/sim/report/report.hpp"
 
-namespace sonarbench::sim {
+namespace sonarbench::io {
 namespace {
 
 namespace fs = std::filesystem;
@@ -23,17 +23,17 @@ std::string LibraryName() { return std::string("sonarbench ") + kVersion; }
 
 }  // namespace
 
-io::RosbagContent RosbagFromDataset(const std::string& dir) {
-  io::Dataset dataset = io::ReadDataset(dir);
-  io::RosbagContent bag;
+RosbagContent RosbagFromDataset(const std::string& dir) {
+  Dataset dataset = ReadDataset(dir);
+  RosbagContent bag;
   bag.sensor = dataset.sensor;
-  bag.labels = io::ReadDatasetLabels(dir, dataset);  // before the beams move out
+  bag.labels = ReadDatasetLabels(dir, dataset);  // before the beams move out
   bag.beams = std::move(dataset.beams);
   const fs::path vehicle_file = fs::path(dir) / "poses/vehicle.tum";
   const fs::path sonar_file = fs::path(dir) / "poses/sonar_true.tum";
   if (!fs::exists(vehicle_file) || !fs::exists(sonar_file)) return bag;
-  const auto vehicle = io::ReadTum(vehicle_file.string());
-  const auto sonar = io::ReadTum(sonar_file.string());
+  const auto vehicle = ReadTum(vehicle_file.string());
+  const auto sonar = ReadTum(sonar_file.string());
   if (vehicle.size() != bag.beams.size() || sonar.size() != bag.beams.size()) {
     throw InputError(vehicle_file.string() + ", " + sonar_file.string() +
                      ": expected a pose for each of the dataset's " +
@@ -53,14 +53,14 @@ io::RosbagContent RosbagFromDataset(const std::string& dir) {
   return bag;
 }
 
-void WriteRosbagFile(const io::RosbagContent& bag, const std::string& path, bool force) {
-  ClaimExportFile(path, force, io::McapLibrary(path).value_or("").rfind("sonarbench", 0) == 0,
+void WriteRosbagFile(const RosbagContent& bag, const std::string& path, bool force) {
+  ClaimExportFile(path, force, McapLibrary(path).value_or("").rfind("sonarbench", 0) == 0,
                   "an MCAP file");
   // A killed export's bag starts with the magic and a header naming sonarbench as its library.
   RemoveDeadTemporaries(path, [](const std::string& head) {
-    return head.starts_with(io::kMcapMagic) && head.find("sonarbench") != std::string::npos;
+    return head.starts_with(kMcapMagic) && head.find("sonarbench") != std::string::npos;
   });
-  WriteFileAtomically(path, [&](std::ostream& out) { io::WriteRosbag(out, bag, LibraryName()); });
+  WriteFileAtomically(path, [&](std::ostream& out) { WriteRosbag(out, bag, LibraryName()); });
 }
 
-}  // namespace sonarbench::sim
+}  // namespace sonarbench::io
