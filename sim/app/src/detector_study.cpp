@@ -371,8 +371,19 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
   std::optional<SceneWorld> own_world;
   const SceneWorld& world = options.world ? *options.world : own_world.emplace(scene);
   if (log) log_score = ScoreLogMap(*log, scene, &world);
-  const SimulatedScene simulated = SimulateForScoring(
-      scene, world, options.seed.value_or(scene.seed), options.threads, options.heads_deg);
+  std::optional<SimulatedScene> own_simulation;
+  if (!options.simulated) {
+    own_simulation.emplace(SimulateForScoring(scene, world, options.seed.value_or(scene.seed),
+                                              options.threads, options.heads_deg));
+  }
+  const SimulatedScene& simulated = options.simulated ? *options.simulated : *own_simulation;
+  // The cells seen from the chosen head angles: the simulation's own unless it saw from all.
+  std::optional<ObservedCells> part;
+  if (options.simulated && options.heads_deg) {
+    part = ObservedFrom(scene, world, simulated.synthesized.size(), options.heads_deg);
+  }
+  const mapping::KeySet& observable = part ? part->observable : simulated.observable;
+  const DirectEchoes& direct = part ? part->direct : simulated.direct;
   const Batches sim_beams =
       SelectBeams(simulated.beams, static_cast<std::size_t>(scene.sensor.geometry.BeamsPerSweep()),
                   options.heads_deg);
@@ -382,7 +393,7 @@ std::vector<DetectorRow> RunDetectorStudy(const Scene& scene, const DetectorStud
     DetectorRow row{
         item,
         MapAndScore(base, item.detection, scene.sensor.geometry, sim_beams, simulated.truth,
-                    simulated.observable, simulated.direct),
+                    observable, direct),
         std::nullopt,
         CountEchoPaths(item.detection, scene.sensor.geometry, sim_beams, simulated.bin_paths)};
     if (log) {

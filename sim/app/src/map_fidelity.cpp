@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "sonarbench/sim/app/simulated_scene.hpp"
 #include "sonarbench/sim/eval/seed_spread.hpp"
 #include "sonarbench/sim/eval/verdict.hpp"
 
@@ -30,9 +31,15 @@ json HeadsJson(const Part& part) {
   return part.heads_deg ? json::array({part.heads_deg->first, part.heads_deg->second}) : json();
 }
 
-// The study's rows for each part; `done(n)` after each setting of each part.
+// The study's rows for each part, from one simulation of the scene; `done(n)` after each setting
+// of each part.
 std::vector<std::vector<DetectorRow>> RowsByPart(const Scene& scene, DetectorStudyOptions options,
                                                  const std::function<void()>& done) {
+  std::optional<SceneWorld> own_world;
+  if (!options.world) options.world = &own_world.emplace(scene);
+  const SimulatedScene simulated =
+      SimulateForScoring(scene, *options.world, options.seed.value_or(scene.seed), options.threads);
+  options.simulated = &simulated;
   std::vector<std::vector<DetectorRow>> rows;
   for (const Part& part : kParts) {
     options.heads_deg = part.heads_deg;

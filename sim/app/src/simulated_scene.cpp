@@ -17,6 +17,19 @@ std::vector<std::uint8_t> DominantPaths(const SynthesizedBeam& beam) {
 
 }  // namespace
 
+ObservedCells ObservedFrom(const Scene& scene, const SceneWorld& world, std::size_t beams,
+                           const std::optional<std::pair<double, double>>& heads_deg) {
+  std::vector<BeamPose> poses = TruePoses(scene, beams);
+  if (heads_deg) {
+    std::erase_if(poses, [&](const BeamPose& p) { return !InHeads(p.head_angle_rad, *heads_deg); });
+  }
+  const octomap::OcTree key_space(scene.mapping.resolution_m);
+  ObservedCells seen;
+  seen.observable = PerfectSensorCells(world.tracer, poses, scene.sensor.geometry,
+                                       scene.sensor.acoustics, key_space, {}, &seen.direct);
+  return seen;
+}
+
 SimulatedScene SimulateForScoring(const Scene& scene, const SceneWorld& world, std::uint64_t seed,
                                   int threads,
                                   const std::optional<std::pair<double, double>>& heads_deg) {
@@ -29,12 +42,9 @@ SimulatedScene SimulateForScoring(const Scene& scene, const SceneWorld& world, s
   s.beams = BeamsOf(s.synthesized);
   const octomap::OcTree key_space(scene.mapping.resolution_m);
   s.truth = VoxelizeMeshes(world.meshes, key_space);
-  std::vector<BeamPose> poses = TruePoses(scene, s.synthesized.size());
-  if (heads_deg) {
-    std::erase_if(poses, [&](const BeamPose& p) { return !InHeads(p.head_angle_rad, *heads_deg); });
-  }
-  s.observable = PerfectSensorCells(world.tracer, poses, scene.sensor.geometry,
-                                    scene.sensor.acoustics, key_space, {}, &s.direct);
+  ObservedCells seen = ObservedFrom(scene, world, s.synthesized.size(), heads_deg);
+  s.observable = std::move(seen.observable);
+  s.direct = std::move(seen.direct);
   return s;
 }
 

@@ -18,6 +18,8 @@
 namespace sonarbench::sim {
 
 /// One setting of the detector study: the scene's detection with these changes.
+struct SimulatedScene;
+
 struct DetectorItem {
   std::string name;  ///< e.g. "threshold 110, 2 echoes, supported"
   mapping::DetectionConfig detection;
@@ -43,6 +45,9 @@ struct DetectorStudyOptions {
   std::function<void(std::size_t done, std::size_t total)> progress;
   /// The scene's world, when the caller has built it already; else the study builds it.
   const SceneWorld* world = nullptr;
+  /// The scene simulated at `seed` over every head angle (SimulateForScoring without heads), when
+  /// the caller has it already (one simulation for several parts); else the study simulates it.
+  const SimulatedScene* simulated = nullptr;
 };
 
 /// Whether `head_angle_rad` lies in [heads.first, heads.second) degrees, taken modulo 360.

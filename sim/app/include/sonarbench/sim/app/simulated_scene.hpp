@@ -25,6 +25,17 @@ struct SimulatedScene {
   DirectEchoes direct;
 };
 
+/// The cells a perfect sensor sees from the true poses of the scene's first `beams` beams, and
+/// their direct echoes; with `heads_deg`, of those whose head angle lies in [first, second)
+/// degrees.
+struct ObservedCells {
+  mapping::KeySet observable;
+  DirectEchoes direct;
+};
+[[nodiscard]] ObservedCells ObservedFrom(const Scene& scene, const SceneWorld& world,
+                                         std::size_t beams,
+                                         const std::optional<std::pair<double, double>>& heads_deg);
+
 /// Simulates `scene` with `seed` in its `world` and voxelises its truth and observable cells; with
 /// `heads_deg`, the cells and echoes that the beams whose head angle lies in [first, second)
 /// degrees see (every beam is simulated and kept).
