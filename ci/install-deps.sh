@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs, from Debian's archive, the packages sonarbench needs, and only those that are missing,
 # so it is cheap to call before every build. `run`: what builds the sonarbench program (and lets
-# CMake configure the tests beside it); `slurm`: the one-node cluster of ci/test-slurm.sh; no
-# argument: everything the tests and sanitizers use too.
+# CMake configure the tests beside it); `slurm`: the one-node cluster of ci/test-slurm.sh; `curl`
+# and `node`: what ci/install-three.sh and ci/install-npm.sh fetch with; no argument: everything
+# the tests and sanitizers use too.
 # Needs root (or sudo).
 set -euo pipefail
 
@@ -15,9 +16,11 @@ packages=(
 case "${1:-all}" in
   run) ;;
   slurm) packages=(slurmctld slurmd slurm-client munge python3) ;;
+  curl) packages=(curl ca-certificates) ;;
+  node) packages=(nodejs npm) ;;
   all) packages+=(libxml2-utils python3 python3-numpy python3-matplotlib chromium
                   clang libclang-rt-14-dev libomp-14-dev) ;;
-  *) echo "ci/install-deps.sh: expected 'run', 'slurm' or nothing, got '$1'" >&2; exit 2 ;;
+  *) echo "ci/install-deps.sh: expected run, slurm, curl, node or nothing, got '$1'" >&2; exit 2 ;;
 esac
 
 missing=()

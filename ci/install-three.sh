@@ -17,14 +17,7 @@ fi
 if [ -f "$dir/package/package.json" ] && grep -q "\"version\": \"$version\"" "$dir/package/package.json"; then
   exit 0
 fi
-if ! command -v curl > /dev/null; then
-  sudo=""
-  if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
-  echo "ci/install-three.sh: installing curl ca-certificates"
-  export DEBIAN_FRONTEND=noninteractive
-  $sudo apt-get update -q
-  $sudo apt-get install -y -q --no-install-recommends curl ca-certificates
-fi
+if ! command -v curl > /dev/null; then bash ci/install-deps.sh curl; fi
 registry=$(npm config get registry 2> /dev/null || echo https://registry.npmjs.org/)
 url="${registry%/}/three/-/three-$version.tgz"
 echo "ci/install-three.sh: fetching three $version for report.html's 3D view"

@@ -99,9 +99,6 @@ MapCells CollectMapCells(const mapping::Mapper& mapper) {
   return cells;
 }
 
-namespace {
-
-// Whether `cells` holds a cell within `k` cells (Chebyshev) of `key`.
 bool AnyWithin(const mapping::KeySet& cells, const Key& key, int k) {
   for (int dx = -k; dx <= k; ++dx) {
     for (int dy = -k; dy <= k; ++dy) {
@@ -115,6 +112,8 @@ bool AnyWithin(const mapping::KeySet& cells, const Key& key, int k) {
   }
   return false;
 }
+
+namespace {
 
 double F1(double precision, double recall) {
   const double sum = precision + recall;

@@ -46,21 +46,6 @@ bool KeyLess(const octomap::OcTreeKey& a, const octomap::OcTreeKey& b) {
   return std::tie(a[2], a[1], a[0]) < std::tie(b[2], b[1], b[0]);
 }
 
-// Whether a truth cell lies within 2 cells of `k` (Chebyshev): not a ghost, as ghost_share counts.
-bool NearTruth(const mapping::KeySet& truth, const octomap::OcTreeKey& k) {
-  for (int dz = -2; dz <= 2; ++dz) {
-    for (int dy = -2; dy <= 2; ++dy) {
-      for (int dx = -2; dx <= 2; ++dx) {
-        const octomap::OcTreeKey n(static_cast<std::uint16_t>(k[0] + dx),
-                                   static_cast<std::uint16_t>(k[1] + dy),
-                                   static_cast<std::uint16_t>(k[2] + dz));
-        if (truth.contains(n)) return true;
-      }
-    }
-  }
-  return false;
-}
-
 // The occupied cells by class against the score (all one class without it): map_top.png's, with
 // its "off surface" split at the ghosts' 2 cells; then the observable surface cells the map
 // missed. Each sorted, so the page's bytes do not follow hash order.
@@ -77,7 +62,7 @@ std::vector<CellClass> Classify(const MapCells& cells, const SceneScore* score) 
     for (const octomap::OcTreeKey& k : cells.occupied) {
       const int c = score->truth.contains(k)             ? 0
                     : score->detector_ghosts.contains(k) ? 2
-                    : NearTruth(score->truth, k)         ? 1
+                    : AnyWithin(score->truth, k, 2)      ? 1
                                                          : 3;
       classes[static_cast<std::size_t>(c)].keys.push_back(k);
     }

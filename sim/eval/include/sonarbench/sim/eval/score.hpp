@@ -110,6 +110,10 @@ struct MapMetrics {
                                                       const mapping::KeySet& truth,
                                                       const DirectEchoes& direct);
 
+/// Whether `cells` holds a cell within `k` cells (Chebyshev) of `key`: how the metrics' tolerances
+/// count (MapMetrics::precision_within).
+[[nodiscard]] bool AnyWithin(const mapping::KeySet& cells, const octomap::OcTreeKey& key, int k);
+
 /// Leaf cells of `map` at its finest resolution, split by occupancy.
 struct MapCells {
   mapping::KeySet occupied;
