@@ -17,14 +17,23 @@ mkdir -p "$state/spool" "$state/save" "$state/munge" "$state/log" "$work/out"
 chmod 700 "$state/munge"
 stop() {
   local code=$?
-  [ -f "$state/slurmd.pid" ] && kill "$(cat "$state/slurmd.pid")" 2>/dev/null || true
-  [ -f "$state/slurmctld.pid" ] && kill "$(cat "$state/slurmctld.pid")" 2>/dev/null || true
-  [ -f "$state/munge/munged.pid" ] && kill "$(cat "$state/munge/munged.pid")" 2>/dev/null || true
+  local pids=() pid
+  for f in "$state/slurmd.pid" "$state/slurmctld.pid" "$state/munge/munged.pid"; do
+    [ -f "$f" ] && pids+=("$(cat "$f")")
+  done
+  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
+  # A daemon writes its state as it stops: the folder goes once every one has exited (10 s at most).
+  for _ in $(seq 100); do
+    local alive=0
+    for pid in "${pids[@]}"; do kill -0 "$pid" 2>/dev/null && alive=1; done
+    [ "$alive" = 0 ] && break
+    sleep 0.1
+  done
   if [ "$code" -ne 0 ]; then
     echo "ci/test-slurm.sh: failed; the daemons' logs:" >&2
     tail -n 30 "$state"/log/*.log "$work"/out/*.log >&2 2>/dev/null || true
   fi
-  rm -rf "$work"
+  rm -rf "$work" || echo "ci/test-slurm.sh: warning: $work not removed" >&2
   exit "$code"
 }
 trap stop EXIT

@@ -271,8 +271,9 @@ std::vector<ReportImage> MapImages(const LogMapResult& result, const Scene* scen
   if (scene) {
     Eigen::Vector3d sonar = Eigen::Vector3d::Zero();
     if (!result.poses.empty()) sonar = result.poses.front().T_world_sonar.translation();
-    return MapTruthImages(result.mapper->tree(), result.score->truth, result.score->observable,
-                          result.score->detector_ghosts, sonar, scene->name + ", " + name);
+    return MapTruthImages(result.mapper->tree(), cells, result.score->truth,
+                          result.score->observable, result.score->detector_ghosts, sonar,
+                          scene->name + ", " + name);
   }
   MapView top;
   top.resolution_m = result.mapper->config().resolution_m;

@@ -157,11 +157,12 @@ void WriteMapFileScoreOutputs(const std::string& out_dir, const Scene& scene,
   r.title = "sonarbench: " + scene.name;
   r.heading = "sonarbench score: " + scene.name;
   r.intro_html = ScoreIntroHtml(scene, s);
+  const MapCells cells = CollectMapCells(*s.map);
   r.images = MapTruthImages(
-      *s.map, s.score.truth, s.score.observable, s.score.detector_ghosts, s.sonar_start_m,
+      *s.map, cells, s.score.truth, s.score.observable, s.score.detector_ghosts, s.sonar_start_m,
       scene.name + ", " + std::filesystem::path(s.map_file).filename().string());
-  r.view3d_html = View3dHtml(CollectMapCells(*s.map), s.file.resolution_m, &s.score,
-                             SonarPath(scene, ScenarioBeamCount(scene)));
+  r.view3d_html =
+      View3dHtml(cells, s.file.resolution_m, &s.score, SonarPath(scene, ScenarioBeamCount(scene)));
   r.scene = &scene;
   r.score = &s.score;
   r.junit = {

@@ -79,13 +79,13 @@ std::string Seconds(double seconds) {
   return text;
 }
 
-std::vector<ReportImage> MapTruthImages(const octomap::OcTree& map, const mapping::KeySet& truth,
+std::vector<ReportImage> MapTruthImages(const octomap::OcTree& map, const MapCells& cells,
+                                        const mapping::KeySet& truth,
                                         const mapping::KeySet& observable,
                                         const mapping::KeySet& detector_ghosts,
                                         const Eigen::Vector3d& side_slice_m,
                                         const std::string& name,
                                         const std::vector<Eigen::Vector3d>& sonar_path_m) {
-  const MapCells cells = CollectMapCells(map);
   MapView top;
   top.resolution_m = map.getResolution();
   top.title = name + ": map against truth, from above";

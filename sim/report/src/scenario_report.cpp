@@ -169,16 +169,14 @@ std::vector<ReportImage> RenderImages(const Scene& scene, const ScenarioResult& 
   std::vector<ReportImage> images(2);
   std::vector<ReportImage> map_images;
   const octomap::OcTree& tree = result.mapper->tree();  // built once, then only read
+  const MapCells cells = CollectMapCells(*result.mapper);
   const std::function<void()> tasks[] = {
       [&] { images[1] = FanImage(result.first_sweep, name); },
       [&] {
-        map_images = MapTruthImages(tree, result.score.truth, result.score.observable,
+        map_images = MapTruthImages(tree, cells, result.score.truth, result.score.observable,
                                     result.score.detector_ghosts, result.sonar_start_m, name, path);
       },
-      [&] {
-        view3d_html =
-            View3dHtml(CollectMapCells(*result.mapper), tree.getResolution(), &result.score, path);
-      },
+      [&] { view3d_html = View3dHtml(cells, tree.getResolution(), &result.score, path); },
       [&] { images[0] = PolarImage(result.first_sweep, name); }};
   RunTasks(result.threads, tasks);
   for (ReportImage& image : map_images) images.push_back(std::move(image));

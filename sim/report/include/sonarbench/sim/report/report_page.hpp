@@ -26,14 +26,15 @@ struct ReportImage {
   std::vector<unsigned char> png;
 };
 
-/// map_top.png and map_side.png: `map` against the truth (its `detector_ghosts` apart) from
-/// above, and in a slice 3 cells thick in y through `side_slice_m` [m, world frame]; `name` (the
-/// scene and seed, or the map) starts their titles. Both mark the sonar along `sonar_path_m`
-/// [m, world frame] (none given: at `side_slice_m`).
+/// map_top.png and map_side.png: the map's `cells` (CollectMapCells of `map`) against the truth
+/// (its `detector_ghosts` apart) from above, and in a slice 3 cells thick in y through
+/// `side_slice_m` [m, world frame]; `name` (the scene and seed, or the map) starts their titles.
+/// Both mark the sonar along `sonar_path_m` [m, world frame] (none given: at `side_slice_m`).
 [[nodiscard]] std::vector<ReportImage> MapTruthImages(
-    const octomap::OcTree& map, const mapping::KeySet& truth, const mapping::KeySet& observable,
-    const mapping::KeySet& detector_ghosts, const Eigen::Vector3d& side_slice_m,
-    const std::string& name, const std::vector<Eigen::Vector3d>& sonar_path_m = {});
+    const octomap::OcTree& map, const MapCells& cells, const mapping::KeySet& truth,
+    const mapping::KeySet& observable, const mapping::KeySet& detector_ghosts,
+    const Eigen::Vector3d& side_slice_m, const std::string& name,
+    const std::vector<Eigen::Vector3d>& sonar_path_m = {});
 
 /// polar.png and fan.png of a sweep (report.html's "first sweep" images); `name` starts their
 /// titles.
