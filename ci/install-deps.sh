@@ -3,7 +3,7 @@
 # so it is cheap to call before every build. `run`: what builds the sonarbench program (and lets
 # CMake configure the tests beside it); `slurm`: the one-node cluster of ci/test-slurm.sh; `curl`
 # and `node`: what ci/install-three.sh and ci/install-npm.sh fetch with; no argument: everything
-# the tests and sanitizers use too.
+# the tests, the sanitizers and the Python module use too.
 # Needs root (or sudo).
 set -euo pipefail
 
@@ -18,7 +18,8 @@ case "${1:-all}" in
   slurm) packages=(slurmctld slurmd slurm-client munge python3) ;;
   curl) packages=(curl ca-certificates) ;;
   node) packages=(nodejs npm) ;;
-  all) packages+=(libxml2-utils python3 python3-numpy python3-matplotlib chromium
+  all) packages+=(libxml2-utils pybind11-dev python3-dev python3-numpy python3-matplotlib
+                  python3-pytest chromium
                   clang libclang-rt-14-dev libomp-14-dev) ;;
   *) echo "ci/install-deps.sh: expected run, slurm, curl, node or nothing, got '$1'" >&2; exit 2 ;;
 esac

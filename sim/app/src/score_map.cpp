@@ -123,10 +123,20 @@ nlohmann::json Vector(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; 
 
 MapFileScore ScoreMapFile(const std::string& map_file, const Scene& scene, const Budgets& budgets,
                           const StageProgress& progress) {
-  auto clock = std::chrono::steady_clock::now();
+  const auto clock = std::chrono::steady_clock::now();
+  io::OcTreeFileInfo info;
+  std::unique_ptr<octomap::OcTree> map = io::ReadOcTreeFile(map_file, budgets.max_cells, &info);
+  return ScoreMapTree(std::move(map), map_file, info, scene, budgets, progress, clock);
+}
+
+MapFileScore ScoreMapTree(std::unique_ptr<octomap::OcTree> map, const std::string& map_file,
+                          const io::OcTreeFileInfo& info, const Scene& scene,
+                          const Budgets& budgets, const StageProgress& progress,
+                          std::chrono::steady_clock::time_point clock) {
   MapFileScore s;
   s.map_file = map_file;
-  s.map = io::ReadOcTreeFile(map_file, budgets.max_cells, &s.file);
+  s.map = std::move(map);
+  s.file = info;
   CheckTruthBudget(map_file, s.file.resolution_m, scene, budgets);
   const std::vector<BeamPose> poses = TruePoses(scene, ScenarioBeamCount(scene));
   if (!poses.empty()) s.sonar_start_m = poses.front().T_world_sonar.translation();

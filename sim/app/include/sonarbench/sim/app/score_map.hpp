@@ -3,6 +3,7 @@
 #include <octomap/OcTree.h>
 
 #include <Eigen/Core>
+#include <chrono>
 #include <memory>
 #include <string>
 #include <vector>
@@ -45,6 +46,14 @@ inline constexpr double kGhostShareWarning = 0.8;
 /// A map past kGhostShareWarning gets a warning in its verdict: a smaller offset shows as ghosts.
 [[nodiscard]] MapFileScore ScoreMapFile(const std::string& map_file, const Scene& scene,
                                         const Budgets& budgets, const StageProgress& progress = {});
+
+/// ScoreMapFile's scoring of a map already read (`info` as ReadOcTreeFile gives it; `map_file`
+/// names it in messages and reports), its read time counted from `read_start`.
+[[nodiscard]] MapFileScore ScoreMapTree(
+    std::unique_ptr<octomap::OcTree> map, const std::string& map_file,
+    const io::OcTreeFileInfo& info, const Scene& scene, const Budgets& budgets,
+    const StageProgress& progress = {},
+    std::chrono::steady_clock::time_point read_start = std::chrono::steady_clock::now());
 
 /// The files WriteMapFileScoreOutputs writes, relative to its `out_dir`, the record first.
 inline const std::vector<std::string> kMapFileScoreOutputFiles = {
