@@ -13,7 +13,7 @@
 #include <string>
 #include <string_view>
 
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 
 namespace sonarbench::fuzz {
 

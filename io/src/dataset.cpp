@@ -12,12 +12,12 @@
 #include <memory>
 #include <sstream>
 
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/io/text.hpp"
 #include "sonarbench/io/yaml_reader.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::io {
 namespace {

@@ -10,8 +10,8 @@
 #include <cstring>
 #include <filesystem>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench {
 

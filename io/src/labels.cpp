@@ -11,9 +11,9 @@
 #include <memory>
 #include <numeric>
 
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::io {
 namespace {

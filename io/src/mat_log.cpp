@@ -12,9 +12,9 @@
 #include <string>
 
 #include "mat_v5.hpp"
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/sensor_geometry.hpp"
 
 namespace sonarbench::io {

@@ -10,8 +10,8 @@
 #include <sstream>
 #include <type_traits>
 
+#include "sonarbench/base/atomic_file.hpp"
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
 
 namespace sonarbench::io::mat_v5 {
 namespace {

@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 
 namespace sonarbench::io::mat_v5 {
 

@@ -7,7 +7,7 @@
 #include <iterator>
 #include <stdexcept>
 
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 
 namespace sonarbench::io {
 namespace {

@@ -2,13 +2,13 @@
 
 #include <filesystem>
 
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/labels.hpp"
 #include "sonarbench/io/npz.hpp"
 #include "sonarbench/io/version.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::io {
 namespace {

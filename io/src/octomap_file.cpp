@@ -8,9 +8,10 @@
 #include <fstream>
 #include <optional>
 
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::io {
 namespace {
@@ -258,6 +259,17 @@ std::unique_ptr<octomap::OcTree> ReadOcTreeFile(const std::string& path, double 
   }
   if (info) *info = checked;
   return tree;
+}
+
+void WriteMapFile(const mapping::Mapper& mapper, const std::string& path, MapFormat format) {
+  // A failed write leaves `out` bad: WriteFileAtomically reports it with the OS's reason.
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    if (format == MapFormat::kFull) {
+      mapper.WriteFull(out);
+    } else {
+      mapper.WriteBinary(out);
+    }
+  });
 }
 
 }  // namespace sonarbench::io

@@ -4,8 +4,8 @@
 #include <cstring>
 #include <map>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::io::ros2 {
 namespace {

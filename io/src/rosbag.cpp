@@ -9,10 +9,10 @@
 #include <stdexcept>
 
 #include "ros2_messages.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::io {
 namespace {

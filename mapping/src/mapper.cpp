@@ -13,7 +13,6 @@
 #include "integrate.hpp"
 #include "key_set.hpp"
 #include "map_tree.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/detection.hpp"
 
 namespace sonarbench::mapping {
@@ -167,14 +166,9 @@ void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out) {
 }
 
 // Both write what the tree would, from the leaves' log-odds: the tree need not be built.
-void Mapper::WriteBinary(const std::string& path) const {
-  // A failed write leaves `out` bad: WriteFileAtomically reports it with the OS's reason.
-  WriteFileAtomically(path, [&](std::ostream& out) { state_->tree.WriteBinaryFromLeaves(out); });
-}
+void Mapper::WriteBinary(std::ostream& out) const { state_->tree.WriteBinaryFromLeaves(out); }
 
-void Mapper::WriteFull(const std::string& path) const {
-  WriteFileAtomically(path, [&](std::ostream& out) { state_->tree.WriteFullFromLeaves(out); });
-}
+void Mapper::WriteFull(std::ostream& out) const { state_->tree.WriteFullFromLeaves(out); }
 
 void Mapper::ForEachLeaf(
     const std::function<void(const octomap::OcTreeKey& key, bool occupied)>& f) const {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "sonarbench/io/octomap_file.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
@@ -37,7 +38,7 @@ double SimulateAndMap(const char* scene_path, std::uint64_t seed, int threads,
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (map_path != nullptr) mapper.WriteBinary(map_path);
+  if (map_path != nullptr) io::WriteMapFile(mapper, map_path, io::MapFormat::kBinary);
   return seconds;
 }
 

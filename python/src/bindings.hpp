@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/labels.hpp"
 #include "sonarbench/mapping/beam.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 

@@ -4,6 +4,7 @@
 
 #include "bindings.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
+#include "sonarbench/io/octomap_file.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/world/budget.hpp"
 #include "sonarbench/sim/world/sensor_model.hpp"
@@ -102,11 +103,7 @@ class PyMapper {
       throw InputError(path + ": exists; pass overwrite=True to replace it");
     }
     const py::gil_scoped_release release;
-    if (full) {
-      mapper_->WriteFull(path);
-    } else {
-      mapper_->WriteBinary(path);
-    }
+    io::WriteMapFile(*mapper_, path, full ? io::MapFormat::kFull : io::MapFormat::kBinary);
   }
 
   [[nodiscard]] const mapping::Mapper& mapper() const { return *mapper_; }

@@ -1,7 +1,7 @@
 // The extension module sonarbench._core; python/sonarbench/__init__.py re-exports it.
 #include "bindings.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/version.hpp"
-#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::python {
 

@@ -3,7 +3,7 @@
 #include <limits>
 
 #include "bindings.hpp"
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 
 namespace sonarbench::python {
 namespace {

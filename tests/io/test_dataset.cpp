@@ -5,8 +5,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/dataset.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
 #include "sonarbench/sim/world/mesh.hpp"

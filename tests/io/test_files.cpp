@@ -6,7 +6,6 @@
 #include <future>
 
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
 #include "test_util.hpp"
 
 namespace sonarbench {
@@ -48,24 +47,6 @@ TEST(ReadFileBytes, AFileLargerThanItsBudgetIsRefusedByItsSize) {
   EXPECT_TRUE(test::ThrowsInputErrorWith([&] { (void)ReadFileBytes(path, 2047); },
                                          {"f.yaml: holds 2048 bytes, more than the 2047 bytes"}));
   EXPECT_EQ(CheckInputFile(path, 2048), 2048u);
-}
-
-// The temporary file is made new: a symlink planted under its name is refused, and the file it
-// names is left as it was.
-TEST(WriteFileAtomically, NeverWritesThroughAPlantedTemporaryName) {
-  test::TempDir dir;
-  const fs::path precious = dir.path() / "precious.txt";
-  std::ofstream(precious) << "precious";
-  const fs::path target = dir.path() / "out.txt";
-  fs::create_symlink(precious, target.string() + ".tmp." + std::to_string(::getpid()));
-  EXPECT_TRUE(test::ThrowsInputErrorWith(
-      [&] { WriteFileAtomically(target.string(), [](std::ostream& out) { out << "new"; }); },
-      {"out.txt: cannot be written", "File exists"}));
-  EXPECT_EQ(ReadFileBytes(precious.string(), 64), "precious");
-  EXPECT_FALSE(fs::exists(target));
-  fs::remove(target.string() + ".tmp." + std::to_string(::getpid()));
-  WriteFileAtomically(target.string(), [](std::ostream& out) { out << "new"; });
-  EXPECT_EQ(ReadFileBytes(target.string(), 64), "new");
 }
 
 TEST(ByteCount, IsExactBelowTenKibibytesAndThreeDigitsAbove) {

@@ -16,8 +16,8 @@
 #include <tuple>
 #include <vector>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/mat_log.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/app/map_log.hpp"
 #include "sonarbench/sim/app/scenario.hpp"

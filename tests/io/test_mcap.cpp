@@ -7,11 +7,11 @@
 #include <utility>
 #include <vector>
 
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/io/rosbag.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "test_util.hpp"
 
 namespace sonarbench {

@@ -9,8 +9,8 @@
 #include <tuple>
 #include <vector>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/octomap_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "test_util.hpp"
 
 namespace sonarbench {

@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "ros2_messages.hpp"
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/io/rosbag.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "test_util.hpp"
 
 namespace sonarbench {

@@ -8,8 +8,8 @@
 #include <tuple>
 #include <vector>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/world/scene.hpp"

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 
 namespace sonarbench::test {
 

@@ -5,10 +5,10 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "sonarbench/base/atomic_file.hpp"
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
 
 namespace sonarbench::app {

@@ -9,11 +9,11 @@
 #include <vector>
 
 #include "cli.hpp"
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mat_log.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/detector_study.hpp"
 #include "sonarbench/sim/app/map_fidelity.hpp"
 #include "sonarbench/sim/app/map_log.hpp"

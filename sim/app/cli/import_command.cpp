@@ -3,12 +3,12 @@
 #include <memory>
 
 #include "cli.hpp"
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mat_log.hpp"
 #include "sonarbench/io/mcap.hpp"
 #include "sonarbench/io/rosbag.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/world/sensor_model.hpp"
 
 namespace sonarbench::app {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "cli.hpp"
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/sim/report/report.hpp"
 
 int main(int argc, char** argv) {

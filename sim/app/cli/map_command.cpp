@@ -3,10 +3,10 @@
 #include <memory>
 
 #include "cli.hpp"
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/map_log.hpp"
 #include "sonarbench/sim/world/sensor_model.hpp"
 

@@ -4,9 +4,9 @@
 #include <optional>
 
 #include "cli.hpp"
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/scenario.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
 

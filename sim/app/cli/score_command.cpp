@@ -2,8 +2,8 @@
 #include <memory>
 
 #include "cli.hpp"
+#include "sonarbench/base/atomic_file.hpp"
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/sim/app/score_map.hpp"
 
 namespace sonarbench::app {

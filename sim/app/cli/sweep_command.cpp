@@ -2,9 +2,9 @@
 #include <memory>
 
 #include "cli.hpp"
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/divisions_study.hpp"
 
 namespace sonarbench::app {

@@ -3,10 +3,10 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "sonarbench/base/atomic_file.hpp"
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/labels.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
 
 namespace sonarbench::sim {
 namespace {

@@ -13,11 +13,11 @@
 #include <sstream>
 
 #include "dataset_resume.hpp"
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/labels.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
 #include "sonarbench/sim/report/images.hpp"

@@ -9,8 +9,8 @@
 #include <span>
 #include <sstream>
 
+#include "sonarbench/base/atomic_file.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/mapping/detection.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/app/map_log.hpp"

@@ -7,13 +7,14 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
 #include "sonarbench/io/mat_log.hpp"
+#include "sonarbench/io/octomap_file.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/report/images.hpp"
@@ -299,8 +300,8 @@ std::vector<ReportImage> WriteMapAndImages(const std::filesystem::path& dir,
         cells = CollectMapCells(*result.mapper);
         images = MapImages(result, scene, name, cells);
       },
-      [&] { result.mapper->WriteFull((dir / "map.ot").string()); },
-      [&] { result.mapper->WriteBinary((dir / "map.bt").string()); },
+      [&] { io::WriteMapFile(*result.mapper, (dir / "map.ot").string(), io::MapFormat::kFull); },
+      [&] { io::WriteMapFile(*result.mapper, (dir / "map.bt").string(), io::MapFormat::kBinary); },
       [&] { polar = PolarImage(result.first_sweep, name); }};
   RunTasks(result.mapper->config().threads, tasks);
   images.push_back(std::move(polar));

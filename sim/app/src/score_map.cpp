@@ -5,9 +5,9 @@
 #include <filesystem>
 #include <sstream>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/report/map_report.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/report/report_page.hpp"

@@ -6,8 +6,8 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "sonarbench/base/atomic_file.hpp"
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/world/criteria.hpp"

@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "figure.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/base/atomic_file.hpp"
 
 namespace sonarbench::sim {
 void WritePng(const std::string& path, const cv::Mat& image) {

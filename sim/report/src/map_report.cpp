@@ -2,7 +2,7 @@
 
 #include <sstream>
 
-#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/base/atomic_file.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
 

@@ -12,10 +12,10 @@
 #include <set>
 #include <stdexcept>
 
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::sim {
 namespace {

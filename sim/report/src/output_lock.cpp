@@ -5,8 +5,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/report/output_directory.hpp"
 
 // The run's lock file: opened safely, the writers' names in it (a line each), read back.

@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <sstream>
 
-#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/base/atomic_file.hpp"
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"
 

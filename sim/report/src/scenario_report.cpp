@@ -9,7 +9,7 @@
 
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/io/octomap_file.hpp"
 #include "sonarbench/sim/report/images.hpp"
 #include "sonarbench/sim/report/map_report.hpp"
 #include "sonarbench/sim/report/report.hpp"
@@ -343,7 +343,7 @@ std::string ErrorJunitXml(std::string_view scenario, std::string_view error_type
 void WriteScenarioOutputs(const std::string& out_dir, const Scene& scene,
                           const ScenarioResult& result) {
   CreateOutputDirectory(out_dir);
-  result.mapper->WriteBinary(out_dir + "/map.bt");
+  io::WriteMapFile(*result.mapper, out_dir + "/map.bt", io::MapFormat::kBinary);
   MapReport report;
   report.title = "sonarbench: " + scene.name;
   report.heading = "sonarbench scenario: " + scene.name;

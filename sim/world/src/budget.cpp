@@ -6,7 +6,7 @@
 #include <numbers>
 #include <vector>
 
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 
 namespace sonarbench::sim {

@@ -6,8 +6,8 @@
 #include <set>
 #include <sstream>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::sim {
 namespace {

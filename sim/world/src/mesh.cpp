@@ -4,8 +4,8 @@
 #include <map>
 #include <numbers>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/world/random.hpp"
 
 namespace sonarbench::sim {

@@ -21,9 +21,9 @@
 #include <vector>
 
 #include "collada_check.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/mapping/error.hpp"
 
 namespace sonarbench::sim {
 namespace {

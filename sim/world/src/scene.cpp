@@ -5,8 +5,8 @@
 #include <optional>
 #include <sstream>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/world/mesh_file.hpp"
 
 namespace sonarbench::sim {

@@ -5,9 +5,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/labels.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/app/map_log.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"

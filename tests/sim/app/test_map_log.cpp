@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "cli_util.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/mat_log.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/app/map_log.hpp"
 #include "sonarbench/sim/app/scenario.hpp"

@@ -5,8 +5,8 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/mapping/beam_cells.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/app/divisions_study.hpp"
 #include "sonarbench/sim/eval/beam_coverage.hpp"
 #include "test_util.hpp"

@@ -5,7 +5,7 @@
 #include <utility>
 
 #include "sim_fixtures.hpp"
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/world/mesh.hpp"

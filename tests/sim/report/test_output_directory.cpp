@@ -5,8 +5,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "sonarbench/base/atomic_file.hpp"
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
 #include "sonarbench/sim/report/output_directory.hpp"
 #include "test_util.hpp"
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <set>
 
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/eval/verdict.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"

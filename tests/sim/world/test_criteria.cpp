@@ -4,7 +4,7 @@
 #include <set>
 
 #include "sim_fixtures.hpp"
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/eval/verdict.hpp"
 #include "sonarbench/sim/report/scenario_report.hpp"

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/world/mesh.hpp"

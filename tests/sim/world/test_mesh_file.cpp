@@ -9,9 +9,9 @@
 #include <utility>
 #include <vector>
 
+#include "sonarbench/base/atomic_file.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/sim/world/mesh.hpp"
 #include "sonarbench/sim/world/mesh_file.hpp"
 #include "test_util.hpp"

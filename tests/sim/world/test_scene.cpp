@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "sim_fixtures.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/world/budget.hpp"

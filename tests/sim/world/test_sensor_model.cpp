@@ -9,8 +9,8 @@
 
 #include "cli_util.hpp"
 #include "sim_fixtures.hpp"
+#include "sonarbench/base/error.hpp"
 #include "sonarbench/io/mapping_yaml.hpp"
-#include "sonarbench/mapping/error.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/world/scene.hpp"

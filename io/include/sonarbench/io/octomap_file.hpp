@@ -6,6 +6,8 @@
 #include <memory>
 #include <string>
 
+#include "sonarbench/mapping/mapper.hpp"
+
 namespace sonarbench::io {
 
 /// What an OctoMap file holds, from its header and a walk over its nodes.
@@ -31,6 +33,12 @@ struct OcTreeFileInfo {
 [[nodiscard]] std::unique_ptr<octomap::OcTree> ReadOcTreeFile(const std::string& path,
                                                               double max_cells,
                                                               OcTreeFileInfo* info = nullptr);
+
+/// Writes `mapper`'s map to `path` atomically (WriteFileAtomically: an existing file is replaced
+/// only once the new one is whole): `.bt` (Mapper::WriteBinary) or, with kFull, `.ot`
+/// (Mapper::WriteFull). Throws EnvironmentError naming the file when the machine refuses.
+enum class MapFormat { kBinary, kFull };
+void WriteMapFile(const mapping::Mapper& mapper, const std::string& path, MapFormat format);
 
 /// The first line of each format, as OctoMap writes it.
 inline constexpr const char* kOcTreeBinaryHeader = "# Octomap OcTree binary file";

@@ -54,10 +54,11 @@ class Mapper {
   [[nodiscard]] const octomap::OcTree& tree() const;
   [[nodiscard]] const MapperConfig& config() const { return config_; }
 
-  /// Writes the map as an OctoMap binary `.bt` file (maximum-likelihood occupancy), atomically.
-  void WriteBinary(const std::string& path) const;
-  /// Writes the map as an OctoMap `.ot` file (full probabilities), atomically.
-  void WriteFull(const std::string& path) const;
+  /// Writes the map in OctoMap's binary `.bt` format (maximum-likelihood occupancy) to `out`;
+  /// a failed write leaves `out` bad.
+  void WriteBinary(std::ostream& out) const;
+  /// Writes the map in OctoMap's `.ot` format (full probabilities) to `out`.
+  void WriteFull(std::ostream& out) const;
   /// Calls `f` with each leaf of the map (a cell updated at least once) and whether it is
   /// occupied (isNodeOccupied), in no particular order. Like the writers, it does not need the
   /// tree built: for maps that tree() is never asked for, it never is.

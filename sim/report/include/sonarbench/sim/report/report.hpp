@@ -4,9 +4,9 @@
 #include <string>
 #include <vector>
 
+#include "sonarbench/base/atomic_file.hpp"
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/version.hpp"
-#include "sonarbench/mapping/atomic_file.hpp"
 
 namespace sonarbench::sim {
 

@@ -1,4 +1,4 @@
-#include "sonarbench/mapping/atomic_file.hpp"
+#include "sonarbench/base/atomic_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -13,7 +13,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "sonarbench/mapping/error.hpp"
+#include "sonarbench/base/error.hpp"
 
 namespace sonarbench {
 namespace {
