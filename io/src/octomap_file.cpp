@@ -202,17 +202,18 @@ OcTreeFileInfo CheckFile(const std::string& path, double max_cells, std::streamo
   Reader reader(in, path);
   OcTreeFileInfo info;
   if (in.peek() == std::char_traits<char>::eof()) {
-    reader.Fail(std::string("the file is empty; expected '") + kOcTreeBinaryHeader + "' or '" +
-                kOcTreeFullHeader + "' first");
+    reader.Fail(std::string("the file is empty; expected '") + mapping::kOctomapBinaryHeader +
+                "' or '" + mapping::kOctomapFullHeader + "' first");
   }
   const std::string first = reader.Line();
-  if (first.starts_with(kOcTreeBinaryHeader)) {
+  if (first.starts_with(mapping::kOctomapBinaryHeader)) {
     info.format = "bt";
-  } else if (first.starts_with(kOcTreeFullHeader)) {
+  } else if (first.starts_with(mapping::kOctomapFullHeader)) {
     info.format = "ot";
   } else {
-    reader.Fail("the first line is " + Quoted(first) + "; expected '" + kOcTreeBinaryHeader +
-                "' (.bt) or '" + kOcTreeFullHeader + "' (.ot)");
+    reader.Fail("the first line is " + Quoted(first) + "; expected '" +
+                mapping::kOctomapBinaryHeader + "' (.bt) or '" + mapping::kOctomapFullHeader +
+                "' (.ot)");
   }
   const Header header = reader.ReadHeader();
   info.tree_type = header.id;

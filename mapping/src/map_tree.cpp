@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "sonarbench/mapping/mapper.hpp"
+
 namespace sonarbench::mapping {
 namespace {
 
@@ -108,10 +110,11 @@ std::array<unsigned, 512> MortonOfTreeIndex() {
 
 }  // namespace
 
-void WriteOctomapBinaryHeader(const octomap::OcTree& tree, std::size_t nodes, std::ostream& out) {
-  // AbstractOccupancyOcTree::writeBinaryConst's header.
-  out << "# Octomap OcTree binary file\n# (feel free to add / change comments, but leave the first "
-         "line as it is!)\n#\n"
+void WriteOctomapHeader(const octomap::OcTree& tree, std::size_t nodes, bool full,
+                        std::ostream& out) {
+  // AbstractOccupancyOcTree::writeBinaryConst's header, and AbstractOcTree::write's.
+  out << (full ? kOctomapFullHeader : kOctomapBinaryHeader)
+      << "\n# (feel free to add / change comments, but leave the first line as it is!)\n#\n"
       << "id " << tree.getTreeType() << "\n"
       << "size " << nodes << "\n"
       << "res " << tree.getResolution() << "\n"
@@ -143,7 +146,7 @@ void MapTree::WriteBinaryFromLeaves(std::ostream& out) const {
   std::string data;
   std::size_t nodes = 0;
   if (!leaves.empty()) BinaryNode(leaves, 0, leaves.size(), 0, occ_prob_thres_log, data, nodes);
-  WriteOctomapBinaryHeader(*this, nodes, out);
+  WriteOctomapHeader(*this, nodes, false, out);
   out.write(data.data(), static_cast<std::streamsize>(data.size()));
 }
 
@@ -152,12 +155,7 @@ void MapTree::WriteFullFromLeaves(std::ostream& out) const {
   std::string data;
   std::size_t nodes = 0;
   if (!leaves.empty()) (void)FullNode(leaves, 0, leaves.size(), 0, data, nodes);
-  out << "# Octomap OcTree file\n# (feel free to add / change comments, but leave the first line "
-         "as it is!)\n#\n"
-      << "id " << getTreeType() << std::endl
-      << "size " << nodes << std::endl
-      << "res " << getResolution() << std::endl
-      << "data" << std::endl;
+  WriteOctomapHeader(*this, nodes, true, out);
   out.write(data.data(), static_cast<std::streamsize>(data.size()));
 }
 

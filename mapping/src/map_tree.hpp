@@ -37,8 +37,10 @@ class OcTreeBaseImpl<OcTreeNode, sonarbench::mapping::detail::ChildLinker> {
 
 namespace sonarbench::mapping {
 
-/// The header of OctoMap's binary `.bt` file (writeBinaryConst's) for `tree` holding `nodes` nodes.
-void WriteOctomapBinaryHeader(const octomap::OcTree& tree, std::size_t nodes, std::ostream& out);
+/// The header of OctoMap's binary `.bt` file (writeBinaryConst's) or, with `full`, of its `.ot`
+/// file (write's) for `tree` holding `nodes` nodes.
+void WriteOctomapHeader(const octomap::OcTree& tree, std::size_t nodes, bool full,
+                        std::ostream& out);
 
 /// OctoMap's OcTree, plus what parallel updates need: the log-odds of its leaves as batches
 /// leave them, kept in 8³-cell blocks beside the tree (as Bonxai keeps a map), each root octant's

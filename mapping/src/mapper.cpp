@@ -161,7 +161,7 @@ BatchStats Mapper::Integrate(std::span<const Beam> beams,
 }
 
 void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out) {
-  WriteOctomapBinaryHeader(tree, tree.size(), out);
+  WriteOctomapHeader(tree, tree.size(), false, out);
   tree.writeBinaryData(out);
 }
 

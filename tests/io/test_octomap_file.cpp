@@ -65,7 +65,7 @@ std::string FullBytes(const octomap::OcTree& tree) {
 // A .bt file of `size` nodes whose data is `data`.
 std::string BinaryFile(const std::string& size, const std::string& data,
                        const std::string& id = "OcTree", const std::string& res = "0.05") {
-  return std::string(io::kOcTreeBinaryHeader) + "\n# comment\nid " + id + "\nsize " + size +
+  return std::string(mapping::kOctomapBinaryHeader) + "\n# comment\nid " + id + "\nsize " + size +
          "\nres " + res + "\ndata\n" + data;
 }
 
@@ -137,7 +137,7 @@ TEST(OcTreeFile, BadFilesAreClearErrors) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::memcpy(nan_node.data(), &nan, sizeof nan);
   const std::string full_header =
-      std::string(io::kOcTreeFullHeader) + "\nid OcTree\nsize 1\nres 0.05\ndata\n";
+      std::string(mapping::kOctomapFullHeader) + "\nid OcTree\nsize 1\nres 0.05\ndata\n";
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"# Octomap something else\n", "first line"},
       {"", "empty"},
@@ -149,9 +149,9 @@ TEST(OcTreeFile, BadFilesAreClearErrors) {
       {BinaryFile(std::to_string(SampleTree().size() + 1), data), "'size'"},
       {BinaryFile(size, data.substr(0, data.size() - 1)), "truncated"},
       {BinaryFile(size, data + "\n"), "bytes follow"},
-      {std::string(io::kOcTreeBinaryHeader) + "\nid OcTree\nsize 1\n", "'data'"},
-      {std::string(io::kOcTreeBinaryHeader) + "\nid OcTree\ncolour blue\ndata\n", "line 3"},
-      {std::string(io::kOcTreeBinaryHeader) + "\nid OcTree\nsize 1\ndata\n", "'res'"},
+      {std::string(mapping::kOctomapBinaryHeader) + "\nid OcTree\nsize 1\n", "'data'"},
+      {std::string(mapping::kOctomapBinaryHeader) + "\nid OcTree\ncolour blue\ndata\n", "line 3"},
+      {std::string(mapping::kOctomapBinaryHeader) + "\nid OcTree\nsize 1\ndata\n", "'res'"},
       {BinaryFile("18", deep), "level 16"},
       {BinaryFile("2", std::string("\x03\x00\x00\x00", 4)), "has none"},
       {BinaryFile("1", std::string("\x00\x00", 2)), "--max-cells"},  // a root leaf: 8^16 cells

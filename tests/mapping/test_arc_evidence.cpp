@@ -8,13 +8,14 @@
 
 #include "arc_evidence.hpp"
 #include "key_set.hpp"
+#include "mapping_grid.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 
 namespace sonarbench::mapping {
 namespace {
 
 // Cells are 5 cm; the Micron's wedge is 35° high, its two-way pattern -3 dB at ±17.5°.
-constexpr double kResolution = 0.05;
+using test::kResolution;
 constexpr double kWidthV = 35.0 * kDegToRad;
 const double kPatternK = 4.0 * std::log(2.0) / (kWidthV * kWidthV);
 

@@ -4,11 +4,12 @@
 
 #include "beam_volume.hpp"
 #include "integrate.hpp"
+#include "mapping_grid.hpp"
 
 namespace sonarbench::mapping {
 namespace {
 
-constexpr double kResolution = 0.05;
+using test::kResolution;
 
 // Half the diagonal of a cell: no point of a cell is farther than this from its centre.
 const double kHalfDiagonal = 0.5 * std::sqrt(3.0) * kResolution;

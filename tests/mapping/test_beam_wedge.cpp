@@ -7,12 +7,13 @@
 
 #include "beam_volume.hpp"
 #include "beam_wedge.hpp"
+#include "mapping_grid.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 
 namespace sonarbench::mapping {
 namespace {
 
-constexpr double kResolution = 0.05;
+using test::kResolution;
 
 Beam BeamAt(const Eigen::Vector3d& origin, double head_angle_rad, const Eigen::Vector3d& rpy) {
   Beam beam;

@@ -14,13 +14,14 @@
 #include "block_set.hpp"
 #include "integrate.hpp"
 #include "map_tree.hpp"
+#include "mapping_grid.hpp"
 #include "ray_keys.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 
 namespace sonarbench::mapping {
 namespace {
 
-constexpr double kResolution = 0.05;
+using test::kResolution;
 
 using Reference = std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHash>;
 

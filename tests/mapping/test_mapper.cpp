@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "key_set.hpp"
+#include "mapping_grid.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "test_util.hpp"
 
@@ -18,7 +19,7 @@ namespace {
 
 // Cells are 5 cm; a cell is named by its centre. The sonar sits at the origin looking along +x
 // (head angle 0): at 1 m its 3° × 35° wedge spans ±0.026 m across and ±0.315 m up and down.
-constexpr double kResolution = 0.05;
+using test::kResolution;
 
 const octomap::OcTreeNode* Cell(const Mapper& mapper, double x, double y, double z) {
   return mapper.tree().search(x, y, z);

@@ -133,16 +133,16 @@ void PrintVerdict(const std::string& name, const sonarbench::sim::Verdict& v) {
   for (const auto& reason : v.reasons) std::cout << "  " << reason << "\n";
 }
 
-sonarbench::sim::OutputClaim OneShotClaim(std::string command, std::vector<std::string> files,
-                                          std::vector<std::string> inputs) {
+io::OutputClaim OneShotClaim(std::string command, std::vector<std::string> files,
+                             std::vector<std::string> inputs) {
   namespace sim = sonarbench::sim;
   std::erase(inputs, std::string());
   std::string what = command;
   for (const std::string& input : inputs) what += "\n" + input;
-  sim::OutputClaim claim;
+  io::OutputClaim claim;
   claim.command = std::move(command);
   claim.config_sha256 = sonarbench::io::Sha256(what);
-  claim.mode = sim::OutputMode::kReplace;
+  claim.mode = io::OutputMode::kReplace;
   claim.record = files.front();
   claim.files = std::move(files);
   claim.inputs = std::move(inputs);

@@ -15,11 +15,11 @@
 #include <string_view>
 #include <vector>
 
+#include "sonarbench/io/output_directory.hpp"
 #include "sonarbench/mapping/mapper_config.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/eval/verdict.hpp"
-#include "sonarbench/sim/report/output_directory.hpp"
 #include "sonarbench/sim/world/budget.hpp"
 #include "sonarbench/sim/world/scene.hpp"
 
@@ -112,8 +112,8 @@ class ProgressLine {
 void PrintVerdict(const std::string& name, const sim::Verdict& v);
 /// What a one-shot command (run, map, fidelity) claims in its --out: `files`, the first of them the
 /// record, written last; the files it reads are never written or removed.
-[[nodiscard]] sim::OutputClaim OneShotClaim(std::string command, std::vector<std::string> files,
-                                            std::vector<std::string> inputs);
+[[nodiscard]] io::OutputClaim OneShotClaim(std::string command, std::vector<std::string> files,
+                                           std::vector<std::string> inputs);
 /// The --shard option's value, else a SLURM array job's shard, else the whole run.
 [[nodiscard]] sim::Shard ResolveShard(const std::string& option);
 

@@ -49,8 +49,8 @@ int Detectors(const DetectorsArgs& args) {
     const std::vector<std::string> log_files = sim::LogInputFiles(args.log);
     inputs.insert(inputs.end(), log_files.begin(), log_files.end());
   }
-  sim::OutputDirectory out(args.out,
-                           OneShotClaim("detectors", sim::kDetectorStudyFiles, std::move(inputs)));
+  io::OutputDirectory out(args.out,
+                          OneShotClaim("detectors", sim::kDetectorStudyFiles, std::move(inputs)));
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   options.progress = [&](std::size_t done, std::size_t total) {
     progress.Update("settings", done, total);

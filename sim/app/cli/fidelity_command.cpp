@@ -89,7 +89,7 @@ int Fidelity(const FidelityArgs& args) {
   std::vector<std::string> inputs = sim::SceneInputFiles(scene);
   const std::vector<std::string> log_files = sim::LogInputFiles(args.log);
   inputs.insert(inputs.end(), log_files.begin(), log_files.end());
-  sim::OutputDirectory out(args.out, OneShotClaim("fidelity", sim::kFidelityOutputFiles, inputs));
+  io::OutputDirectory out(args.out, OneShotClaim("fidelity", sim::kFidelityOutputFiles, inputs));
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   const auto synthesized = sim::SimulateScene(
       scene, world.tracer, args.seed.value_or(scene.seed), args.threads,

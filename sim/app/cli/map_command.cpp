@@ -63,7 +63,7 @@ int Map(const MapArgs& args) {
   }
   std::vector<std::string> files = sonarbench::sim::kLogMapOutputFiles;
   std::rotate(files.begin(), files.end() - 1, files.end());  // the record, report.json, first
-  sonarbench::sim::OutputDirectory out(args.out, OneShotClaim("map", files, inputs));
+  io::OutputDirectory out(args.out, OneShotClaim("map", files, inputs));
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   auto result = sonarbench::sim::MapLog(
       args.input, sensor, config, scene ? &*scene : nullptr, args.budgets,

@@ -46,8 +46,8 @@ void PrintSummary(const sonarbench::sim::Scene& scene, const sonarbench::sim::Sc
 
 // A run that broke leaves a junit.xml saying so (and no other output) for the CI system that
 // collects it; but an earlier complete result in --out stays as it was, whole.
-void CommitErrorJunit(sonarbench::sim::OutputDirectory& out, const RunArgs& args,
-                      std::string_view type, const std::string& message) {
+void CommitErrorJunit(io::OutputDirectory& out, const RunArgs& args, std::string_view type,
+                      const std::string& message) {
   try {
     out.DiscardStaged();
     if (out.HoldsRecord()) {
@@ -79,7 +79,7 @@ int Run(const RunArgs& args) {
   } catch (const std::exception&) {
     refused = std::current_exception();  // reported in junit.xml below
   }
-  sim::OutputDirectory out(
+  io::OutputDirectory out(
       args.out,
       OneShotClaim("run", files, loaded ? sim::SceneInputFiles(*loaded) : std::vector{args.scene}));
   try {

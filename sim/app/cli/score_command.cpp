@@ -24,8 +24,8 @@ int Score(const ScoreArgs& args) {
   sim::CheckBudgets(scene, args.budgets);
   std::vector<std::string> inputs = sim::SceneInputFiles(scene);
   inputs.push_back(args.map);
-  sim::OutputDirectory out(args.out,
-                           OneShotClaim("score", sim::kMapFileScoreOutputFiles, std::move(inputs)));
+  io::OutputDirectory out(args.out,
+                          OneShotClaim("score", sim::kMapFileScoreOutputFiles, std::move(inputs)));
   ProgressLine progress(ProgressLine::WantedFor(args.no_progress));
   const sim::MapFileScore file_score = sim::ScoreMapFile(
       args.map, scene, args.budgets,

@@ -17,11 +17,11 @@
 #include "sonarbench/base/error.hpp"
 #include "sonarbench/io/files.hpp"
 #include "sonarbench/io/labels.hpp"
+#include "sonarbench/io/output_directory.hpp"
 #include "sonarbench/io/text.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/eval/ground_truth.hpp"
 #include "sonarbench/sim/report/images.hpp"
-#include "sonarbench/sim/report/output_directory.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
@@ -49,12 +49,12 @@ std::string Number(double value) {
 
 // Every file a dataset of `sweeps` sweeps holds (with truth when simulated, label files when
 // `labels`), and the partial marker: what its output directory claims.
-OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sweeps,
-                         bool simulated, bool labels, bool force) {
-  OutputClaim claim;
+io::OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sweeps,
+                             bool simulated, bool labels, bool force) {
+  io::OutputClaim claim;
   claim.command = std::move(command);
   claim.config_sha256 = std::move(config);
-  claim.mode = OutputMode::kResume;
+  claim.mode = io::OutputMode::kResume;
   claim.files = {"manifest.json", kPartialMarker, "poses/sonar.tum"};
   if (simulated) {
     claim.files.insert(claim.files.end(),
@@ -72,7 +72,7 @@ OutputClaim DatasetClaim(std::string command, std::string config, std::size_t sw
 // Readies an owned dataset directory for `config` (truth/ only when `simulated`). Returns true when
 // a complete dataset of that very configuration is already there, every file the hash its
 // manifest gives (nothing to do).
-bool PrepareDirectory(const OutputDirectory& out, const std::string& config, bool simulated,
+bool PrepareDirectory(const io::OutputDirectory& out, const std::string& config, bool simulated,
                       ResumeRecords& records) {
   const fs::path& root = out.root();
   if (records.ManifestComplete()) return true;
@@ -87,8 +87,8 @@ bool PrepareDirectory(const OutputDirectory& out, const std::string& config, boo
 
 // Writes manifest.json over the claimed files present (sha256 and size), then drops the marker
 // and the sweeps' records.
-void Finalize(const OutputDirectory& out, const std::vector<std::string>& claimed, json manifest,
-              const ResumeRecords& records) {
+void Finalize(const io::OutputDirectory& out, const std::vector<std::string>& claimed,
+              json manifest, const ResumeRecords& records) {
   const fs::path& root = out.root();
   std::vector<std::string> files;
   for (const std::string& relative : claimed) {
@@ -373,10 +373,10 @@ DatasetSummary SimulateDataset(const Scene& scene, const std::string& dir,
   CheckOutputDirectory(dir);
   const SceneWorld world(scene);
   const BeamSynthesizer synthesizer = SceneSynthesizer(scene, world.tracer, seed);
-  OutputClaim claim = DatasetClaim("simulate", summary.config_sha256, summary.sweeps_total, true,
-                                   options.labels, options.force);
+  io::OutputClaim claim = DatasetClaim("simulate", summary.config_sha256, summary.sweeps_total,
+                                       true, options.labels, options.force);
   claim.inputs = SceneInputFiles(scene);
-  const OutputDirectory out(dir, claim);
+  const io::OutputDirectory out(dir, claim);
   ResumeRecords records(out.root(), summary.config_sha256);
   if (PrepareDirectory(out, summary.config_sha256, true, records)) {
     summary.complete = summary.already_complete = true;
@@ -445,11 +445,11 @@ DatasetSummary ImportLogDataset(const std::string& log_path, const ImportedLog& 
   if (!log.options.empty()) inputs["options"] = log.options;
   summary.config_sha256 = io::Sha256(inputs.dump());
   CheckOutputDirectory(dir);
-  OutputClaim claim =
+  io::OutputClaim claim =
       DatasetClaim("import", summary.config_sha256, summary.sweeps_total, false, false, force);
   claim.inputs = {log_path};
   if (!sensor_file.empty()) claim.inputs.push_back(sensor_file);
-  const OutputDirectory out(dir, claim);
+  const io::OutputDirectory out(dir, claim);
   ResumeRecords records(out.root(), summary.config_sha256);
   if (PrepareDirectory(out, summary.config_sha256, false, records)) {
     summary.complete = summary.already_complete = true;

@@ -11,6 +11,7 @@
 #include "sonarbench/base/error.hpp"
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/files.hpp"
+#include "sonarbench/io/output_directory.hpp"
 #include "sonarbench/mapping/mapper.hpp"
 #include "sonarbench/sim/app/dataset_writer.hpp"
 #include "sonarbench/sim/app/simulated_scene.hpp"
@@ -18,7 +19,6 @@
 #include "sonarbench/sim/eval/ground_truth.hpp"
 #include "sonarbench/sim/eval/score.hpp"
 #include "sonarbench/sim/report/images.hpp"
-#include "sonarbench/sim/report/output_directory.hpp"
 #include "sonarbench/sim/report/report.hpp"
 #include "sonarbench/sim/sonar/scene_world.hpp"
 #include "sonarbench/sim/sonar/simulation.hpp"
@@ -230,12 +230,12 @@ std::vector<StudyItem> DivisionsStudyItems() {
 namespace {
 
 // The study's claim on its output folder: its files, each item's, study.json last.
-OutputClaim StudyClaim(const Scene& scene, const std::string& config, std::size_t item_count,
-                       bool force) {
-  OutputClaim claim;
+io::OutputClaim StudyClaim(const Scene& scene, const std::string& config, std::size_t item_count,
+                           bool force) {
+  io::OutputClaim claim;
   claim.command = "sweep";
   claim.config_sha256 = config;
-  claim.mode = OutputMode::kResume;
+  claim.mode = io::OutputMode::kResume;
   claim.files = {"divisions.csv", "coverage_vs_divisions.png", "time_vs_divisions.png",
                  "study.json"};
   for (std::size_t i = 0; i < item_count; ++i) claim.files.push_back(ItemFile(i));
@@ -311,8 +311,8 @@ StudySummary RunDivisionsStudy(const Scene& original, const std::string& dir,
   const SceneWorld world(scene);
   const std::vector<StudyItem> items =
       options.items.empty() ? DivisionsStudyItems() : options.items;
-  const OutputClaim claim = StudyClaim(scene, config, items.size(), options.force);
-  const OutputDirectory out(dir, claim);
+  const io::OutputClaim claim = StudyClaim(scene, config, items.size(), options.force);
+  const io::OutputDirectory out(dir, claim);
   const fs::path& root = out.root();
   fs::create_directories(root / "items");
 

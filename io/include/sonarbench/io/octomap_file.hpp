@@ -40,8 +40,4 @@ struct OcTreeFileInfo {
 enum class MapFormat { kBinary, kFull };
 void WriteMapFile(const mapping::Mapper& mapper, const std::string& path, MapFormat format);
 
-/// The first line of each format, as OctoMap writes it.
-inline constexpr const char* kOcTreeBinaryHeader = "# Octomap OcTree binary file";
-inline constexpr const char* kOcTreeFullHeader = "# Octomap OcTree file";
-
 }  // namespace sonarbench::io

@@ -15,6 +15,10 @@
 
 namespace sonarbench::mapping {
 
+/// The first line of each OctoMap file format: binary `.bt` and full `.ot`, as OctoMap writes them.
+inline constexpr const char* kOctomapBinaryHeader = "# Octomap OcTree binary file";
+inline constexpr const char* kOctomapFullHeader = "# Octomap OcTree file";
+
 /// Writes `tree` in OctoMap's binary `.bt` format: the bytes OcTree::writeBinaryConst writes,
 /// without the " done." that Debian's liboctomap prints on stderr for each file.
 void WriteOctomapBinary(const octomap::OcTree& tree, std::ostream& out);

@@ -120,7 +120,7 @@ struct MapGoals {
 
 /// detectors.csv (a row per setting), precision_vs_recall_scene.png and, with a log,
 /// precision_vs_recall_log.png (precision against recall at one cell of tolerance) and study.json,
-/// into `dir` (a folder the caller owns, e.g. an OutputDirectory's write_root()).
+/// into `dir` (a folder the caller owns, e.g. an io::OutputDirectory's write_root()).
 void WriteDetectorStudy(const std::string& dir, const Scene& scene,
                         const DetectorStudyOptions& options, const std::vector<DetectorRow>& rows);
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace sonarbench::sim {
+namespace sonarbench::io {
 
 /// How a command's outputs meet the outputs already in its directory.
 enum class OutputMode {
@@ -129,4 +129,4 @@ class OutputDirectory {
 /// Every file of ReadOwnership's claims, with the marker and the lock; nullopt as there.
 [[nodiscard]] std::optional<std::vector<std::string>> OwnedFiles(const std::filesystem::path& dir);
 
-}  // namespace sonarbench::sim
+}  // namespace sonarbench::io

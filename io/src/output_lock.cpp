@@ -6,11 +6,11 @@
 #include <cstring>
 
 #include "sonarbench/base/error.hpp"
+#include "sonarbench/io/output_directory.hpp"
 #include "sonarbench/io/text.hpp"
-#include "sonarbench/sim/report/output_directory.hpp"
 
 // The run's lock file: opened safely, the writers' names in it (a line each), read back.
-namespace sonarbench::sim {
+namespace sonarbench::io {
 
 // Opens the lock file, never through a symlink and never one with another name (a hard link):
 // writing the holder's name would change a file elsewhere.
@@ -82,4 +82,4 @@ std::string OutputDirectory::Holder() const {
   return holder.empty() ? "holder unknown" : io::Quoted(holder, 200);
 }
 
-}  // namespace sonarbench::sim
+}  // namespace sonarbench::io

@@ -1,4 +1,4 @@
-#include "sonarbench/sim/report/output_directory.hpp"
+#include "sonarbench/io/output_directory.hpp"
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -17,7 +17,7 @@
 #include "sonarbench/io/dataset.hpp"
 #include "sonarbench/io/files.hpp"
 
-namespace sonarbench::sim {
+namespace sonarbench::io {
 namespace {
 
 namespace fs = std::filesystem;
@@ -582,4 +582,4 @@ void OutputDirectory::Release() noexcept {
   lock_fd_ = -1;
 }
 
-}  // namespace sonarbench::sim
+}  // namespace sonarbench::io

@@ -7,10 +7,10 @@
 
 #include "sonarbench/base/atomic_file.hpp"
 #include "sonarbench/io/files.hpp"
-#include "sonarbench/sim/report/output_directory.hpp"
+#include "sonarbench/io/output_directory.hpp"
 #include "test_util.hpp"
 
-namespace sonarbench::sim {
+namespace sonarbench::io {
 namespace {
 
 namespace fs = std::filesystem;
@@ -453,4 +453,4 @@ TEST(OutputDirectory, AReportWrittenBeforeMarkersOwnsTheOutputsItNames) {
 }
 
 }  // namespace
-}  // namespace sonarbench::sim
+}  // namespace sonarbench::io
