@@ -12,7 +12,6 @@
 #include "key_set.hpp"
 #include "mapping_grid.hpp"
 #include "sonarbench/mapping/mapper.hpp"
-#include "test_util.hpp"
 
 namespace sonarbench::mapping {
 namespace {
